@@ -1,0 +1,1 @@
+pub fn build() -> crate::scene::Scene { super::planebox::build() }
