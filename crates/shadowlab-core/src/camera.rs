@@ -20,6 +20,17 @@ fn default_fov() -> f32 { 60.0 }
 fn default_near() -> f32 { 0.1 }
 fn default_far() -> f32 { 100.0 }
 
+/// Right-handed view matrix (wgpu/D3D conventions below: NDC z in [0, 1], y up).
+pub fn look_at(eye: Vec3, center: Vec3, up: Vec3) -> Mat4 {
+    glam::camera::rh::view::look_at_mat4(eye, center, up)
+}
+pub fn perspective(fov_y_rad: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
+    glam::camera::rh::proj::directx::perspective(fov_y_rad, aspect, near, far)
+}
+pub fn orthographic(left: f32, right: f32, bottom: f32, top: f32, near: f32, far: f32) -> Mat4 {
+    glam::camera::rh::proj::directx::orthographic(left, right, bottom, top, near, far)
+}
+
 /// One keyframe of a camera path.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -38,10 +49,10 @@ impl Camera {
         if f.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y }
     }
     pub fn view(&self) -> Mat4 {
-        Mat4::look_at_rh(self.position, self.target, self.up())
+        look_at(self.position, self.target, self.up())
     }
     pub fn proj(&self, aspect: f32) -> Mat4 {
-        Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far)
+        perspective(self.fov_y_deg.to_radians(), aspect, self.near, self.far)
     }
     pub fn view_proj(&self, width: u32, height: u32) -> Mat4 {
         self.proj(width as f32 / height as f32) * self.view()

@@ -1,1 +1,172 @@
-//! (in progress)
+//! TOML setup files: everything a run needs, so runs are reproducible. Unknown keys are errors.
+//! Paths inside a setup are relative to the setup file.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::camera::Camera;
+use crate::light::Light;
+use crate::loaders::{SceneTransform, UpAxis};
+
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Setup {
+    pub scene: SceneSection,
+    #[serde(default)]
+    pub camera: Option<Camera>,
+    #[serde(default)]
+    pub lights: Vec<Light>,
+    #[serde(default)]
+    pub output: OutputSection,
+    #[serde(default)]
+    pub techniques: Vec<TechniqueEntry>,
+}
+
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSection {
+    /// A scene file (.gltf, .glb, .obj), relative to the setup file.
+    pub path: Option<PathBuf>,
+    /// Or a built-in scene name.
+    pub builtin: Option<String>,
+    #[serde(default)]
+    pub up: UpAxis,
+    #[serde(default = "one")]
+    pub scale: f32,
+    #[serde(default)]
+    pub offset: [f32; 3],
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSection {
+    #[serde(default = "default_size")]
+    pub width: u32,
+    #[serde(default = "default_size")]
+    pub height: u32,
+}
+
+fn default_size() -> u32 {
+    1024
+}
+
+impl Default for OutputSection {
+    fn default() -> Self {
+        OutputSection { width: 1024, height: 1024 }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TechniqueEntry {
+    pub spec: String,
+}
+
+/// Where the scene comes from, resolved against the setup's directory.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneSource {
+    Builtin(String),
+    File(PathBuf),
+}
+
+impl Setup {
+    pub fn parse(text: &str) -> Result<Setup, String> {
+        toml::from_str(text).map_err(|e| e.to_string())
+    }
+
+    /// Reads a setup file; errors name the file.
+    pub fn load(path: &Path) -> Result<Setup, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut s = Setup::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        if let Some(p) = &s.scene.path {
+            let base = path.parent().unwrap_or(Path::new("."));
+            s.scene.path = Some(base.join(p));
+        }
+        s.validate().map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(s)
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        self.scene_source()?;
+        if let Some(c) = &self.camera {
+            c.validate()?;
+        }
+        for l in &self.lights {
+            l.validate()?;
+        }
+        Ok(())
+    }
+
+    pub fn scene_source(&self) -> Result<SceneSource, String> {
+        match (&self.scene.path, &self.scene.builtin) {
+            (Some(p), None) => Ok(SceneSource::File(p.clone())),
+            (None, Some(b)) => Ok(SceneSource::Builtin(b.clone())),
+            (None, None) => Err("[scene] needs `path` or `builtin`".into()),
+            (Some(_), Some(_)) => Err("[scene] takes `path` or `builtin`, not both".into()),
+        }
+    }
+
+    pub fn transform(&self) -> SceneTransform {
+        SceneTransform { up: self.scene.up, scale: self.scene.scale, offset: Vec3::from(self.scene.offset) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    const EXAMPLE: &str = r#"
+[scene]
+path = "../../shared/scenes/sponza-dabrovic/sponza.obj"
+up = "y"
+scale = 1.0
+
+[camera]
+position = [-9.0, 2.0, 0.0]
+target = [9.0, 5.0, 0.0]
+fov_y_deg = 65.0
+near = 0.1
+far = 100.0
+
+[[lights]]
+type = "directional"
+direction = [0.35, -1.0, 0.25]
+
+[[lights]]
+type = "spot"
+position = [0.0, 5.0, 0.0]
+direction = [0.0, -1.0, 0.0]
+cone_deg = 35.0
+
+[output]
+width = 1024
+height = 768
+
+[[techniques]]
+spec = "sm:res=512,pcf=3"
+"#;
+    #[test]
+    fn parses_the_documented_form() {
+        let s = Setup::parse(EXAMPLE).unwrap();
+        s.validate().unwrap();
+        assert_eq!(s.output.height, 768);
+        assert_eq!(s.lights.len(), 2);
+        assert!(matches!(s.lights[1], Light::Spot { cone_deg, .. } if cone_deg == 35.0));
+        assert_eq!(s.techniques[0].spec, "sm:res=512,pcf=3");
+        assert_eq!(s.camera.unwrap().fov_y_deg, 65.0);
+    }
+    #[test]
+    fn unknown_keys_are_errors() {
+        let e = Setup::parse(&EXAMPLE.replace("fov_y_deg", "fovy")).unwrap_err();
+        assert!(e.contains("fovy"), "{e}");
+        assert!(Setup::parse("[scene]\nbuiltin='room'\nscael=2").is_err());
+        assert!(Setup::parse("[scene]\nbuiltin='room'\n[[lights]]\ntype='area'").is_err());
+        let both = Setup::parse("[scene]\nbuiltin='room'\npath='x.obj'").unwrap();
+        assert!(both.validate().is_err());
+    }
+}

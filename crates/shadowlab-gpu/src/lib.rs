@@ -1,1 +1,20 @@
-pub fn x(){}
+//! shadowlab-gpu: the wgpu side of shadowlab.
+//!
+//! Data flows one way: [`scene_gpu::GpuScene`] (buffers, BVH) -> [`gbuffer`] (position, normal,
+//! albedo, motion, evaluation mask) -> a [`techniques::Technique`] (its shadow data, then a
+//! visibility buffer) -> [`reference`] `rt` visibility on the same samples -> [`shade`].
+//! [`lab::Lab`] runs that flow for one view and hands back what metrics and reports need.
+
+pub mod binding;
+pub mod context;
+pub mod frame;
+pub mod gbuffer;
+pub mod lab;
+pub mod reference;
+pub mod scene_gpu;
+pub mod shade;
+pub mod shaders;
+pub mod techniques;
+pub mod timing;
+
+pub use context::{Gpu, GpuError};

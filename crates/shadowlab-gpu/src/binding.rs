@@ -1,0 +1,42 @@
+//! Terse bind group layouts: entries are numbered 0.. in the order given.
+
+use wgpu::{BindingType, BufferBindingType, ShaderStages};
+
+pub fn uniform() -> BindingType {
+    BindingType::Buffer { ty: BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None }
+}
+pub fn storage(read_only: bool) -> BindingType {
+    BindingType::Buffer { ty: BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None }
+}
+/// An unfilterable float texture read with `textureLoad` (G-buffer targets).
+pub fn texture_float() -> BindingType {
+    BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    }
+}
+pub fn texture_depth() -> BindingType {
+    BindingType::Texture { sample_type: wgpu::TextureSampleType::Depth, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false }
+}
+pub fn comparison_sampler() -> BindingType {
+    BindingType::Sampler(wgpu::SamplerBindingType::Comparison)
+}
+
+pub fn layout(device: &wgpu::Device, label: &str, vis: ShaderStages, types: &[BindingType]) -> wgpu::BindGroupLayout {
+    let entries: Vec<_> = types
+        .iter()
+        .enumerate()
+        .map(|(i, ty)| wgpu::BindGroupLayoutEntry { binding: i as u32, visibility: vis, ty: *ty, count: None })
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+}
+
+pub fn group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
+    let entries: Vec<_> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+}

@@ -1,0 +1,197 @@
+//! Device creation, buffer helpers and readback.
+
+use wgpu::util::DeviceExt;
+
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error("no GPU adapter found ({0}). On Debian/Ubuntu without a GPU install Mesa's software Vulkan: sudo apt-get install mesa-vulkan-drivers libvulkan1")]
+    NoAdapter(String),
+    #[error("could not open the GPU device: {0}")]
+    Device(String),
+    #[error("{0}")]
+    Invalid(String),
+    #[error("GPU error: {0}")]
+    Validation(String),
+}
+
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub limits: wgpu::Limits,
+    errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+}
+
+impl Gpu {
+    /// Opens the first high-performance adapter (any backend; lavapipe on GPU-less machines).
+    pub fn new() -> Result<Gpu, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("shadowlab"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits.clone(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+        let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(e.to_string())));
+        Ok(Gpu { device, queue, info, limits, errors })
+    }
+
+    /// Returns the first GPU validation/out-of-memory error raised since the last call.
+    pub fn take_error(&self) -> Result<(), GpuError> {
+        let first = self.errors.lock().unwrap().drain(..).next();
+        match first {
+            Some(msg) => Err(GpuError::Validation(msg)),
+            None => Ok(()),
+        }
+    }
+
+    /// "llvmpipe (Vulkan, Cpu)" and the like, for reports.
+    pub fn adapter_summary(&self) -> String {
+        format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
+    }
+
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Rejects output sizes of 0 or above the device's texture limit.
+    pub fn check_size(&self, width: u32, height: u32, what: &str) -> Result<(), GpuError> {
+        let max = self.limits.max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(GpuError::Invalid(format!("{what} {width}x{height} must be between 1 and {max} on this device")));
+        }
+        Ok(())
+    }
+
+    pub fn buffer_init(&self, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        // wgpu rejects empty buffers; keep one word so bindings stay valid.
+        let contents = if contents.is_empty() { &[0u8; 4][..] } else { contents };
+        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+    }
+
+    pub fn storage(&self, label: &str, size: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    pub fn uniform<T: bytemuck::Pod>(&self, label: &str, value: &T) -> wgpu::Buffer {
+        self.buffer_init(label, bytemuck::bytes_of(value), wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)
+    }
+
+    pub fn wait(&self) {
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+
+    /// Copies a buffer back to the CPU (blocking).
+    pub fn read_buffer(&self, src: &wgpu::Buffer) -> Vec<u8> {
+        let size = src.size();
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        self.map_and_take(&staging)
+    }
+
+    pub fn read_buffer_as<T: bytemuck::Pod>(&self, src: &wgpu::Buffer, count: usize) -> Vec<T> {
+        let bytes = self.read_buffer(src);
+        bytemuck::pod_collect_to_vec(&bytes[..count * std::mem::size_of::<T>()])
+    }
+
+    /// Copies a 2D texture (mip 0) back to the CPU as tightly packed rows.
+    pub fn read_texture(&self, tex: &wgpu::Texture, bytes_per_pixel: u32) -> Vec<u8> {
+        let (w, h) = (tex.width(), tex.height());
+        let row = w * bytes_per_pixel;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback-texture"),
+            size: (padded * h) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            tex.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        self.queue.submit([enc.finish()]);
+        let data = self.map_and_take(&staging);
+        let mut out = Vec::with_capacity((row * h) as usize);
+        for y in 0..h as usize {
+            out.extend_from_slice(&data[y * padded as usize..y * padded as usize + row as usize]);
+        }
+        out
+    }
+
+    fn map_and_take(&self, staging: &wgpu::Buffer) -> Vec<u8> {
+        let slice = staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait();
+        rx.recv().expect("map callback").expect("buffer map failed");
+        let data = slice.get_mapped_range().expect("mapped range").to_vec();
+        staging.unmap();
+        data
+    }
+
+    pub fn shader(&self, label: &str, source: &str) -> wgpu::ShaderModule {
+        self.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) })
+    }
+
+    /// A compute pipeline with explicit bind group layouts.
+    pub fn compute_pipeline(&self, label: &str, source: &str, entry: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::ComputePipeline {
+        let module = self.shader(label, source);
+        let layout = self.pipeline_layout(label, layouts);
+        self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    }
+
+    pub fn pipeline_layout(&self, label: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::PipelineLayout {
+        let opt: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
+        self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &opt, immediate_size: 0 })
+    }
+
+    /// Records one compute dispatch covering `w x h` threads in 8x8 groups.
+    pub fn dispatch_2d(&self, enc: &mut wgpu::CommandEncoder, label: &str, pipeline: &wgpu::ComputePipeline, groups: &[&wgpu::BindGroup], w: u32, h: u32) {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
+        for (i, g) in groups.iter().enumerate() {
+            pass.set_bind_group(i as u32, *g, &[]);
+        }
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+    }
+}

@@ -1,0 +1,161 @@
+//! G-buffer pass (position + linear depth, geometric normal, albedo, motion) and the evaluation
+//! mask for one light.
+
+use wgpu::TextureFormat as F;
+
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose;
+use crate::timing::StageTimer;
+use crate::{binding, Gpu};
+
+const GBUFFER_WGSL: &str = include_str!("gbuffer.wgsl");
+const MASK_WGSL: &str = include_str!("mask.wgsl");
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("gbuffer.wgsl", compose(GBUFFER_WGSL, true)), ("mask.wgsl", compose(MASK_WGSL, false))]
+}
+
+pub const POSITION_FORMAT: F = F::Rgba32Float;
+pub const NORMAL_FORMAT: F = F::Rgba32Float;
+pub const ALBEDO_FORMAT: F = F::Rgba8Unorm;
+pub const MOTION_FORMAT: F = F::Rg32Float;
+
+/// The G-buffer of one view. Position `w` is the linear view depth (0 where empty).
+pub struct GBuffer {
+    pub width: u32,
+    pub height: u32,
+    pub position: wgpu::Texture,
+    pub normal: wgpu::Texture,
+    pub albedo: wgpu::Texture,
+    pub motion: wgpu::Texture,
+    pub depth: wgpu::Texture,
+    /// u32 per pixel: 1 = evaluated for the current light.
+    pub mask: wgpu::Buffer,
+}
+
+fn target(gpu: &Gpu, label: &str, w: u32, h: u32, format: F, extra: wgpu::TextureUsages) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra,
+        view_formats: &[],
+    })
+}
+
+impl GBuffer {
+    pub fn new(gpu: &Gpu, w: u32, h: u32) -> GBuffer {
+        let c = wgpu::TextureUsages::COPY_SRC;
+        GBuffer {
+            width: w,
+            height: h,
+            position: target(gpu, "gbuffer.position", w, h, POSITION_FORMAT, c),
+            normal: target(gpu, "gbuffer.normal", w, h, NORMAL_FORMAT, c),
+            albedo: target(gpu, "gbuffer.albedo", w, h, ALBEDO_FORMAT, c),
+            motion: target(gpu, "gbuffer.motion", w, h, MOTION_FORMAT, c),
+            depth: target(gpu, "gbuffer.depth", w, h, F::Depth32Float, wgpu::TextureUsages::empty()),
+            mask: gpu.storage("gbuffer.mask", (w * h * 4) as u64),
+        }
+    }
+    pub fn pixels(&self) -> usize {
+        (self.width * self.height) as usize
+    }
+}
+
+/// Pipelines for the G-buffer and mask passes.
+pub struct GBufferPass {
+    raster: wgpu::RenderPipeline,
+    frame_layout: wgpu::BindGroupLayout,
+    mask: wgpu::ComputePipeline,
+    mask_layout: wgpu::BindGroupLayout,
+}
+
+impl GBufferPass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene) -> GBufferPass {
+        let d = &gpu.device;
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let frame_layout = binding::layout(d, "gbuffer.frame", vf, &[binding::uniform()]);
+        let module = gpu.shader("gbuffer", &compose(GBUFFER_WGSL, true));
+        let layout = gpu.pipeline_layout("gbuffer", &[&frame_layout, &scene.layout]);
+        let targets: Vec<Option<wgpu::ColorTargetState>> =
+            [POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT, MOTION_FORMAT].iter().map(|f| Some((*f).into())).collect();
+        let raster = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("gbuffer"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: F::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let c = wgpu::ShaderStages::COMPUTE;
+        let mask_layout = binding::layout(
+            d,
+            "mask",
+            c,
+            &[binding::uniform(), binding::uniform(), binding::texture_float(), binding::texture_float(), binding::storage(false)],
+        );
+        let mask = gpu.compute_pipeline("mask", &compose(MASK_WGSL, false), "main", &[&mask_layout]);
+        GBufferPass { raster, frame_layout, mask, mask_layout }
+    }
+
+    /// Rasterises the scene into `g` (stage `gbuffer`).
+    pub fn render(&self, gpu: &Gpu, timer: &mut StageTimer, scene: &GpuScene, frame: &wgpu::Buffer, g: &GBuffer) {
+        let group = binding::group(&gpu.device, "gbuffer.frame", &self.frame_layout, &[frame.as_entire_binding()]);
+        let views: Vec<wgpu::TextureView> = [&g.position, &g.normal, &g.albedo, &g.motion].iter().map(|t| t.create_view(&Default::default())).collect();
+        let depth = g.depth.create_view(&Default::default());
+        timer.stage(gpu, "gbuffer", |enc| {
+            let atts: Vec<Option<wgpu::RenderPassColorAttachment>> = views
+                .iter()
+                .map(|v| {
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: v,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                    })
+                })
+                .collect();
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gbuffer"),
+                color_attachments: &atts,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.raster);
+            pass.set_bind_group(0, &group, &[]);
+            pass.set_bind_group(1, &scene.group, &[]);
+            pass.draw(0..scene.triangle_count * 3, 0..1);
+        });
+    }
+
+    /// Writes `g.mask` for one light (stage `mask`).
+    pub fn mask(&self, gpu: &Gpu, timer: &mut StageTimer, frame: &wgpu::Buffer, light: &wgpu::Buffer, g: &GBuffer) {
+        let pv = g.position.create_view(&Default::default());
+        let nv = g.normal.create_view(&Default::default());
+        let group = binding::group(
+            &gpu.device,
+            "mask",
+            &self.mask_layout,
+            &[frame.as_entire_binding(), light.as_entire_binding(), wgpu::BindingResource::TextureView(&pv), wgpu::BindingResource::TextureView(&nv), g.mask.as_entire_binding()],
+        );
+        timer.stage(gpu, "mask", |enc| gpu.dispatch_2d(enc, "mask", &self.mask, &[&group], g.width, g.height));
+    }
+}

@@ -1,0 +1,150 @@
+//! The lab: one scene on the GPU, views prepared once (G-buffer, mask, reference), techniques
+//! run against them. The CLI and the integration tests both drive this.
+
+use std::collections::BTreeMap;
+
+use shadowlab_core::bvh::Bvh;
+use shadowlab_core::camera::Camera;
+use shadowlab_core::light::Light;
+use shadowlab_core::params::{ParamValues, TechniqueSpec};
+use shadowlab_core::scene::Scene;
+
+use crate::frame::{FrameUniform, LightUniform};
+use crate::gbuffer::{GBuffer, GBufferPass};
+use crate::scene_gpu::GpuScene;
+use crate::shade::ShadePass;
+use crate::techniques::{self, FrameInputs, TechniqueInfo, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{Gpu, GpuError};
+
+pub struct Lab<'a> {
+    pub gpu: &'a Gpu,
+    pub scene: &'a Scene,
+    pub bvh: Bvh,
+    pub gscene: GpuScene,
+    gbuffer_pass: GBufferPass,
+}
+
+/// One view of the scene for one light, with its G-buffer read back.
+pub struct View {
+    pub camera: Camera,
+    pub light: Light,
+    pub width: u32,
+    pub height: u32,
+    pub gbuffer: GBuffer,
+    pub frame: wgpu::Buffer,
+    pub light_buf: wgpu::Buffer,
+    pub visibility: wgpu::Buffer,
+    pub shade: ShadePass,
+    /// xyz world position, w linear depth (0 = empty).
+    pub position: Vec<[f32; 4]>,
+    pub normal: Vec<[f32; 4]>,
+    pub mask: Vec<u32>,
+    /// G-buffer and mask stage times (ms).
+    pub stages_ms: BTreeMap<String, f64>,
+}
+
+/// The result of one technique on one view.
+pub struct Run {
+    pub label: String,
+    pub technique: &'static str,
+    pub params: ParamValues,
+    pub visibility: Vec<f32>,
+    /// RGBA8 shaded picture.
+    pub shaded: Vec<u8>,
+    pub report: TechniqueReport,
+    /// Median per stage over the timed repetitions.
+    pub stages_ms: BTreeMap<String, f64>,
+    pub total_ms: f64,
+    /// Pipeline and resource creation (not part of total_ms).
+    pub setup_ms: f64,
+}
+
+impl<'a> Lab<'a> {
+    pub fn new(gpu: &'a Gpu, scene: &'a Scene) -> Result<Lab<'a>, GpuError> {
+        let bvh = Bvh::build(scene).map_err(GpuError::Invalid)?;
+        let gscene = GpuScene::new(gpu, scene, &bvh)?;
+        let gbuffer_pass = GBufferPass::new(gpu, &gscene);
+        gpu.take_error()?;
+        Ok(Lab { gpu, scene, bvh, gscene, gbuffer_pass })
+    }
+
+    /// Renders the G-buffer and the mask for `light`, and reads them back.
+    pub fn view(&self, camera: &Camera, prev: &Camera, light: &Light, width: u32, height: u32) -> Result<View, GpuError> {
+        let gpu = self.gpu;
+        gpu.check_size(width, height, "output size")?;
+        camera.validate().map_err(GpuError::Invalid)?;
+        light.validate().map_err(GpuError::Invalid)?;
+        let g = GBuffer::new(gpu, width, height);
+        let frame = gpu.uniform("frame", &FrameUniform::new(camera, prev, width, height));
+        let light_buf = gpu.uniform("light", &LightUniform::new(light, self.gscene.eps));
+        let mut timer = StageTimer::default();
+        self.gbuffer_pass.render(gpu, &mut timer, &self.gscene, &frame, &g);
+        self.gbuffer_pass.mask(gpu, &mut timer, &frame, &light_buf, &g);
+        gpu.take_error()?;
+        let position: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&g.position, 16));
+        let normal: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&g.normal, 16));
+        let mask: Vec<u32> = gpu.read_buffer_as(&g.mask, g.pixels());
+        let visibility = gpu.storage("visibility", g.pixels() as u64 * 4);
+        let shade = ShadePass::new(gpu, &g);
+        Ok(View {
+            camera: *camera,
+            light: *light,
+            width,
+            height,
+            gbuffer: g,
+            frame,
+            light_buf,
+            visibility,
+            shade,
+            position,
+            normal,
+            mask,
+            stages_ms: timer.medians(),
+        })
+    }
+
+    /// Resolves `spec`, creates the technique, runs it once to warm up and `repeat` more times
+    /// timed, then shades and reads back its visibility.
+    pub fn run(&self, view: &View, spec: &TechniqueSpec, repeat: usize) -> Result<Run, GpuError> {
+        let (info, params) = techniques::resolve(spec, Some(&view.light))?;
+        self.run_resolved(view, info, params, spec.label(), repeat)
+    }
+
+    pub fn run_resolved(&self, view: &View, info: &'static TechniqueInfo, params: ParamValues, label: String, repeat: usize) -> Result<Run, GpuError> {
+        let gpu = self.gpu;
+        let t0 = std::time::Instant::now();
+        let mut tech = (info.create)(gpu, &self.gscene, &params, &view.light)?;
+        gpu.take_error()?;
+        let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let inputs = FrameInputs {
+            scene: &self.gscene,
+            gbuffer: &view.gbuffer,
+            light: view.light,
+            light_buf: &view.light_buf,
+            frame: &view.frame,
+            visibility: &view.visibility,
+        };
+        let mut timer = StageTimer::default();
+        let mut warm = StageTimer::default();
+        tech.run(gpu, &inputs, &mut warm)?;
+        gpu.take_error()?;
+        for _ in 0..repeat.max(1) {
+            tech.run(gpu, &inputs, &mut timer)?;
+        }
+        gpu.take_error()?;
+        let stages_ms = timer.medians();
+        let total_ms = stages_ms.values().sum();
+        let visibility: Vec<f32> = gpu.read_buffer_as(&view.visibility, view.gbuffer.pixels());
+        let report = tech.report(gpu);
+        let mut shade_timer = StageTimer::default();
+        let shaded = view.shade.shade(gpu, &mut shade_timer, &view.frame, &view.light_buf, &view.gbuffer, &view.visibility);
+        gpu.take_error()?;
+        Ok(Run { label, technique: info.name, params, visibility, shaded, report, stages_ms, total_ms, setup_ms })
+    }
+
+    /// The reference on this view.
+    pub fn reference(&self, view: &View, repeat: usize) -> Result<Run, GpuError> {
+        self.run_resolved(view, &crate::reference::INFO, ParamValues::default(), "rt".into(), repeat)
+    }
+}

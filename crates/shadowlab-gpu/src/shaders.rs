@@ -1,0 +1,25 @@
+//! Shader composition: every shader is `common.wgsl` + (optionally `scene.wgsl`) + its own file.
+//! [`all`] lists every composed shader so a CPU-only test validates each with naga.
+
+pub const COMMON: &str = include_str!("common.wgsl");
+pub const SCENE: &str = include_str!("scene.wgsl");
+
+/// `common.wgsl`, then `scene.wgsl` if `with_scene`, then `body`.
+pub fn compose(body: &str, with_scene: bool) -> String {
+    let mut s = String::from(COMMON);
+    if with_scene {
+        s.push_str(SCENE);
+    }
+    s.push_str(body);
+    s
+}
+
+/// (file name, composed source) of every shader the crate uses.
+pub fn all() -> Vec<(&'static str, String)> {
+    let mut v = vec![];
+    v.extend(crate::gbuffer::shaders());
+    v.extend(crate::reference::shaders());
+    v.extend(crate::shade::shaders());
+    v.extend(crate::techniques::shaders());
+    v
+}

@@ -1,0 +1,103 @@
+//! The technique trait and the one registry. A technique is a folder with its `mod.rs` and
+//! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
+
+pub mod sm;
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use shadowlab_core::light::Light;
+use shadowlab_core::metrics::SamplingStats;
+use shadowlab_core::params::{ParamDef, ParamValues, TechniqueSpec};
+
+use crate::gbuffer::GBuffer;
+use crate::scene_gpu::GpuScene;
+use crate::timing::StageTimer;
+use crate::{Gpu, GpuError};
+
+/// Everything a technique reads for one view and one light; it writes `visibility`
+/// (f32 per pixel, 1 lit, 0 shadowed) for the pixels where `gbuffer.mask` is 1.
+pub struct FrameInputs<'a> {
+    pub scene: &'a GpuScene,
+    pub gbuffer: &'a GBuffer,
+    pub light: Light,
+    /// `LightUniform` of `light`.
+    pub light_buf: &'a wgpu::Buffer,
+    /// `FrameUniform` of the view.
+    pub frame: &'a wgpu::Buffer,
+    pub visibility: &'a wgpu::Buffer,
+}
+
+/// An RGBA8 picture a technique offers the report (shadow maps, count maps, warps).
+#[derive(Clone, Debug)]
+pub struct NamedImage {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct TechniqueReport {
+    /// GPU memory the technique keeps per light (maps, warps, tiles, masks; the BVH for `rt`).
+    pub shadow_data_bytes: u64,
+    /// Hardware-independent counters: `fetches_per_pixel`, `rays_traced`, ...
+    pub counters: BTreeMap<String, f64>,
+    /// How view samples land in the shadow map (shadow-map techniques).
+    pub sampling: Option<SamplingStats>,
+    #[serde(skip)]
+    pub images: Vec<NamedImage>,
+}
+
+pub trait Technique {
+    /// Renders the shadow data for this frame and evaluates visibility, timing each stage by name.
+    fn run(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError>;
+    /// Memory, counters, sampling statistics and pictures of the last run.
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport;
+}
+
+pub type CreateFn = fn(&Gpu, &GpuScene, &ParamValues, &Light) -> Result<Box<dyn Technique>, GpuError>;
+
+/// What `shadowlab techniques` lists, and how to make one.
+pub struct TechniqueInfo {
+    pub name: &'static str,
+    pub summary: &'static str,
+    pub cost: &'static str,
+    pub quality: &'static str,
+    pub source: &'static str,
+    /// Light types it supports.
+    pub lights: &'static [&'static str],
+    pub params: &'static [ParamDef],
+    pub create: CreateFn,
+}
+
+/// Every technique, in listing order.
+pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO];
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    sm::shaders()
+}
+
+pub fn find(name: &str) -> Result<&'static TechniqueInfo, GpuError> {
+    REGISTRY.iter().copied().find(|t| t.name == name).ok_or_else(|| {
+        let names: Vec<_> = REGISTRY.iter().map(|t| t.name).collect();
+        GpuError::Invalid(format!("unknown technique '{name}' (known: {})", names.join(", ")))
+    })
+}
+
+/// Checks a spec against the registry without a GPU: name, parameters, light type.
+pub fn resolve(spec: &TechniqueSpec, light: Option<&Light>) -> Result<(&'static TechniqueInfo, ParamValues), GpuError> {
+    let info = find(&spec.name)?;
+    let values = spec.resolve(info.params).map_err(GpuError::Invalid)?;
+    if let Some(l) = light {
+        if !info.lights.contains(&l.kind()) {
+            return Err(GpuError::Invalid(format!(
+                "technique '{}' does not support {} lights (it supports: {})",
+                info.name,
+                l.kind(),
+                info.lights.join(", ")
+            )));
+        }
+    }
+    Ok((info, values))
+}

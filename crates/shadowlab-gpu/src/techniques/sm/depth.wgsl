@@ -1,0 +1,36 @@
+// Shadow-map pass: depth only, alpha-tested texels discarded. Depth is post-projective
+// (orthographic: linear in light-space distance; spot: perspective), 0 = near the light.
+
+struct SmParams {
+    light_view_proj: mat4x4<f32>,
+    // x: world size of one texel (orthographic) or per unit of light-view depth (perspective)
+    // y: 1 if perspective; z: resolution; w: pcf kernel width
+    texel: vec4<f32>,
+    // x: constant bias, y: slope-scaled bias, z: normal offset (all in texels), w: max slope
+    bias: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> sm: SmParams;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) material: u32,
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+    let v = vertices[vi];
+    var o: VsOut;
+    o.clip = sm.light_view_proj * vec4<f32>(v.pos, 1.0);
+    o.uv = v.uv;
+    o.material = v.material;
+    return o;
+}
+
+@fragment
+fn fs_main(in: VsOut) {
+    if cut_out(materials[in.material], in.uv) {
+        discard;
+    }
+}

@@ -1,0 +1,74 @@
+// Shadow-map evaluation: each evaluated sample is offset (normal offset, constant and
+// slope-scaled bias, in world units of one shadow texel), projected into the light, and
+// compared with an NxN kernel of single-texel hardware comparisons (PCF). Also counts how many
+// view samples land in each texel (sampling statistics).
+
+struct SmParams {
+    light_view_proj: mat4x4<f32>,
+    texel: vec4<f32>,
+    bias: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<uniform> light: LightU;
+@group(0) @binding(2) var<uniform> sm: SmParams;
+@group(0) @binding(3) var g_position: texture_2d<f32>;
+@group(0) @binding(4) var g_normal: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read> mask: array<u32>;
+@group(0) @binding(6) var shadow_map: texture_depth_2d;
+@group(0) @binding(7) var cmp: sampler_comparison;
+@group(0) @binding(8) var<storage, read_write> visibility: array<f32>;
+@group(0) @binding(9) var<storage, read_write> counts: array<atomic<u32>>;
+
+fn to_map(p: vec3<f32>) -> vec3<f32> {
+    let c = sm.light_view_proj * vec4<f32>(p, 1.0);
+    let ndc = c.xyz / c.w;
+    return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, ndc.z);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= frame.size.x || id.y >= frame.size.y {
+        return;
+    }
+    let i = id.y * frame.size.x + id.x;
+    if mask[i] == 0u {
+        visibility[i] = 0.0;
+        return;
+    }
+    let p = textureLoad(g_position, id.xy, 0).xyz;
+    let n = textureLoad(g_normal, id.xy, 0).xyz;
+    let l = to_light(light, p);
+    let res = sm.texel.z;
+
+    // sampling statistics: the texel this view sample lands in
+    let m0 = to_map(p);
+    if all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
+        let t = vec2<u32>(m0.xy * res);
+        atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
+    }
+
+    // world size of one texel at p
+    var texel = sm.texel.x;
+    if sm.texel.y > 0.5 {
+        texel = sm.texel.x * max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
+    }
+    let cos_t = clamp(dot(n, l), 1e-4, 1.0);
+    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, sm.bias.w);
+    let q = p + n * (sm.bias.z * texel) + l * ((sm.bias.x + sm.bias.y * tan_t) * texel);
+    let m = to_map(q);
+    if any(m.xy < vec2<f32>(0.0)) || any(m.xy > vec2<f32>(1.0)) || m.z > 1.0 {
+        visibility[i] = 1.0;
+        return;
+    }
+    let k = i32(sm.texel.w);
+    let half = f32(k - 1) * 0.5;
+    var lit = 0.0;
+    for (var y = 0; y < k; y++) {
+        for (var x = 0; x < k; x++) {
+            let uv = m.xy + (vec2<f32>(f32(x), f32(y)) - half) / res;
+            lit += textureSampleCompareLevel(shadow_map, cmp, uv, m.z);
+        }
+    }
+    visibility[i] = lit / f32(k * k);
+}

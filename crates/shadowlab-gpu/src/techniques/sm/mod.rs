@@ -1,0 +1,231 @@
+//! `sm`: baseline shadow mapping (Williams 1978) for directional (orthographic, fitted to the
+//! scene bounds) and spot (perspective) lights, with constant, slope-scaled and normal-offset
+//! bias in units of one shadow texel, and NxN PCF through hardware comparison sampling.
+//! Stored depth: post-projective, 0 = near the light (orthographic: linear).
+
+use bytemuck::{Pod, Zeroable};
+use shadowlab_core::light::Light;
+use shadowlab_core::lightspace;
+use shadowlab_core::metrics::sampling_stats;
+use shadowlab_core::params::{ParamDef, ParamValues};
+
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose;
+use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{binding, Gpu, GpuError};
+
+const DEPTH_WGSL: &str = include_str!("depth.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("sm/depth.wgsl", compose(DEPTH_WGSL, true)), ("sm/eval.wgsl", compose(EVAL_WGSL, false))]
+}
+
+/// Shadow-map side in texels. The seeds evaluate 512 against 1024x1024 output.
+pub const DEFAULT_RES: f64 = 512.0;
+/// Constant bias (texels along the light). Too low: acne on lit surfaces; too high: peter-panning.
+pub const DEFAULT_BIAS: f64 = 0.5;
+/// Slope-scaled bias (texels x tan of the light angle): half a texel of depth change across half
+/// a texel is the worst case of a nearest lookup; 1.0 leaves margin. Too high detaches contact shadows.
+pub const DEFAULT_SLOPE_BIAS: f64 = 1.0;
+/// Normal offset (texels along the surface normal). Removes acne at grazing angles; too high
+/// shifts shadows sideways and makes thin occluders miss.
+pub const DEFAULT_NORMAL_OFFSET: f64 = 0.5;
+
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef { key: "res", default: DEFAULT_RES, min: 16.0, max: 16384.0, integer: true, doc: "shadow map side (texels)", source: "seeds 000/002 evaluation: 512 with 1024x1024 output" },
+    ParamDef { key: "pcf", default: 1.0, min: 1.0, max: 7.0, integer: true, doc: "PCF kernel width N (NxN single-texel comparisons); 1 = hard test", source: "Reeves et al. 1987" },
+    ParamDef { key: "bias", default: DEFAULT_BIAS, min: 0.0, max: 100.0, integer: false, doc: "constant depth bias, texels; low: acne, high: peter-panning", source: "shadowlab default (half a texel)" },
+    ParamDef { key: "slope_bias", default: DEFAULT_SLOPE_BIAS, min: 0.0, max: 100.0, integer: false, doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope", source: "shadowlab default; the worst case of a nearest lookup is 0.5" },
+    ParamDef { key: "max_slope", default: 10.0, min: 0.0, max: 1000.0, integer: false, doc: "clamp on tan(angle to light) for the slope bias", source: "shadowlab default" },
+    ParamDef { key: "normal_offset", default: DEFAULT_NORMAL_OFFSET, min: 0.0, max: 100.0, integer: false, doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows", source: "Holbert 2011 (normal offset shadows)" },
+];
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "sm",
+    summary: "shadow mapping: one depth map from the light (orthographic or perspective), biased hard test or NxN PCF",
+    cost: "one depth pass over the scene + N^2 comparison fetches per pixel",
+    quality: "aliasing where texels project large on screen (perspective aliasing); acne vs peter-panning trade-off",
+    source: "Williams 1978; seed 002 chapter 2; PCF: Reeves, Salesin, Cook 1987",
+    lights: &["directional", "spot"],
+    params: PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(ShadowMap::new(gpu, scene, p, light)?)),
+};
+
+/// WGSL `SmParams` (in depth.wgsl and eval.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SmParams {
+    pub light_view_proj: [[f32; 4]; 4],
+    pub texel: [f32; 4],
+    pub bias: [f32; 4],
+}
+
+pub struct ShadowMap {
+    res: u32,
+    pcf: u32,
+    params: SmParams,
+    map: wgpu::Texture,
+    counts: wgpu::Buffer,
+    uniform: wgpu::Buffer,
+    depth_pipeline: wgpu::RenderPipeline,
+    depth_group: wgpu::BindGroup,
+    eval_pipeline: wgpu::ComputePipeline,
+    eval_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+impl ShadowMap {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<ShadowMap, GpuError> {
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "shadow map")?;
+        let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("sm does not support point lights".into()))?;
+        let params = SmParams {
+            light_view_proj: lp.view_proj.to_cols_array_2d(),
+            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, p.get("pcf") as f32],
+            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
+        };
+        let d = &gpu.device;
+        let map = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("sm.map"),
+            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let uniform = gpu.uniform("sm.params", &params);
+        let depth_layout = binding::layout(d, "sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
+        let depth_group = binding::group(d, "sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
+        let module = gpu.shader("sm.depth", &compose(DEPTH_WGSL, true));
+        let depth_pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("sm.depth"),
+            layout: Some(&gpu.pipeline_layout("sm.depth", &[&depth_layout, &scene.layout])),
+            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &[] }),
+            multiview_mask: None,
+            cache: None,
+        });
+        use binding::{comparison_sampler as cmp, storage, texture_depth, texture_float as tex, uniform as uni};
+        let eval_layout = binding::layout(
+            d,
+            "sm.eval",
+            wgpu::ShaderStages::COMPUTE,
+            &[uni(), uni(), uni(), tex(), tex(), storage(true), texture_depth(), cmp(), storage(false), storage(false)],
+        );
+        let eval_pipeline = gpu.compute_pipeline("sm.eval", &compose(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("sm.cmp"),
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            mag_filter: wgpu::FilterMode::Nearest,
+            min_filter: wgpu::FilterMode::Nearest,
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            ..Default::default()
+        });
+        let counts = gpu.storage("sm.counts", res as u64 * res as u64 * 4);
+        Ok(ShadowMap { res, pcf: p.get_u32("pcf"), params, map, counts, uniform, depth_pipeline, depth_group, eval_pipeline, eval_layout, sampler })
+    }
+}
+
+impl Technique for ShadowMap {
+    fn run(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let map_view = self.map.create_view(&Default::default());
+        timer.stage(gpu, "sm.render", |enc| {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("sm.render"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &map_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.depth_pipeline);
+            pass.set_bind_group(0, &self.depth_group, &[]);
+            pass.set_bind_group(1, &f.scene.group, &[]);
+            pass.draw(0..f.scene.triangle_count * 3, 0..1);
+        });
+        let pv = f.gbuffer.position.create_view(&Default::default());
+        let nv = f.gbuffer.normal.create_view(&Default::default());
+        let group = binding::group(
+            &gpu.device,
+            "sm.eval",
+            &self.eval_layout,
+            &[
+                f.frame.as_entire_binding(),
+                f.light_buf.as_entire_binding(),
+                self.uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&pv),
+                wgpu::BindingResource::TextureView(&nv),
+                f.gbuffer.mask.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&map_view),
+                wgpu::BindingResource::Sampler(&self.sampler),
+                f.visibility.as_entire_binding(),
+                self.counts.as_entire_binding(),
+            ],
+        );
+        timer.stage(gpu, "sm.evaluate", |enc| {
+            enc.clear_buffer(&self.counts, 0, None);
+            gpu.dispatch_2d(enc, "sm.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let n = (self.res * self.res) as usize;
+        let counts: Vec<u32> = gpu.read_buffer_as(&self.counts, n);
+        let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4));
+        let mut r = TechniqueReport { shadow_data_bytes: n as u64 * 4, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+        r.counters.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
+        r.counters.insert("shadow_map_texels".into(), n as f64);
+        r.images.push(depth_image("shadow map (depth)", self.res, &depth));
+        r.images.push(count_image("view samples per texel", self.res, &counts));
+        let _ = self.params;
+        r
+    }
+}
+
+/// Grey depth picture, stretched to the range of covered texels (1.0 = empty shows black).
+pub fn depth_image(name: &str, res: u32, depth: &[f32]) -> NamedImage {
+    let (lo, hi) = depth.iter().filter(|d| **d < 1.0).fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &d| (a.min(d), b.max(d)));
+    let rgba = depth
+        .iter()
+        .flat_map(|&d| {
+            let g = if d >= 1.0 || hi <= lo { 0 } else { (255.0 * (1.0 - (d - lo) / (hi - lo)) * 0.85 + 30.0) as u8 };
+            [g, g, g, 255]
+        })
+        .collect();
+    NamedImage { name: name.into(), width: res, height: res, rgba }
+}
+
+/// Heat picture of the sample count per texel (log scale; black = unused).
+pub fn count_image(name: &str, res: u32, counts: &[u32]) -> NamedImage {
+    let max = counts.iter().copied().max().unwrap_or(1).max(1) as f32;
+    let rgba = counts
+        .iter()
+        .flat_map(|&c| {
+            if c == 0 {
+                return [0, 0, 0, 255];
+            }
+            let t = (c as f32).ln_1p() / max.ln_1p();
+            [(255.0 * t.sqrt()) as u8, (255.0 * t * t) as u8, (255.0 * (1.0 - t) * 0.6) as u8, 255]
+        })
+        .collect();
+    NamedImage { name: name.into(), width: res, height: res, rgba }
+}

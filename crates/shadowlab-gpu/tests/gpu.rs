@@ -1,0 +1,107 @@
+//! GPU integration tests (lavapipe in CI). A missing adapter fails them unless
+//! SHADOWLAB_SKIP_GPU_TESTS=1 is set; CI never sets it.
+
+use shadowlab_core::builtin::builtin;
+use shadowlab_core::bvh::cpu_visibility;
+use shadowlab_core::metrics::compare;
+use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::scene::Scene;
+use shadowlab_gpu::lab::{Lab, View};
+use shadowlab_gpu::Gpu;
+
+fn gpu() -> Option<Gpu> {
+    if std::env::var("SHADOWLAB_SKIP_GPU_TESTS").as_deref() == Ok("1") {
+        eprintln!("SHADOWLAB_SKIP_GPU_TESTS=1: GPU test not run");
+        return None;
+    }
+    Some(Gpu::new().unwrap_or_else(|e| panic!("{e} (set SHADOWLAB_SKIP_GPU_TESTS=1 to skip GPU tests)")))
+}
+
+fn view(lab: &Lab, scene: &Scene, light: usize, size: u32) -> View {
+    lab.view(&scene.camera, &scene.camera, &scene.lights[light], size, size).unwrap()
+}
+
+fn agreement(a: &[f32], b: &[f32], mask: &[u32]) -> f64 {
+    100.0 - compare(a, b, mask).wrong_pct
+}
+
+#[test]
+fn rt_gpu_matches_cpu_on_every_builtin_scene_and_light() {
+    let Some(gpu) = gpu() else { return };
+    for s in shadowlab_core::builtin::BUILTIN_SCENES {
+        let scene = (s.build)();
+        let lab = Lab::new(&gpu, &scene).unwrap();
+        for li in 0..scene.lights.len() {
+            let v = view(&lab, &scene, li, 256);
+            let rt = lab.reference(&v, 1).unwrap();
+            let cpu = cpu_visibility(&lab.bvh, &scene, &scene.lights[li], &v.position, &v.normal, &v.mask, lab.gscene.eps);
+            let m = compare(&rt.visibility, &cpu, &v.mask);
+            assert!(m.evaluated_pixels > 1000, "{} light {li}: only {} evaluated pixels", s.name, m.evaluated_pixels);
+            assert!(100.0 - m.wrong_pct >= 99.99, "{} light {li}: GPU/CPU agree on {:.4}%", s.name, 100.0 - m.wrong_pct);
+            let lit = rt.visibility.iter().zip(&v.mask).filter(|(x, m)| **m != 0 && **x > 0.5).count();
+            assert!(lit > 0 && (lit as u64) < m.evaluated_pixels, "{} light {li}: no shadow or no light at all", s.name);
+            assert_eq!(rt.report.counters["rays_traced"] as u64, m.evaluated_pixels);
+        }
+    }
+}
+
+#[test]
+fn sm_at_high_resolution_matches_rt_on_planebox() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let sm = lab.run(&v, &TechniqueSpec::parse("sm:res=4096,pcf=1").unwrap(), 1).unwrap();
+    let a = agreement(&sm.visibility, &rt.visibility, &v.mask);
+    assert!(a >= 99.0, "sm 4096 agrees with rt on {a:.3}%");
+    let s = sm.report.sampling.unwrap();
+    assert!(s.used_texel_fraction > 0.0 && s.samples_per_used_texel_mean >= 1.0);
+    assert_eq!(sm.report.shadow_data_bytes, 4096 * 4096 * 4);
+}
+
+#[test]
+fn sm_error_falls_with_resolution_on_courtyard() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 512);
+    let rt = lab.reference(&v, 1).unwrap();
+    let wrong: Vec<f64> = [256, 512, 1024]
+        .iter()
+        .map(|r| {
+            let run = lab.run(&v, &TechniqueSpec::parse(&format!("sm:res={r}")).unwrap(), 1).unwrap();
+            compare(&run.visibility, &rt.visibility, &v.mask).wrong_pct
+        })
+        .collect();
+    assert!(wrong[0] > wrong[1] && wrong[1] > wrong[2], "wrong % at 256/512/1024: {wrong:?}");
+}
+
+#[test]
+fn same_run_twice_gives_identical_visibility() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("foliage").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let spec = TechniqueSpec::parse("sm:pcf=3").unwrap();
+    let v1 = view(&lab, &scene, 0, 128);
+    let a = lab.run(&v1, &spec, 1).unwrap();
+    let v2 = view(&lab, &scene, 0, 128);
+    let b = lab.run(&v2, &spec, 1).unwrap();
+    assert_eq!(v1.mask, v2.mask);
+    assert_eq!(a.visibility, b.visibility);
+    assert_eq!(a.shaded, b.shaded);
+}
+
+#[test]
+fn bad_requests_are_errors_not_panics() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    assert!(lab.view(&scene.camera, &scene.camera, &scene.lights[0], 0, 16).is_err());
+    assert!(lab.view(&scene.camera, &scene.camera, &scene.lights[0], 1 << 20, 16).is_err());
+    let v = view(&lab, &scene, 1, 32); // point light
+    let e = lab.run(&v, &TechniqueSpec::parse("sm").unwrap(), 1).err().expect("sm on a point light must fail");
+    assert!(e.to_string().contains("point"), "{e}");
+    assert!(lab.run(&v, &TechniqueSpec::parse("nope").unwrap(), 1).is_err());
+    assert!(lab.run(&v, &TechniqueSpec::parse("sm:res=3").unwrap(), 1).is_err());
+}
