@@ -1,1 +1,103 @@
-fn main(){}
+//! `shadowlab`: render, compare and benchmark shadow techniques against an exact reference.
+
+mod bench;
+mod compare;
+mod config;
+mod export;
+mod listing;
+mod output;
+mod report;
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "shadowlab", version, about = "Shadow-technique lab: every technique against an exact ray-traced reference")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Where a run comes from: a setup file and/or a scene, with overrides.
+#[derive(Args, Clone, Debug, Default)]
+pub struct RunArgs {
+    /// TOML setup file (scene, camera, lights, output size, techniques)
+    #[arg(long)]
+    pub setup: Option<PathBuf>,
+    /// Built-in scene name or scene file (.gltf, .glb, .obj); overrides the setup's scene
+    #[arg(long)]
+    pub scene: Option<String>,
+    /// Technique spec `name` or `name:key=value,...`; repeatable; overrides the setup's list
+    #[arg(short = 't', long = "technique")]
+    pub techniques: Vec<String>,
+    /// Output size WxH (default: the setup's, else 1024x1024)
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Index of the light to evaluate (default 0)
+    #[arg(long, default_value_t = 0)]
+    pub light: usize,
+    /// Timed repetitions per technique after one warm-up (median reported)
+    #[arg(long, default_value_t = 3)]
+    pub repeat: usize,
+    /// No progress bar or summary
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List built-in scenes and shipped setups
+    Scenes,
+    /// List techniques with their parameters, defaults and sources
+    Techniques,
+    /// Render one technique (default `rt`) to a shaded PNG
+    Render {
+        #[command(flatten)]
+        run: RunArgs,
+        /// Output PNG
+        #[arg(long, default_value = "render.png")]
+        out: PathBuf,
+    },
+    /// Compare techniques against `rt`: report/index.html, metrics.json/.csv, PNGs
+    Compare {
+        #[command(flatten)]
+        run: RunArgs,
+        /// Output directory (written under a temporary name, then renamed)
+        #[arg(long, default_value = "report")]
+        out: PathBuf,
+        /// Also write position/normal/mask/visibility .npy files for Python
+        #[arg(long)]
+        export: bool,
+    },
+    /// Time every stage on the built-in scenes (and sponza/conference when present)
+    Bench {
+        /// Setup files to benchmark (default: the built-in scenes plus setups/sponza.toml and setups/conference.toml when their scenes exist)
+        #[arg(long)]
+        setup: Vec<PathBuf>,
+        /// Output size WxH
+        #[arg(long, default_value = "1024x1024")]
+        size: String,
+        /// Timed frames per stage (median reported)
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Write the markdown table here as well as to stdout
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Scenes => listing::scenes(),
+        Command::Techniques => listing::techniques(),
+        Command::Render { run, out } => compare::render(&run, &out),
+        Command::Compare { run, out, export } => compare::compare(&run, &out, export),
+        Command::Bench { setup, size, frames, out } => bench::bench(&setup, &size, frames, out.as_deref()),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,44 @@
+//! `shadowlab scenes` and `shadowlab techniques`, both read from the registries.
+
+use anyhow::Result;
+use shadowlab_core::builtin::{BUILTIN_SCENES, DEFAULT_SCENE};
+use shadowlab_gpu::techniques::REGISTRY;
+
+pub fn scenes() -> Result<()> {
+    println!("Built-in scenes (no files needed):");
+    for s in BUILTIN_SCENES {
+        let scene = (s.build)();
+        let default = if s.name == DEFAULT_SCENE { " [default]" } else { "" };
+        let lights: Vec<_> = scene.lights.iter().map(|l| l.kind()).collect();
+        println!("  {:<10} {:>6} tris, lights: {:<18} {}{default}", s.name, scene.triangle_count(), lights.join(", "), s.summary);
+    }
+    println!("\nSetups (use with --setup): see setups/*.toml; scene files load from .gltf, .glb and .obj (--scene PATH).");
+    if let Ok(rd) = std::fs::read_dir("setups") {
+        let mut names: Vec<_> = rd.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
+        names.sort();
+        for p in names {
+            println!("  {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+pub fn techniques() -> Result<()> {
+    for t in REGISTRY {
+        println!("{}  —  {}", t.name, t.summary);
+        println!("  lights:  {}", t.lights.join(", "));
+        println!("  cost:    {}", t.cost);
+        println!("  quality: {}", t.quality);
+        println!("  source:  {}", t.source);
+        if t.params.is_empty() {
+            println!("  parameters: none");
+        }
+        for p in t.params {
+            let range = if p.integer { format!("{}..{}", p.min, p.max) } else { format!("{}..{}", p.min, p.max) };
+            println!("  {:<14} default {:<8} [{range}]  {}  (source: {})", p.key, p.default, p.doc, p.source);
+        }
+        println!();
+    }
+    println!("Spec syntax: name or name:key=value,key=value (label=... names the run).");
+    Ok(())
+}
