@@ -70,6 +70,7 @@ pub fn build() -> Scene {
     let floor = b.material(Material::solid("floor paving", [0.62, 0.56, 0.49]));
     let plaster = b.material(Material::solid("wall plaster", [0.80, 0.64, 0.48]));
     let grass = b.material(Material::solid("garden grass", [0.32, 0.46, 0.21]));
+    let hedge = b.material(Material::solid("hedge", [0.16, 0.30, 0.12]));
     let banners = [
         b.material(Material::solid("banner red", [0.62, 0.09, 0.08])),
         b.material(Material::solid("banner blue", [0.10, 0.22, 0.55])),
@@ -77,11 +78,13 @@ pub fn build() -> Scene {
     let bronze = b.material(Material::solid("bronze", [0.45, 0.33, 0.16]));
     let water = b.material(Material::solid("water", [0.20, 0.36, 0.42]));
 
-    // Floor, garden beyond the far end, outer walls, the closed end behind the camera.
+    // Floor, outer walls, the closed end behind the camera.
     let (x0, x1) = (-HALF_LEN - 0.8, HALF_LEN + 0.9);
     let zo = OUTER_Z + WALL_T;
     b.cuboid(Vec3::new(x0, -0.2, -zo), Vec3::new(x1, 0.0, zo), floor);
-    b.cuboid(Vec3::new(-60.0, -0.2, -30.0), Vec3::new(x0, 0.0, 30.0), grass);
+    // A small garden closed by a hedge that hides the horizon (keeps the scene bounds tight).
+    b.cuboid(Vec3::new(-31.0, -0.2, -16.0), Vec3::new(x0, 0.0, 16.0), grass);
+    b.cuboid(Vec3::new(-31.0, 0.0, -16.0), Vec3::new(-30.0, 2.2, 16.0), hedge);
     for s in [-1.0f32, 1.0] {
         let (za, zb) = (s * OUTER_Z, s * zo);
         b.cuboid(Vec3::new(x0, 0.0, za.min(zb)), Vec3::new(x1, WALL_TOP, za.max(zb)), plaster);
@@ -195,7 +198,8 @@ pub(super) mod tests {
 
     use super::*;
 
-    /// Nearest hit (distance, triangle) of the ray `o + t d`, brute force (Moller-Trumbore).
+    /// Nearest hit (distance, triangle) of the ray `o + t d`, brute force (Moller-Trumbore);
+    /// cut-out texels of alpha-tested materials are skipped, as the renderers do.
     pub(in crate::builtin) fn first_hit(s: &Scene, o: Vec3, d: Vec3) -> Option<(f32, usize)> {
         let mut best: Option<(f32, usize)> = None;
         for i in 0..s.triangle_count() {
@@ -203,14 +207,19 @@ pub(super) mod tests {
             let (e1, e2) = (b - a, c - a);
             let p = d.cross(e2);
             let det = e1.dot(p);
-            if det.abs() < 1e-12 {
-                continue;
-            }
             let (r, q) = (o - a, (o - a).cross(e1));
             let (u, v, t) = (r.dot(p) / det, d.dot(q) / det, e2.dot(q) / det);
-            if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 1e-4 && best.map_or(true, |(bt, _)| t < bt) {
-                best = Some((t, i));
+            if det.abs() < 1e-12 || u < 0.0 || v < 0.0 || u + v > 1.0 || t <= 1e-4 || best.is_some_and(|(bt, _)| t >= bt) {
+                continue;
             }
+            let (m, uv) = (&s.materials[s.vertices[3 * i].material as usize], |k: usize| Vec2::from(s.vertices[3 * i + k].uv));
+            if let (Some(cut), Some(tex)) = (m.alpha_cutoff, m.texture) {
+                let at = uv(0) * (1.0 - u - v) + uv(1) * u + uv(2) * v;
+                if (s.textures[tex as usize].alpha_at(at) as f32 / 255.0) < cut {
+                    continue;
+                }
+            }
+            best = Some((t, i));
         }
         best
     }

@@ -96,7 +96,7 @@ impl MeshBuilder {
             (t * ang.cos() + s * ang.sin()) * radius
         };
         for i in 0..segments {
-            let (r0, r1) = (ring(i), ring(i + 1));
+            let (r0, r1) = (ring(i), ring((i + 1) % segments));
             let (u0, u1) = (i as f32 / segments as f32, (i + 1) as f32 / segments as f32);
             self.tri([a + r0, a + r1, b + r1], [Vec2::new(u0, 1.0), Vec2::new(u1, 1.0), Vec2::new(u1, 0.0)], mat);
             self.tri([a + r0, b + r1, b + r0], [Vec2::new(u0, 1.0), Vec2::new(u1, 0.0), Vec2::new(u0, 0.0)], mat);

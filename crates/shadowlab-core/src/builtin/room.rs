@@ -6,7 +6,7 @@
 //! dual-paraboloid maps, NoTW for point lights). The camera stands in the front-right corner and
 //! looks at the table with the point light inside the view, so its shadows surround the viewer.
 
-use std::f32::consts::FRAC_PI_2;
+use std::f32::consts::{FRAC_PI_2, PI};
 
 use glam::{Mat4, Vec2, Vec3};
 
@@ -69,7 +69,7 @@ pub fn build() -> Scene {
     for i in 0..5 {
         let x = (i as f32 - 2.0) * 0.72;
         seats.push((Vec3::new(x, 0.0, th.y + 0.3), 0.0));
-        seats.push((Vec3::new(x, 0.0, -th.y - 0.3), 2.0 * FRAC_PI_2));
+        seats.push((Vec3::new(x, 0.0, -th.y - 0.3), PI));
     }
     seats.push((Vec3::new(th.x + 0.3, 0.0, 0.0), FRAC_PI_2));
     seats.push((Vec3::new(-th.x - 0.3, 0.0, 0.0), -FRAC_PI_2));
@@ -123,7 +123,7 @@ pub fn build() -> Scene {
         .collect();
     let table_top = Vec3::new(0.0, TABLE_H, 0.0);
     let lights = vec![
-        Light::Spot { position: SPOT_POSITION, direction: table_top - SPOT_POSITION, cone_deg: 38.0 },
+        Light::Spot { position: SPOT_POSITION, direction: (table_top - SPOT_POSITION).normalize(), cone_deg: 38.0 },
         Light::Point { position: POINT_POSITION },
     ];
     b.finish("room", cam, lights, path)
@@ -172,7 +172,7 @@ mod tests {
             assert!(view.dot(POINT_POSITION - cam.position) > 0.0, "point light behind the camera");
             let to_light = POINT_POSITION - cam.position;
             let hit = first_hit(&s, cam.position, to_light.normalize());
-            assert!(hit.map_or(true, |(t, _)| t > to_light.length()), "point light hidden from {}", cam.position);
+            assert!(hit.is_none_or(|(t, _)| t > to_light.length()), "point light hidden from {}", cam.position);
             for (what, p) in [("point light", POINT_POSITION), ("table", Vec3::new(0.0, TABLE_H, 0.0))] {
                 let px = cam.project_to_pixel(p, 1024, 1024).unwrap();
                 assert!(px.cmpgt(Vec2::splat(100.0)).all() && px.cmplt(Vec2::splat(924.0)).all(), "{what} at pixel {px}");
@@ -194,7 +194,7 @@ mod tests {
             assert!(inside(light, 0.1));
             let o = table + Vec3::Y * 1e-3;
             let hit = first_hit(&s, o, (light - o).normalize());
-            assert!(hit.map_or(true, |(t, _)| t > o.distance(light)), "table top does not see the light at {light}");
+            assert!(hit.is_none_or(|(t, _)| t > o.distance(light)), "table top does not see the light at {light}");
         }
     }
 

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Makes sure a Vulkan driver is present (Mesa's lavapipe on machines without a GPU).
+# Installs it with apt when running as root or with password-less sudo; otherwise prints the
+# exact command and fails.
+set -euo pipefail
+
+have_driver() {
+    # any Vulkan ICD manifest means a driver is installed
+    ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 && ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1'
+}
+
+if have_driver; then
+    exit 0
+fi
+
+PKGS="mesa-vulkan-drivers libvulkan1"
+if ! command -v apt-get >/dev/null 2>&1; then
+    echo "error: no Vulkan driver found and apt-get is not available; install your platform's Vulkan driver (on Debian/Ubuntu: sudo apt-get install $PKGS)" >&2
+    exit 1
+fi
+if [ "$(id -u)" -eq 0 ]; then
+    SUDO=""
+elif sudo -n true 2>/dev/null; then
+    SUDO="sudo -n"
+else
+    echo "error: no Vulkan driver found. Run: sudo apt-get install -y $PKGS" >&2
+    exit 1
+fi
+echo "setup: installing $PKGS (software Vulkan for machines without a GPU)" >&2
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq $PKGS >/dev/null
+have_driver || { echo "error: Vulkan driver still missing after installing $PKGS" >&2; exit 1; }
