@@ -1,0 +1,162 @@
+//! End-to-end tests of the `shadowlab` binary: outputs, determinism, and clear errors for bad
+//! input (one `error:` line, non-zero exit, no panic, no report left behind).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_shadowlab"));
+    c.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    c
+}
+
+fn skip_gpu() -> bool {
+    std::env::var("SHADOWLAB_SKIP_GPU_TESTS").as_deref() == Ok("1")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("shadowlab-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("run shadowlab")
+}
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shadowlab-core/tests/fixtures")
+}
+
+fn assert_clean_error(out: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure, stderr: {err}");
+    assert!(!err.contains("panicked"), "panic instead of an error: {err}");
+    assert!(err.contains("error:") && err.contains(needle), "expected an error mentioning '{needle}', got: {err}");
+}
+
+/// metrics.json without the fields that are timings (which legitimately vary).
+fn metrics_without_times(dir: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap()).unwrap();
+    fn strip(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                m.retain(|k, _| !k.ends_with("_ms") && k != "build_ms");
+                m.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
+
+#[test]
+fn compare_writes_report_metrics_and_exports() {
+    if skip_gpu() {
+        return;
+    }
+    let out = tmp("report");
+    let o = run(&["compare", "--scene", "planebox", "--size", "96x64", "-t", "sm", "-t", "sm:pcf=3,label=soft", "--repeat", "1", "--export", "--quiet", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["index.html", "metrics.json", "metrics.csv", "rt.png", "sm.png", "sm-error.png", "soft.png", "position.npy", "normal.npy", "mask.npy", "visibility/rt.npy", "visibility/soft.npy"] {
+        assert!(out.join(f).exists(), "missing {f}");
+    }
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["width"], 96);
+    assert_eq!(m["height"], 64);
+    assert_eq!(m["scene_transform"][0][0], 1.0);
+    let t = &m["techniques"][1];
+    assert_eq!(t["label"], "soft");
+    assert_eq!(t["technique"], "sm");
+    assert_eq!(t["params"]["pcf"], 3.0);
+    assert_eq!(t["counters"]["fetches_per_pixel"], 9.0);
+    for k in ["wrong_pct", "false_lit_pct", "false_shadow_pct", "mae", "evaluated_pixels", "shadow_data_bytes", "stages_ms", "total_ms"] {
+        assert!(!t[k].is_null(), "metrics.json lacks {k}");
+    }
+    assert!(t["evaluated_pixels"].as_u64().unwrap() > 100);
+    // npy header states the shape
+    let head = std::fs::read(out.join("position.npy")).unwrap();
+    let text = String::from_utf8_lossy(&head[..128.min(head.len())]);
+    assert!(text.contains("(64, 96, 3"), "{text}");
+    let csv = std::fs::read_to_string(out.join("metrics.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3);
+    assert!(!std::fs::read_dir(out.parent().unwrap()).unwrap().any(|e| e.unwrap().file_name().to_string_lossy().contains(".partial")));
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn the_same_run_twice_gives_identical_metrics() {
+    if skip_gpu() {
+        return;
+    }
+    let (a, b) = (tmp("twice-a"), tmp("twice-b"));
+    for d in [&a, &b] {
+        let o = run(&["compare", "--setup", "../../setups/foliage.toml", "--size", "128x128", "--repeat", "1", "-q", "--out", d.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    assert_eq!(metrics_without_times(&a), metrics_without_times(&b));
+    let _ = std::fs::remove_dir_all(&a);
+    let _ = std::fs::remove_dir_all(&b);
+}
+
+#[test]
+fn bad_input_gives_one_clear_error_and_no_report() {
+    let out = tmp("bad");
+    let o = out.to_str().unwrap();
+    let f = fixtures();
+    let setup_dir = tmp("setup");
+    std::fs::create_dir_all(&setup_dir).unwrap();
+    let bad_setup = setup_dir.join("bad.toml");
+    std::fs::write(&bad_setup, "[scene]\nbuiltin = \"room\"\nscael = 2.0\n").unwrap();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["--scene".into(), "atlantis".into()], "unknown scene"),
+        (vec!["-t".into(), "nope".into()], "unknown technique"),
+        (vec!["-t".into(), "sm:rez=2".into()], "no parameter 'rez'"),
+        (vec!["-t".into(), "sm:res=0".into()], "out of range"),
+        (vec!["--size".into(), "0x10".into()], "at least 1"),
+        (vec!["--size".into(), "big".into()], "WxH"),
+        (vec!["--scene".into(), f.join("malformed/garbage.obj").display().to_string()], "garbage.obj"),
+        (vec!["--scene".into(), f.join("malformed/truncated.glb").display().to_string()], "truncated.glb"),
+        (vec!["--scene".into(), "/nonexistent/scene.obj".into()], "not found"),
+        (vec!["--setup".into(), bad_setup.display().to_string()], "scael"),
+        (vec!["--scene".into(), "room".into(), "--light".into(), "1".into(), "-t".into(), "sm".into()], "point"),
+        (vec!["--light".into(), "7".into()], "light"),
+    ];
+    for (args, needle) in cases {
+        let mut all = vec!["compare".to_string(), "--quiet".into(), "--out".into(), o.into()];
+        all.extend(args);
+        let refs: Vec<&str> = all.iter().map(|s| s.as_str()).collect();
+        assert_clean_error(&run(&refs), needle);
+        assert!(!out.exists(), "a failed run left {}", out.display());
+    }
+    // over the device limit: needs the device
+    if !skip_gpu() {
+        assert_clean_error(&run(&["compare", "-q", "--scene", "planebox", "--size", "100000x8", "--out", o]), "device");
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn no_adapter_is_one_clear_error() {
+    // Restricting wgpu to a backend this build lacks leaves no adapter at all.
+    let o = bin().env("WGPU_BACKEND", "gl").args(["render", "--scene", "planebox", "--size", "8x8", "--out", "/dev/null"]).output().unwrap();
+    assert_clean_error(&o, "no GPU adapter found");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("mesa-vulkan-drivers"));
+}
+
+#[test]
+fn techniques_and_scenes_list_the_registries() {
+    let o = run(&["techniques"]);
+    assert!(o.status.success());
+    let s = String::from_utf8_lossy(&o.stdout);
+    for needle in ["sm ", "rt ", "res", "default 512", "pcf", "normal_offset", "source:"] {
+        assert!(s.contains(needle), "techniques output lacks '{needle}'");
+    }
+    let o = run(&["scenes"]);
+    let s = String::from_utf8_lossy(&o.stdout);
+    for needle in ["courtyard", "room", "foliage", "[default]"] {
+        assert!(s.contains(needle), "scenes output lacks '{needle}'");
+    }
+}
