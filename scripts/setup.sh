@@ -5,8 +5,18 @@
 set -euo pipefail
 
 have_driver() {
-    # any Vulkan ICD manifest means a driver is installed
-    ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 && ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1'
+    # a Vulkan loader plus at least one ICD manifest means a driver is installed
+    local icd found=""
+    for icd in /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json /usr/local/share/vulkan/icd.d/*.json; do
+        [ -e "$icd" ] && found=1
+    done
+    [ -n "$found" ] || return 1
+    local libs
+    libs="$(ldconfig -p 2>/dev/null || true)"
+    case "$libs" in
+        *libvulkan.so.1*) return 0 ;;
+        *) return 1 ;;
+    esac
 }
 
 if have_driver; then
