@@ -120,6 +120,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
             "counters": rt.report.counters,
         },
         "techniques": techniques,
+        "peak_rss_mib": crate::bench::peak_rss_mib(),
     });
     std::fs::write(dir.path("metrics.json"), serde_json::to_string_pretty(&metrics)?)?;
     std::fs::write(dir.path("metrics.csv"), csv(&metrics))?;

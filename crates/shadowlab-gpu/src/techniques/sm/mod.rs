@@ -24,22 +24,27 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 
 /// Shadow-map side in texels. The seeds evaluate 512 against 1024x1024 output.
 pub const DEFAULT_RES: f64 = 512.0;
+// Bias defaults come from a sweep (bias 0/0.25/0.5 x slope 0/0.5/1 x normal offset 0/0.5/1,
+// res 512, 512x512 output) on courtyard, room, foliage and sponza, 2026-11-22: (0.5, 0, 0.5) was
+// within 0.1 point of the best wrong-pixel rate on every scene; any slope bias added light leaks
+// under ledges (sponza 1.62 % -> 2.58 % with slope 1) because the normal offset already grows
+// with the slope. See BENCHMARKS.md.
 /// Constant bias (texels along the light). Too low: acne on lit surfaces; too high: peter-panning.
 pub const DEFAULT_BIAS: f64 = 0.5;
-/// Slope-scaled bias (texels x tan of the light angle): half a texel of depth change across half
-/// a texel is the worst case of a nearest lookup; 1.0 leaves margin. Too high detaches contact shadows.
-pub const DEFAULT_SLOPE_BIAS: f64 = 1.0;
-/// Normal offset (texels along the surface normal). Removes acne at grazing angles; too high
-/// shifts shadows sideways and makes thin occluders miss.
+/// Slope-scaled bias (texels x tan of the light angle, clamped at `max_slope`). Off by default:
+/// with the normal offset it only detaches contact shadows (light leaks under ledges).
+pub const DEFAULT_SLOPE_BIAS: f64 = 0.0;
+/// Normal offset (texels along the surface normal). Without it grazing surfaces show acne
+/// (room: 22 % wrong at 0); too high shifts shadows sideways and makes thin occluders miss.
 pub const DEFAULT_NORMAL_OFFSET: f64 = 0.5;
 
 pub const PARAMS: &[ParamDef] = &[
     ParamDef { key: "res", default: DEFAULT_RES, min: 16.0, max: 16384.0, integer: true, doc: "shadow map side (texels)", source: "seeds 000/002 evaluation: 512 with 1024x1024 output" },
     ParamDef { key: "pcf", default: 1.0, min: 1.0, max: 7.0, integer: true, doc: "PCF kernel width N (NxN single-texel comparisons); 1 = hard test", source: "Reeves et al. 1987" },
-    ParamDef { key: "bias", default: DEFAULT_BIAS, min: 0.0, max: 100.0, integer: false, doc: "constant depth bias, texels; low: acne, high: peter-panning", source: "shadowlab default (half a texel)" },
-    ParamDef { key: "slope_bias", default: DEFAULT_SLOPE_BIAS, min: 0.0, max: 100.0, integer: false, doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope", source: "shadowlab default; the worst case of a nearest lookup is 0.5" },
+    ParamDef { key: "bias", default: DEFAULT_BIAS, min: 0.0, max: 100.0, integer: false, doc: "constant depth bias, texels; low: acne, high: peter-panning", source: "shadowlab sweep 2026-11-22 (BENCHMARKS.md)" },
+    ParamDef { key: "slope_bias", default: DEFAULT_SLOPE_BIAS, min: 0.0, max: 100.0, integer: false, doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope", source: "shadowlab sweep 2026-11-22: 0 (normal offset covers slopes)" },
     ParamDef { key: "max_slope", default: 10.0, min: 0.0, max: 1000.0, integer: false, doc: "clamp on tan(angle to light) for the slope bias", source: "shadowlab default" },
-    ParamDef { key: "normal_offset", default: DEFAULT_NORMAL_OFFSET, min: 0.0, max: 100.0, integer: false, doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows", source: "Holbert 2011 (normal offset shadows)" },
+    ParamDef { key: "normal_offset", default: DEFAULT_NORMAL_OFFSET, min: 0.0, max: 100.0, integer: false, doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows", source: "Holbert 2011 (normal offset shadows); value from the shadowlab sweep" },
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
