@@ -87,6 +87,22 @@ fn compare_writes_report_metrics_and_exports() {
 }
 
 #[test]
+fn a_scene_file_loads_without_a_setup() {
+    if skip_gpu() {
+        return;
+    }
+    let out = tmp("file");
+    let scene = fixtures().join("quad.obj");
+    let o = run(&["compare", "-q", "--scene", scene.to_str().unwrap(), "--size", "32x32", "-t", "sm", "--repeat", "1", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["scene"], "quad");
+    assert!(m["triangles"].as_u64().unwrap() > 0);
+    assert_eq!(m["scene_transform"][1][1], 1.0);
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
 fn the_same_run_twice_gives_identical_metrics() {
     if skip_gpu() {
         return;

@@ -24,7 +24,7 @@ pub struct Setup {
     pub techniques: Vec<TechniqueEntry>,
 }
 
-#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSection {
     /// A scene file (.gltf, .glb, .obj), relative to the setup file.
@@ -41,6 +41,12 @@ pub struct SceneSection {
 
 fn one() -> f32 {
     1.0
+}
+
+impl Default for SceneSection {
+    fn default() -> Self {
+        SceneSection { path: None, builtin: None, up: UpAxis::Y, scale: 1.0, offset: [0.0; 3] }
+    }
 }
 
 #[derive(Clone, Copy, Debug, Deserialize, Serialize)]
@@ -160,6 +166,15 @@ spec = "sm:res=512,pcf=3"
         assert_eq!(s.techniques[0].spec, "sm:res=512,pcf=3");
         assert_eq!(s.camera.unwrap().fov_y_deg, 65.0);
     }
+    #[test]
+    fn defaults_are_the_identity_transform() {
+        let d = Setup::default();
+        assert_eq!(d.transform().matrix(), glam::Mat4::IDENTITY);
+        let p = Setup::parse("[scene]\nbuiltin = 'room'").unwrap();
+        assert_eq!(p.transform().matrix(), glam::Mat4::IDENTITY);
+        assert_eq!((p.output.width, p.output.height), (1024, 1024));
+    }
+
     #[test]
     fn unknown_keys_are_errors() {
         let e = Setup::parse(&EXAMPLE.replace("fov_y_deg", "fovy")).unwrap_err();
