@@ -55,14 +55,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let cos_t = clamp(dot(n, l), 1e-4, 1.0);
     let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, sm.bias.w);
-    let q = p + n * (sm.bias.z * texel) + l * ((sm.bias.x + sm.bias.y * tan_t) * texel);
+    // PCF taps up to `half` texels away see a sloped receiver `half * tan` texels deeper:
+    // that much slope bias is added for the kernel (receiver-plane bias, Isidoro 2006).
+    let k = i32(sm.texel.w);
+    let half = f32(k - 1) * 0.5;
+    let q = p + n * (sm.bias.z * texel) + l * ((sm.bias.x + (sm.bias.y + half) * tan_t) * texel);
     let m = to_map(q);
     if any(m.xy < vec2<f32>(0.0)) || any(m.xy > vec2<f32>(1.0)) || m.z > 1.0 {
         visibility[i] = 1.0;
         return;
     }
-    let k = i32(sm.texel.w);
-    let half = f32(k - 1) * 0.5;
     var lit = 0.0;
     for (var y = 0; y < k; y++) {
         for (var x = 0; x < k; x++) {
