@@ -120,3 +120,72 @@ fn bad_requests_are_errors_not_panics() {
     assert!(lab.run(&v, &TechniqueSpec::parse("nope").unwrap(), 1).is_err());
     assert!(lab.run(&v, &TechniqueSpec::parse("sm:res=3").unwrap(), 1).is_err());
 }
+
+#[test]
+fn pcf_and_spot_maps_at_high_resolution_match_rt() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let pcf = lab.run(&v, &TechniqueSpec::parse("sm:res=4096,pcf=3").unwrap(), 1).unwrap();
+    let a = agreement(&pcf.visibility, &rt.visibility, &v.mask);
+    if a < 99.0 {
+        panic!("sm 4096 pcf 3 agrees with rt on {a:.3}%; {}", save_images("pcf-planebox", &v, &pcf, &rt));
+    }
+    assert_eq!(pcf.report.counters["fetches_per_pixel"], 9.0);
+    // PCF gives fractional values at the shadow edge, and only there
+    let fractional = pcf.visibility.iter().zip(&v.mask).filter(|(x, m)| **m != 0 && **x > 0.01 && **x < 0.99).count();
+    assert!(fractional > 0 && (fractional as f64) < 0.05 * v.mask.iter().filter(|m| **m != 0).count() as f64, "{fractional} fractional pixels");
+
+    let room = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &room).unwrap();
+    let v = view(&lab, &room, 0, 256); // spot light
+    let rt = lab.reference(&v, 1).unwrap();
+    let sm = lab.run(&v, &TechniqueSpec::parse("sm:res=4096").unwrap(), 1).unwrap();
+    let a = agreement(&sm.visibility, &rt.visibility, &v.mask);
+    if a < 99.0 {
+        panic!("spot sm 4096 agrees with rt on {a:.3}%; {}", save_images("spot-room", &v, &sm, &rt));
+    }
+}
+
+/// A card whose texture is transparent on its left half floats over a floor under a vertical
+/// light: the shadow must cover exactly the right half, for `rt` and for `sm`.
+#[test]
+fn alpha_cutouts_cast_exact_shadows() {
+    use glam::{Vec2, Vec3};
+    use shadowlab_core::builtin::MeshBuilder;
+    use shadowlab_core::camera::Camera;
+    use shadowlab_core::light::Light;
+    use shadowlab_core::scene::{Material, Texture};
+    let Some(gpu) = gpu() else { return };
+    let mut b = MeshBuilder::default();
+    let floor = b.material(Material::solid("floor", [0.8; 3]));
+    let rgba: Vec<u8> = (0..8 * 8).flat_map(|i| if i % 8 < 4 { [255, 0, 0, 0] } else { [255, 0, 0, 255] }).collect();
+    let tex = b.texture(Texture { name: "half".into(), width: 8, height: 8, rgba });
+    let card = b.material(Material { texture: Some(tex), alpha_cutoff: Some(0.5), ..Material::solid("card", [1.0; 3]) });
+    b.quad(Vec3::new(-4.0, 0.0, 4.0), Vec3::new(8.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -8.0), Vec2::ONE, floor);
+    // card spans x in [-1, 1]; uv.x = 0 at x = -1
+    b.quad(Vec3::new(-1.0, 1.0, 1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -2.0), Vec2::ONE, card);
+    let cam = Camera::new(Vec3::new(0.0, 6.0, 0.01), Vec3::ZERO, 60.0, 0.1, 20.0);
+    let scene = b.finish("cutout", cam, vec![Light::Directional { direction: -Vec3::Y }], vec![]);
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = lab.view(&cam, &cam, &scene.lights[0], 128, 128).unwrap();
+    let rt = lab.reference(&v, 1).unwrap();
+    let sm = lab.run(&v, &TechniqueSpec::parse("sm:res=2048").unwrap(), 1).unwrap();
+    let (mut checked, mut wrong_rt, mut wrong_sm) = (0, 0, 0);
+    for i in 0..v.mask.len() {
+        let p = v.position[i];
+        // floor pixels away from the card's outline and from the alpha edge at x = 0
+        if v.mask[i] == 0 || p[1] > 0.5 || p[2].abs() > 0.9 || p[0].abs() > 0.9 || p[0].abs() < 0.1 {
+            continue;
+        }
+        let expect_lit = p[0] < 0.0;
+        checked += 1;
+        wrong_rt += ((rt.visibility[i] >= 0.5) != expect_lit) as u32;
+        wrong_sm += ((sm.visibility[i] >= 0.5) != expect_lit) as u32;
+    }
+    assert!(checked > 500, "only {checked} floor pixels under the card");
+    assert_eq!(wrong_rt, 0, "rt ignores or misplaces the cut-out");
+    assert_eq!(wrong_sm, 0, "sm ignores or misplaces the cut-out");
+}
