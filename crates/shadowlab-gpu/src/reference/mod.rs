@@ -5,15 +5,14 @@
 use shadowlab_core::params::ParamDef;
 
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
-use crate::techniques::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
 const RT_WGSL: &str = include_str!("rt.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("rt.wgsl", compose(RT_WGSL, true))]
+    vec![("rt.wgsl", compose_view(RT_WGSL, true))]
 }
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -37,43 +36,15 @@ pub struct RayTraced {
 
 impl RayTraced {
     pub fn new(gpu: &Gpu, scene: &GpuScene) -> RayTraced {
-        let layout = binding::layout(
-            &gpu.device,
-            "rt",
-            wgpu::ShaderStages::COMPUTE,
-            &[
-                binding::uniform(),
-                binding::uniform(),
-                binding::texture_float(),
-                binding::texture_float(),
-                binding::storage(true),
-                binding::storage(false),
-                binding::storage(false),
-            ],
-        );
-        let pipeline = gpu.compute_pipeline("rt", &compose(RT_WGSL, true), "main", &[&layout, &scene.layout]);
+        let layout = view_layout(gpu, "rt", &[binding::storage(false)]);
+        let pipeline = gpu.compute_pipeline("rt", &compose_view(RT_WGSL, true), "main", &[&layout, &scene.layout]);
         RayTraced { pipeline, layout, rays: gpu.storage("rt.rays", 4), bvh_bytes: scene.bvh_bytes, last_rays: 0 }
     }
 }
 
 impl Technique for RayTraced {
     fn run(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let pv = f.gbuffer.position.create_view(&Default::default());
-        let nv = f.gbuffer.normal.create_view(&Default::default());
-        let group = binding::group(
-            &gpu.device,
-            "rt",
-            &self.layout,
-            &[
-                f.frame.as_entire_binding(),
-                f.light_buf.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&pv),
-                wgpu::BindingResource::TextureView(&nv),
-                f.gbuffer.mask.as_entire_binding(),
-                f.visibility.as_entire_binding(),
-                self.rays.as_entire_binding(),
-            ],
-        );
+        let group = f.view_group(gpu, "rt", &self.layout, &[self.rays.as_entire_binding()]);
         gpu.queue.write_buffer(&self.rays, 0, &[0u8; 4]);
         timer.stage(gpu, "rt.trace", |enc| {
             gpu.dispatch_2d(enc, "rt.trace", &self.pipeline, &[&group, &f.scene.group], f.gbuffer.width, f.gbuffer.height)

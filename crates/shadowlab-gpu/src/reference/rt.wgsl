@@ -2,12 +2,6 @@
 // pixel through the BVH, any-hit with early exit, alpha cut-outs honoured. Mirrors
 // shadowlab-core/src/bvh.rs (`shadow_ray`, `intersect_triangle`, `occluded`).
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<uniform> light: LightU;
-@group(0) @binding(2) var g_position: texture_2d<f32>;
-@group(0) @binding(3) var g_normal: texture_2d<f32>;
-@group(0) @binding(4) var<storage, read> mask: array<u32>;
-@group(0) @binding(5) var<storage, read_write> visibility: array<f32>;
 @group(0) @binding(6) var<storage, read_write> rays: atomic<u32>;
 
 const MAX_DEPTH: u32 = 64u;
@@ -96,17 +90,11 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    var s: Sample;
+    if !load_sample(id, &s) {
         return;
     }
-    let i = id.y * frame.size.x + id.x;
-    if mask[i] == 0u {
-        visibility[i] = 0.0;
-        return;
-    }
-    let p = textureLoad(g_position, id.xy, 0).xyz;
-    let n = textureLoad(g_normal, id.xy, 0).xyz;
-    let o = p + n * light.eps;
+    let o = s.p + s.n * light.eps;
     var d = -light.direction.xyz;
     var tmax = 1e30;
     if light.kind != LIGHT_DIRECTIONAL {
@@ -115,5 +103,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         d = to / tmax;
     }
     atomicAdd(&rays, 1u);
-    visibility[i] = select(1.0, 0.0, occluded(o, d, tmax));
+    visibility[s.i] = select(1.0, 0.0, occluded(o, d, tmax));
 }

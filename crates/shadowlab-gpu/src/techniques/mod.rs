@@ -28,6 +28,41 @@ pub struct FrameInputs<'a> {
     pub visibility: &'a wgpu::Buffer,
 }
 
+/// The view inputs of `view.wgsl`: group 0 bindings 0-5, prepended to visibility shaders.
+pub const VIEW_WGSL: &str = include_str!("view.wgsl");
+
+/// `common.wgsl` (+ `scene.wgsl`) + `view.wgsl` + `body`.
+pub fn compose_view(body: &str, with_scene: bool) -> String {
+    crate::shaders::compose(&format!("{VIEW_WGSL}{body}"), with_scene)
+}
+
+/// Bind group layout for a visibility pass: the six view bindings of `view.wgsl`, then `extra`
+/// numbered from 6.
+pub fn view_layout(gpu: &Gpu, label: &str, extra: &[wgpu::BindingType]) -> wgpu::BindGroupLayout {
+    use crate::binding::{storage, texture_float, uniform};
+    let mut types = vec![uniform(), uniform(), texture_float(), texture_float(), storage(true), storage(false)];
+    types.extend_from_slice(extra);
+    crate::binding::layout(&gpu.device, label, wgpu::ShaderStages::COMPUTE, &types)
+}
+
+impl FrameInputs<'_> {
+    /// Bind group for [`view_layout`]: the view inputs, then `extra` from binding 6.
+    pub fn view_group(&self, gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource]) -> wgpu::BindGroup {
+        let pv = self.gbuffer.position.create_view(&Default::default());
+        let nv = self.gbuffer.normal.create_view(&Default::default());
+        let mut res = vec![
+            self.frame.as_entire_binding(),
+            self.light_buf.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&pv),
+            wgpu::BindingResource::TextureView(&nv),
+            self.gbuffer.mask.as_entire_binding(),
+            self.visibility.as_entire_binding(),
+        ];
+        res.extend_from_slice(extra);
+        crate::binding::group(&gpu.device, label, layout, &res)
+    }
+}
+
 /// An RGBA8 picture a technique offers the report (shadow maps, count maps, warps).
 #[derive(Clone, Debug)]
 pub struct NamedImage {

@@ -9,15 +9,9 @@ struct SmParams {
     bias: vec4<f32>,
 }
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<uniform> light: LightU;
-@group(0) @binding(2) var<uniform> sm: SmParams;
-@group(0) @binding(3) var g_position: texture_2d<f32>;
-@group(0) @binding(4) var g_normal: texture_2d<f32>;
-@group(0) @binding(5) var<storage, read> mask: array<u32>;
-@group(0) @binding(6) var shadow_map: texture_depth_2d;
-@group(0) @binding(7) var cmp: sampler_comparison;
-@group(0) @binding(8) var<storage, read_write> visibility: array<f32>;
+@group(0) @binding(6) var<uniform> sm: SmParams;
+@group(0) @binding(7) var shadow_map: texture_depth_2d;
+@group(0) @binding(8) var cmp: sampler_comparison;
 @group(0) @binding(9) var<storage, read_write> counts: array<atomic<u32>>;
 
 fn to_map(p: vec3<f32>) -> vec3<f32> {
@@ -28,16 +22,13 @@ fn to_map(p: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    var s: Sample;
+    if !load_sample(id, &s) {
         return;
     }
-    let i = id.y * frame.size.x + id.x;
-    if mask[i] == 0u {
-        visibility[i] = 0.0;
-        return;
-    }
-    let p = textureLoad(g_position, id.xy, 0).xyz;
-    let n = textureLoad(g_normal, id.xy, 0).xyz;
+    let p = s.p;
+    let n = s.n;
+    let i = s.i;
     let l = to_light(light, p);
     let res = sm.texel.z;
 

@@ -11,7 +11,7 @@ use shadowlab_core::params::{ParamDef, ParamValues};
 
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
-use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
+use crate::techniques::{compose_view, view_layout, FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
@@ -19,7 +19,7 @@ const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("sm/depth.wgsl", compose(DEPTH_WGSL, true)), ("sm/eval.wgsl", compose(EVAL_WGSL, false))]
+    vec![("sm/depth.wgsl", compose(DEPTH_WGSL, true)), ("sm/eval.wgsl", compose_view(EVAL_WGSL, false))]
 }
 
 /// Shadow-map side in texels. The seeds evaluate 512 against 1024x1024 output.
@@ -123,14 +123,8 @@ impl ShadowMap {
             multiview_mask: None,
             cache: None,
         });
-        use binding::{comparison_sampler as cmp, storage, texture_depth, texture_float as tex, uniform as uni};
-        let eval_layout = binding::layout(
-            d,
-            "sm.eval",
-            wgpu::ShaderStages::COMPUTE,
-            &[uni(), uni(), uni(), tex(), tex(), storage(true), texture_depth(), cmp(), storage(false), storage(false)],
-        );
-        let eval_pipeline = gpu.compute_pipeline("sm.eval", &compose(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let eval_layout = view_layout(gpu, "sm.eval", &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)]);
+        let eval_pipeline = gpu.compute_pipeline("sm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("sm.cmp"),
             compare: Some(wgpu::CompareFunction::LessEqual),
@@ -166,22 +160,14 @@ impl Technique for ShadowMap {
             pass.set_bind_group(1, &f.scene.group, &[]);
             pass.draw(0..f.scene.triangle_count * 3, 0..1);
         });
-        let pv = f.gbuffer.position.create_view(&Default::default());
-        let nv = f.gbuffer.normal.create_view(&Default::default());
-        let group = binding::group(
-            &gpu.device,
+        let group = f.view_group(
+            gpu,
             "sm.eval",
             &self.eval_layout,
             &[
-                f.frame.as_entire_binding(),
-                f.light_buf.as_entire_binding(),
                 self.uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&pv),
-                wgpu::BindingResource::TextureView(&nv),
-                f.gbuffer.mask.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&map_view),
                 wgpu::BindingResource::Sampler(&self.sampler),
-                f.visibility.as_entire_binding(),
                 self.counts.as_entire_binding(),
             ],
         );
