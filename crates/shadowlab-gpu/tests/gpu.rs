@@ -189,3 +189,37 @@ fn alpha_cutouts_cast_exact_shadows() {
     assert_eq!(wrong_rt, 0, "rt ignores or misplaces the cut-out");
     assert_eq!(wrong_sm, 0, "sm ignores or misplaces the cut-out");
 }
+
+#[test]
+fn motion_vectors_match_the_camera_motion() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let cam = scene.camera;
+    let mut prev = cam;
+    prev.position += glam::Vec3::new(0.3, 0.05, -0.2);
+    prev.target += glam::Vec3::new(0.3, 0.0, 0.0);
+    let (w, h) = (64, 48);
+    let v = lab.view(&cam, &prev, &scene.lights[0], w, h).unwrap();
+    let motion: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&v.gbuffer.motion, 8));
+    let mut checked = 0;
+    for y in (0..h).step_by(7) {
+        for x in (0..w).step_by(7) {
+            let i = (y * w + x) as usize;
+            let p = v.position[i];
+            if p[3] <= 0.0 {
+                continue;
+            }
+            let world = glam::Vec3::new(p[0], p[1], p[2]);
+            let now = cam.project_to_pixel(world, w, h).unwrap();
+            let before = prev.project_to_pixel(world, w, h).unwrap();
+            let expect = now - before;
+            let got = glam::Vec2::from(motion[i]);
+            assert!((got - expect).length() < 0.05 + 1e-3 * expect.length(), "pixel ({x},{y}): motion {got} expected {expect}");
+            // the sample is where the pixel centre is
+            assert!((now - glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).length() < 0.01, "{now}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 20);
+}
