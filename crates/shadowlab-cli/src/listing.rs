@@ -34,7 +34,7 @@ pub fn techniques() -> Result<()> {
             println!("  parameters: none");
         }
         for p in t.params {
-            let range = if p.integer { format!("{}..{}", p.min, p.max) } else { format!("{}..{}", p.min, p.max) };
+            let range = format!("{}..{}{}", p.min, p.max, if p.integer { ", whole" } else { "" });
             println!("  {:<14} default {:<8} [{range}]  {}  (source: {})", p.key, p.default, p.doc, p.source);
         }
         println!();

@@ -124,7 +124,7 @@ mod tests {
         assert_eq!(m.wrong_pct, 50.0);
         assert_eq!(m.false_lit_pct, 25.0);
         assert_eq!(m.false_shadow_pct, 25.0);
-        assert!((m.mae - (0.8 + 0.7) as f64 / 4.0).abs() < 1e-6);
+        assert!((m.mae - (0.8 + 0.7) / 4.0).abs() < 1e-6);
     }
     #[test]
     fn sampling_of_known_counts() {

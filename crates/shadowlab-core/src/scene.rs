@@ -168,7 +168,8 @@ impl TriangleSink {
         }
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let scale = (p[1] - p[0]).length_squared().max((p[2] - p[0]).length_squared());
-        if !(n.length_squared() > scale * scale * 1e-14) || n.length_squared() == 0.0 {
+        let area2 = n.length_squared();
+        if area2 == 0.0 || area2 <= scale * scale * 1e-14 {
             self.report.degenerate_triangles_skipped += 1;
             return false;
         }

@@ -52,9 +52,8 @@ impl GpuScene {
                     let tex = &scene.textures[t as usize];
                     (offsets[t as usize], tex.width, tex.height)
                 });
-                let flags = (m.texture.is_some() as u32) * MAT_TEXTURED
-                    | (m.alpha_cutoff.is_some() as u32) * MAT_MASKED
-                    | (m.double_sided as u32) * MAT_DOUBLE_SIDED;
+                let bit = |on: bool, b: u32| if on { b } else { 0 };
+                let flags = bit(m.texture.is_some(), MAT_TEXTURED) | bit(m.alpha_cutoff.is_some(), MAT_MASKED) | bit(m.double_sided, MAT_DOUBLE_SIDED);
                 GpuMaterial { base_color: m.base_color, tex_offset: off, tex_width: w, tex_height: h, flags, alpha_cutoff: m.alpha_cutoff.unwrap_or(0.0), _pad: [0; 3] }
             })
             .collect();

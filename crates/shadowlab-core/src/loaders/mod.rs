@@ -65,7 +65,7 @@ impl SceneTransform {
 /// Loads a scene file by extension, applies `xf`, and gives it a default camera and light
 /// fitted to its bounds (setups normally override both).
 pub fn load(path: &Path, xf: &SceneTransform) -> Result<Scene, LoadError> {
-    if !(xf.scale.is_finite() && xf.scale > 0.0) || !xf.offset.is_finite() {
+    if !(xf.scale.is_finite() && xf.scale > 0.0 && xf.offset.is_finite()) {
         return Err(LoadError::invalid(path, "scale must be a positive finite number and offset finite"));
     }
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
