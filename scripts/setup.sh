@@ -19,6 +19,11 @@ have_driver() {
     esac
 }
 
+if ! command -v cargo >/dev/null 2>&1; then
+    echo "error: cargo not found; install a stable Rust toolchain (rustup) and run make again" >&2
+    exit 1
+fi
+
 if have_driver; then
     exit 0
 fi

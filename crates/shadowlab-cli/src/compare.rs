@@ -93,6 +93,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
             "counters": run.report.counters,
             "sampling": run.report.sampling,
             "images": {"shaded": format!("{s}.png"), "error": format!("{s}-error.png"), "error_split": format!("{s}-error-split.png"), "extra": images},
+            "visibility_npy": export_raw.then(|| format!("visibility/{s}.npy")),
         }));
     }
     let metrics = json!({
