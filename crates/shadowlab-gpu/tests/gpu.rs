@@ -223,3 +223,28 @@ fn motion_vectors_match_the_camera_motion() {
     }
     assert!(checked > 20);
 }
+
+/// Manual (needs ../shared/scenes): `cargo test --release -p shadowlab-gpu --test gpu -- --ignored`.
+#[test]
+#[ignore = "needs the real scenes of ../shared/scenes"]
+fn rt_gpu_matches_cpu_on_real_scenes() {
+    let Some(gpu) = gpu() else { return };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../setups");
+    for name in ["sponza", "conference", "sibenik"] {
+        let setup = shadowlab_core::setup::Setup::load(&root.join(format!("{name}.toml"))).unwrap();
+        let Some(path) = setup.scene.path.clone().filter(|p| p.exists()) else {
+            panic!("{name}: scene file missing");
+        };
+        let scene = shadowlab_core::loaders::load(&path, &setup.transform()).unwrap();
+        let lab = Lab::new(&gpu, &scene).unwrap();
+        let cam = setup.camera.unwrap();
+        for light in &setup.lights {
+            let v = lab.view(&cam, &cam, light, 512, 512).unwrap();
+            let rt = lab.reference(&v, 1).unwrap();
+            let cpu = cpu_visibility(&lab.bvh, &scene, light, &v.position, &v.normal, &v.mask, lab.gscene.eps);
+            let m = compare(&rt.visibility, &cpu, &v.mask);
+            eprintln!("{name} {}: GPU/CPU agree on {:.4} % of {} pixels", light.kind(), 100.0 - m.wrong_pct, m.evaluated_pixels);
+            assert!(100.0 - m.wrong_pct >= 99.99);
+        }
+    }
+}
