@@ -127,10 +127,10 @@ impl<'a> Lab<'a> {
         };
         let mut timer = StageTimer::default();
         let mut warm = StageTimer::default();
-        tech.run(gpu, &inputs, &mut warm)?;
+        techniques::run_frame(tech.as_mut(), gpu, &inputs, &mut warm)?;
         gpu.take_error()?;
         for _ in 0..repeat.max(1) {
-            tech.run(gpu, &inputs, &mut timer)?;
+            techniques::run_frame(tech.as_mut(), gpu, &inputs, &mut timer)?;
         }
         gpu.take_error()?;
         let stages_ms = timer.medians();

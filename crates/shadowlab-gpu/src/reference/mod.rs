@@ -43,7 +43,12 @@ impl RayTraced {
 }
 
 impl Technique for RayTraced {
-    fn run(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    /// The BVH is built and uploaded with the scene: nothing to render per frame.
+    fn render(&mut self, _gpu: &Gpu, _f: &FrameInputs, _timer: &mut StageTimer) -> Result<(), GpuError> {
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         let group = f.view_group(gpu, "rt", &self.layout, &[self.rays.as_entire_binding()]);
         gpu.queue.write_buffer(&self.rays, 0, &[0u8; 4]);
         timer.stage(gpu, "rt.trace", |enc| {

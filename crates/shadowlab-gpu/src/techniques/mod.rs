@@ -84,11 +84,28 @@ pub struct TechniqueReport {
     pub images: Vec<NamedImage>,
 }
 
+/// One shadow technique for one light. The lab calls, per frame: [`prepare`](Technique::prepare)
+/// (analysis of the view samples, e.g. a warp), [`render`](Technique::render) (the shadow data),
+/// [`evaluate`](Technique::evaluate) (the visibility buffer); then [`report`](Technique::report).
+/// Each records its GPU work through `timer` under pass names (`<technique>.<stage>`).
 pub trait Technique {
-    /// Renders the shadow data for this frame and evaluates visibility, timing each stage by name.
-    fn run(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError>;
-    /// Memory, counters, sampling statistics and pictures of the last run.
+    /// Per-frame analysis of the view before the shadow data is rendered (default: none).
+    fn prepare(&mut self, _gpu: &Gpu, _f: &FrameInputs, _timer: &mut StageTimer) -> Result<(), GpuError> {
+        Ok(())
+    }
+    /// Renders the shadow data (maps, warps, tiles...) for this frame.
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError>;
+    /// Writes `f.visibility` for every evaluated pixel.
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError>;
+    /// Memory, counters, sampling statistics and pictures of the last frame.
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport;
+}
+
+/// prepare, render, evaluate.
+pub fn run_frame(t: &mut dyn Technique, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    t.prepare(gpu, f, timer)?;
+    t.render(gpu, f, timer)?;
+    t.evaluate(gpu, f, timer)
 }
 
 pub type CreateFn = fn(&Gpu, &GpuScene, &ParamValues, &Light) -> Result<Box<dyn Technique>, GpuError>;

@@ -140,7 +140,7 @@ impl ShadowMap {
 }
 
 impl Technique for ShadowMap {
-    fn run(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         let map_view = self.map.create_view(&Default::default());
         timer.stage(gpu, "sm.render", |enc| {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -160,6 +160,11 @@ impl Technique for ShadowMap {
             pass.set_bind_group(1, &f.scene.group, &[]);
             pass.draw(0..f.scene.triangle_count * 3, 0..1);
         });
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let map_view = self.map.create_view(&Default::default());
         let group = f.view_group(
             gpu,
             "sm.eval",
