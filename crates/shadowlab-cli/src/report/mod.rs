@@ -9,6 +9,8 @@ pub fn html(metrics: &serde_json::Value) -> Result<String> {
     let mut env = minijinja::Environment::new();
     env.add_template("index.html", TEMPLATE)?;
     env.add_filter("f", |v: f64, digits: usize| format!("{v:.digits$}"));
+    // whole numbers without a trailing ".0" (parameters, counters)
+    env.add_filter("num", |v: f64| if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { format!("{v}") });
     env.add_filter("bytes", |v: f64| {
         if v >= 1048576.0 { format!("{:.2} MiB", v / 1048576.0) } else if v >= 1024.0 { format!("{:.1} KiB", v / 1024.0) } else { format!("{v} B") }
     });
@@ -32,6 +34,8 @@ mod tests {
         });
         let h = super::html(&m).unwrap();
         assert!(h.contains("sm:pcf=3") && h.contains("1.250") && h.contains("1.00 MiB") && h.contains("b.png"));
+        assert!(h.contains("res=512<") || h.contains("res=512,") || h.contains("res=512 "), "parameters print as whole numbers");
+        assert!(h.contains("<td>9</td>"), "fetches print as whole numbers");
         assert!(!h.contains("http://") && !h.contains("https://"), "report must work offline");
     }
 }
