@@ -85,6 +85,8 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
     let specs = specs_text.iter().map(|s| TechniqueSpec::parse(s).map_err(|e| anyhow!(e))).collect::<Result<Vec<_>>>()?;
     let mut labels = std::collections::HashSet::new();
     for s in &specs {
+        // names and parameters are checked before a (possibly large) scene is loaded
+        shadowlab_gpu::techniques::resolve(s, None)?;
         if !labels.insert(s.label()) {
             bail!("two techniques share the label '{}'; give one `label=...`", s.label());
         }
