@@ -69,8 +69,18 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         let s = slug(&run.label);
         let m = metrics_of(&run.visibility, &rt.visibility, &view.mask);
         export::png(&dir.path(&format!("{s}.png")), w, h, &run.shaded)?;
-        export::png(&dir.path(&format!("{s}-error.png")), w, h, &error_image(&rt.shaded, &run.visibility, &rt.visibility, &view.mask, false))?;
-        export::png(&dir.path(&format!("{s}-error-split.png")), w, h, &error_image(&rt.shaded, &run.visibility, &rt.visibility, &view.mask, true))?;
+        export::png(
+            &dir.path(&format!("{s}-error.png")),
+            w,
+            h,
+            &error_image(&rt.shaded, &run.visibility, &rt.visibility, &view.mask, false),
+        )?;
+        export::png(
+            &dir.path(&format!("{s}-error-split.png")),
+            w,
+            h,
+            &error_image(&rt.shaded, &run.visibility, &rt.visibility, &view.mask, true),
+        )?;
         let mut images = Vec::new();
         for (k, img) in run.report.images.iter().enumerate() {
             let file = format!("{s}-extra{k}.png");
@@ -146,22 +156,48 @@ fn row_major(m: &glam::Mat4) -> [[f32; 4]; 4] {
     m.transpose().to_cols_array_2d()
 }
 
-const CSV_COLUMNS: &[&str] = &["wrong_pct", "false_lit_pct", "false_shadow_pct", "mae", "evaluated_pixels", "shadow_data_bytes", "total_ms"];
+const CSV_COLUMNS: &[&str] =
+    &["wrong_pct", "false_lit_pct", "false_shadow_pct", "mae", "evaluated_pixels", "shadow_data_bytes", "total_ms"];
 
 fn csv(metrics: &serde_json::Value) -> String {
     let mut s = format!("label,technique,{},fetches_per_pixel,rays_traced\n", CSV_COLUMNS.join(","));
     for t in metrics["techniques"].as_array().into_iter().flatten() {
         let q = |k: &str| t["counters"].get(k).map(|v| v.to_string()).unwrap_or_default();
         let cols: Vec<String> = CSV_COLUMNS.iter().map(|k| t[*k].to_string()).collect();
-        s += &format!("\"{}\",{},{},{},{}\n", t["label"].as_str().unwrap_or("").replace('"', "\"\""), t["technique"].as_str().unwrap_or(""), cols.join(","), q("fetches_per_pixel"), q("rays_traced"));
+        s += &format!(
+            "\"{}\",{},{},{},{}\n",
+            t["label"].as_str().unwrap_or("").replace('"', "\"\""),
+            t["technique"].as_str().unwrap_or(""),
+            cols.join(","),
+            q("fetches_per_pixel"),
+            q("rays_traced")
+        );
     }
     s
 }
 
 fn summary(cfg: &RunConfig, m: &serde_json::Value) {
-    println!("{} ({} triangles), {}x{}, light {} ({}), {}", cfg.scene.name, cfg.scene.triangle_count(), cfg.width, cfg.height, cfg.light_index, cfg.light().kind(), m["adapter"].as_str().unwrap_or(""));
+    println!(
+        "{} ({} triangles), {}x{}, light {} ({}), {}",
+        cfg.scene.name,
+        cfg.scene.triangle_count(),
+        cfg.width,
+        cfg.height,
+        cfg.light_index,
+        cfg.light().kind(),
+        m["adapter"].as_str().unwrap_or("")
+    );
     println!("{:<28} {:>8} {:>9} {:>9} {:>8} {:>10} {:>12}", "technique", "wrong%", "f-lit%", "f-shad%", "mae", "ms", "bytes");
-    println!("{:<28} {:>8} {:>9} {:>9} {:>8} {:>10.2} {:>12}", "rt (reference)", "-", "-", "-", "-", m["reference"]["total_ms"].as_f64().unwrap_or(0.0), m["bvh"]["bytes"]);
+    println!(
+        "{:<28} {:>8} {:>9} {:>9} {:>8} {:>10.2} {:>12}",
+        "rt (reference)",
+        "-",
+        "-",
+        "-",
+        "-",
+        m["reference"]["total_ms"].as_f64().unwrap_or(0.0),
+        m["bvh"]["bytes"]
+    );
     for t in m["techniques"].as_array().into_iter().flatten() {
         let f = |k: &str| t[k].as_f64().unwrap_or(f64::NAN);
         println!(

@@ -62,7 +62,11 @@ pub fn load_scene(source: &SceneSource, xf: &SceneTransform) -> Result<Scene> {
 
 fn scene_arg(s: &str) -> SceneSource {
     let looks_like_file = s.contains('/') || s.contains('.') || Path::new(s).exists();
-    if looks_like_file && builtin(s).is_none() { SceneSource::File(PathBuf::from(s)) } else { SceneSource::Builtin(s.to_string()) }
+    if looks_like_file && builtin(s).is_none() {
+        SceneSource::File(PathBuf::from(s))
+    } else {
+        SceneSource::Builtin(s.to_string())
+    }
 }
 
 pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {

@@ -23,7 +23,8 @@ pub fn gbuffer(dir: &Path, w: u32, h: u32, position: &[[f32; 4]], normal: &[[f32
     let shape3 = [h as u64, w as u64, 3];
     let pos: Vec<f32> = position.iter().flat_map(|p| if p[3] > 0.0 { [p[0], p[1], p[2]] } else { [f32::NAN; 3] }).collect();
     npy(&dir.join("position.npy"), &shape3, &pos)?;
-    let nrm: Vec<f32> = normal.iter().zip(position).flat_map(|(n, p)| if p[3] > 0.0 { [n[0], n[1], n[2]] } else { [f32::NAN; 3] }).collect();
+    let nrm: Vec<f32> =
+        normal.iter().zip(position).flat_map(|(n, p)| if p[3] > 0.0 { [n[0], n[1], n[2]] } else { [f32::NAN; 3] }).collect();
     npy(&dir.join("normal.npy"), &shape3, &nrm)?;
     let m: Vec<u8> = mask.iter().map(|&x| (x != 0) as u8).collect();
     npy(&dir.join("mask.npy"), &[h as u64, w as u64], &m)

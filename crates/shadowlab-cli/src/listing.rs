@@ -14,7 +14,8 @@ pub fn scenes() -> Result<()> {
     }
     println!("\nSetups (use with --setup): see setups/*.toml; scene files load from .gltf, .glb and .obj (--scene PATH).");
     if let Ok(rd) = std::fs::read_dir("setups") {
-        let mut names: Vec<_> = rd.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
+        let mut names: Vec<_> =
+            rd.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
         names.sort();
         for p in names {
             println!("  {}", p.display());

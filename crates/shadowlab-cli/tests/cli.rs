@@ -58,9 +58,38 @@ fn compare_writes_report_metrics_and_exports() {
         return;
     }
     let out = tmp("report");
-    let o = run(&["compare", "--scene", "planebox", "--size", "96x64", "-t", "sm", "-t", "sm:pcf=3,label=soft", "--repeat", "1", "--export", "--quiet", "--out", out.to_str().unwrap()]);
+    let o = run(&[
+        "compare",
+        "--scene",
+        "planebox",
+        "--size",
+        "96x64",
+        "-t",
+        "sm",
+        "-t",
+        "sm:pcf=3,label=soft",
+        "--repeat",
+        "1",
+        "--export",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for f in ["index.html", "metrics.json", "metrics.csv", "rt.png", "sm.png", "sm-error.png", "soft.png", "position.npy", "normal.npy", "mask.npy", "visibility/rt.npy", "visibility/soft.npy"] {
+    for f in [
+        "index.html",
+        "metrics.json",
+        "metrics.csv",
+        "rt.png",
+        "sm.png",
+        "sm-error.png",
+        "soft.png",
+        "position.npy",
+        "normal.npy",
+        "mask.npy",
+        "visibility/rt.npy",
+        "visibility/soft.npy",
+    ] {
         assert!(out.join(f).exists(), "missing {f}");
     }
     let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
@@ -93,7 +122,20 @@ fn a_scene_file_loads_without_a_setup() {
     }
     let out = tmp("file");
     let scene = fixtures().join("quad.obj");
-    let o = run(&["compare", "-q", "--scene", scene.to_str().unwrap(), "--size", "32x32", "-t", "sm", "--repeat", "1", "--out", out.to_str().unwrap()]);
+    let o = run(&[
+        "compare",
+        "-q",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--size",
+        "32x32",
+        "-t",
+        "sm",
+        "--repeat",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
     assert_eq!(m["scene"], "quad");
@@ -109,7 +151,18 @@ fn the_same_run_twice_gives_identical_metrics() {
     }
     let (a, b) = (tmp("twice-a"), tmp("twice-b"));
     for d in [&a, &b] {
-        let o = run(&["compare", "--setup", "../../setups/foliage.toml", "--size", "128x128", "--repeat", "1", "-q", "--out", d.to_str().unwrap()]);
+        let o = run(&[
+            "compare",
+            "--setup",
+            "../../setups/foliage.toml",
+            "--size",
+            "128x128",
+            "--repeat",
+            "1",
+            "-q",
+            "--out",
+            d.to_str().unwrap(),
+        ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     assert_eq!(metrics_without_times(&a), metrics_without_times(&b));
@@ -157,7 +210,8 @@ fn bad_input_gives_one_clear_error_and_no_report() {
 #[test]
 fn no_adapter_is_one_clear_error() {
     // Restricting wgpu to a backend this build lacks leaves no adapter at all.
-    let o = bin().env("WGPU_BACKEND", "gl").args(["render", "--scene", "planebox", "--size", "8x8", "--out", "/dev/null"]).output().unwrap();
+    let o =
+        bin().env("WGPU_BACKEND", "gl").args(["render", "--scene", "planebox", "--size", "8x8", "--out", "/dev/null"]).output().unwrap();
     assert_clean_error(&o, "no GPU adapter found");
     assert!(String::from_utf8_lossy(&o.stderr).contains("mesa-vulkan-drivers"));
 }

@@ -186,7 +186,15 @@ pub fn occluded(bvh: &Bvh, scene: &Scene, r: &ShadowRay) -> bool {
 
 /// CPU reference visibility for G-buffer samples (`position`/`normal` xyz per pixel, `mask` 1 =
 /// evaluated). Non-evaluated pixels get 0. Runs on all cores with rayon.
-pub fn cpu_visibility(bvh: &Bvh, scene: &Scene, light: &Light, position: &[[f32; 4]], normal: &[[f32; 4]], mask: &[u32], eps: f32) -> Vec<f32> {
+pub fn cpu_visibility(
+    bvh: &Bvh,
+    scene: &Scene,
+    light: &Light,
+    position: &[[f32; 4]],
+    normal: &[[f32; 4]],
+    mask: &[u32],
+    eps: f32,
+) -> Vec<f32> {
     (0..mask.len())
         .into_par_iter()
         .map(|i| {
@@ -195,7 +203,11 @@ pub fn cpu_visibility(bvh: &Bvh, scene: &Scene, light: &Light, position: &[[f32;
             }
             let p = Vec3::from_slice(&position[i][..3]);
             let n = Vec3::from_slice(&normal[i][..3]);
-            if occluded(bvh, scene, &shadow_ray(light, p, n, eps)) { 0.0 } else { 1.0 }
+            if occluded(bvh, scene, &shadow_ray(light, p, n, eps)) {
+                0.0
+            } else {
+                1.0
+            }
         })
         .collect()
 }

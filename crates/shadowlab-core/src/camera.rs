@@ -16,9 +16,15 @@ pub struct Camera {
     pub far: f32,
 }
 
-fn default_fov() -> f32 { 60.0 }
-fn default_near() -> f32 { 0.1 }
-fn default_far() -> f32 { 100.0 }
+fn default_fov() -> f32 {
+    60.0
+}
+fn default_near() -> f32 {
+    0.1
+}
+fn default_far() -> f32 {
+    100.0
+}
 
 /// Right-handed view matrix (wgpu/D3D conventions below: NDC z in [0, 1], y up).
 pub fn look_at(eye: Vec3, center: Vec3, up: Vec3) -> Mat4 {
@@ -46,7 +52,11 @@ impl Camera {
     /// Up vector: +Y unless the view is (nearly) vertical, then +Z.
     fn up(&self) -> Vec3 {
         let f = (self.target - self.position).normalize_or_zero();
-        if f.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y }
+        if f.cross(Vec3::Y).length_squared() < 1e-6 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        }
     }
     pub fn view(&self) -> Mat4 {
         look_at(self.position, self.target, self.up())

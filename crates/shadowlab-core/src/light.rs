@@ -46,7 +46,11 @@ impl Light {
             }
             Light::Point { position } => position.is_finite(),
         };
-        if finite { Ok(()) } else { Err(format!("{} light needs a finite position and a non-zero direction", self.kind())) }
+        if finite {
+            Ok(())
+        } else {
+            Err(format!("{} light needs a finite position and a non-zero direction", self.kind()))
+        }
     }
 }
 

@@ -16,7 +16,11 @@ pub struct LightProjection {
 }
 
 fn up_for(dir: Vec3) -> Vec3 {
-    if dir.normalize().cross(Vec3::Y).length_squared() < 1e-4 { Vec3::Z } else { Vec3::Y }
+    if dir.normalize().cross(Vec3::Y).length_squared() < 1e-4 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
 }
 
 /// Directional light: an orthographic box around the scene bounds, looking along the light.

@@ -102,7 +102,11 @@ pub fn error_image(shaded: &[u8], v: &[f32], v_rt: &[f32], mask: &[u32], split: 
         let g = (0.299 * px[0] as f32 + 0.587 * px[1] as f32 + 0.114 * px[2] as f32) as u8;
         let (a, b) = (v[i] >= 0.5, v_rt[i] >= 0.5);
         let c = if mask[i] != 0 && a != b {
-            if a || !split { [230, 20, 20] } else { [30, 80, 240] }
+            if a || !split {
+                [230, 20, 20]
+            } else {
+                [30, 80, 240]
+            }
         } else {
             [g, g, g]
         };

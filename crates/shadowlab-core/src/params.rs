@@ -46,9 +46,7 @@ impl TechniqueSpec {
         let mut label = None;
         if let Some(rest) = rest {
             for kv in rest.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-                let (k, v) = kv
-                    .split_once('=')
-                    .ok_or_else(|| format!("technique spec '{text}': expected key=value, got '{kv}'"))?;
+                let (k, v) = kv.split_once('=').ok_or_else(|| format!("technique spec '{text}': expected key=value, got '{kv}'"))?;
                 let (k, v) = (k.trim(), v.trim());
                 if k == "label" {
                     label = Some(v.to_string());

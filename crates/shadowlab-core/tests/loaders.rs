@@ -31,12 +31,7 @@ fn material(scene: &Scene, name: &str) -> usize {
 
 /// Triangles (three vertices each) that use material `mat`.
 fn triangles_of(scene: &Scene, mat: usize) -> Vec<[Vertex; 3]> {
-    scene
-        .vertices
-        .chunks_exact(3)
-        .filter(|t| t[0].material == mat as u32)
-        .map(|t| [t[0], t[1], t[2]])
-        .collect()
+    scene.vertices.chunks_exact(3).filter(|t| t[0].material == mat as u32).map(|t| [t[0], t[1], t[2]]).collect()
 }
 
 /// The uv of the vertex at `p` among the triangles of `mat` (panics if there is none).
@@ -276,7 +271,7 @@ fn glb_matrix_node_strip_and_buffer_view_image() {
     assert_has_vertex(&s, m, Vec3::new(1.0, 3.0, 1.0));
     assert_eq!(uv_at(&s, m, Vec3::new(1.0, 3.0, 1.0)), Vec2::new(1.0, 1.0));
     assert_has_vertex(&s, m, Vec3::new(1.0, 4.0, 2.0)); // strip vertex (1,1,2)
-    // both strip triangles keep the same (counter-clockwise) orientation
+                                                        // both strip triangles keep the same (counter-clockwise) orientation
     let strip: Vec<_> = triangles_of(&s, m).into_iter().filter(|t| t[0].pos[2] == 2.0).collect();
     assert_eq!(strip.len(), 2);
     assert!(strip.iter().all(|t| Vec3::from(t[0].normal) == Vec3::Z));

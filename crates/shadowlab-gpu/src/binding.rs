@@ -17,7 +17,11 @@ pub fn texture_float() -> BindingType {
     }
 }
 pub fn texture_depth() -> BindingType {
-    BindingType::Texture { sample_type: wgpu::TextureSampleType::Depth, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false }
+    BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Depth,
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    }
 }
 pub fn comparison_sampler() -> BindingType {
     BindingType::Sampler(wgpu::SamplerBindingType::Comparison)
@@ -33,10 +37,7 @@ pub fn layout(device: &wgpu::Device, label: &str, vis: ShaderStages, types: &[Bi
 }
 
 pub fn group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
-    let entries: Vec<_> = resources
-        .iter()
-        .enumerate()
-        .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
-        .collect();
+    let entries: Vec<_> =
+        resources.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() }).collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
 }

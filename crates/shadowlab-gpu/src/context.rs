@@ -163,7 +163,8 @@ impl Gpu {
     }
 
     pub fn shader(&self, label: &str, source: &str) -> wgpu::ShaderModule {
-        self.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) })
+        self.device
+            .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) })
     }
 
     /// A compute pipeline with explicit bind group layouts.
@@ -182,11 +183,23 @@ impl Gpu {
 
     pub fn pipeline_layout(&self, label: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::PipelineLayout {
         let opt: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
-        self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &opt, immediate_size: 0 })
+        self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &opt,
+            immediate_size: 0,
+        })
     }
 
     /// Records one compute dispatch covering `w x h` threads in 8x8 groups.
-    pub fn dispatch_2d(&self, enc: &mut wgpu::CommandEncoder, label: &str, pipeline: &wgpu::ComputePipeline, groups: &[&wgpu::BindGroup], w: u32, h: u32) {
+    pub fn dispatch_2d(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        label: &str,
+        pipeline: &wgpu::ComputePipeline,
+        groups: &[&wgpu::BindGroup],
+        w: u32,
+        h: u32,
+    ) {
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
         pass.set_pipeline(pipeline);
         for (i, g) in groups.iter().enumerate() {

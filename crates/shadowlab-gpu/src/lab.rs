@@ -111,7 +111,14 @@ impl<'a> Lab<'a> {
         self.run_resolved(view, info, params, spec.label(), repeat)
     }
 
-    pub fn run_resolved(&self, view: &View, info: &'static TechniqueInfo, params: ParamValues, label: String, repeat: usize) -> Result<Run, GpuError> {
+    pub fn run_resolved(
+        &self,
+        view: &View,
+        info: &'static TechniqueInfo,
+        params: ParamValues,
+        label: String,
+        repeat: usize,
+    ) -> Result<Run, GpuError> {
         let gpu = self.gpu;
         let t0 = std::time::Instant::now();
         let mut tech = (info.create)(gpu, &self.gscene, &params, &view.light)?;

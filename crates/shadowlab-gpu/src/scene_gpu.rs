@@ -53,8 +53,18 @@ impl GpuScene {
                     (offsets[t as usize], tex.width, tex.height)
                 });
                 let bit = |on: bool, b: u32| if on { b } else { 0 };
-                let flags = bit(m.texture.is_some(), MAT_TEXTURED) | bit(m.alpha_cutoff.is_some(), MAT_MASKED) | bit(m.double_sided, MAT_DOUBLE_SIDED);
-                GpuMaterial { base_color: m.base_color, tex_offset: off, tex_width: w, tex_height: h, flags, alpha_cutoff: m.alpha_cutoff.unwrap_or(0.0), _pad: [0; 3] }
+                let flags = bit(m.texture.is_some(), MAT_TEXTURED)
+                    | bit(m.alpha_cutoff.is_some(), MAT_MASKED)
+                    | bit(m.double_sided, MAT_DOUBLE_SIDED);
+                GpuMaterial {
+                    base_color: m.base_color,
+                    tex_offset: off,
+                    tex_width: w,
+                    tex_height: h,
+                    flags,
+                    alpha_cutoff: m.alpha_cutoff.unwrap_or(0.0),
+                    _pad: [0; 3],
+                }
             })
             .collect();
         let max = gpu.limits.max_storage_buffer_binding_size as usize;
@@ -76,7 +86,13 @@ impl GpuScene {
             &gpu.device,
             "scene",
             &layout,
-            &[vertices.as_entire_binding(), mats.as_entire_binding(), tex.as_entire_binding(), nodes.as_entire_binding(), prims.as_entire_binding()],
+            &[
+                vertices.as_entire_binding(),
+                mats.as_entire_binding(),
+                tex.as_entire_binding(),
+                nodes.as_entire_binding(),
+                prims.as_entire_binding(),
+            ],
         );
         Ok(GpuScene {
             vertices,

@@ -136,7 +136,10 @@ fn pcf_and_spot_maps_at_high_resolution_match_rt() {
     assert_eq!(pcf.report.counters["fetches_per_pixel"], 9.0);
     // PCF gives fractional values at the shadow edge, and only there
     let fractional = pcf.visibility.iter().zip(&v.mask).filter(|(x, m)| **m != 0 && **x > 0.01 && **x < 0.99).count();
-    assert!(fractional > 0 && (fractional as f64) < 0.05 * v.mask.iter().filter(|m| **m != 0).count() as f64, "{fractional} fractional pixels");
+    assert!(
+        fractional > 0 && (fractional as f64) < 0.05 * v.mask.iter().filter(|m| **m != 0).count() as f64,
+        "{fractional} fractional pixels"
+    );
 
     let room = builtin("room").unwrap();
     let lab = Lab::new(&gpu, &room).unwrap();

@@ -74,21 +74,60 @@ fn shared_struct_layouts_match_rust() {
     let all = shadowlab_gpu::shaders::all();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     let rt = get("rt.wgsl");
-    check(&rt, "Vertex", size_of::<Vertex>(), &[("pos", offset_of!(Vertex, pos)), ("material", offset_of!(Vertex, material)), ("normal", offset_of!(Vertex, normal)), ("uv", offset_of!(Vertex, uv))]);
+    check(
+        &rt,
+        "Vertex",
+        size_of::<Vertex>(),
+        &[
+            ("pos", offset_of!(Vertex, pos)),
+            ("material", offset_of!(Vertex, material)),
+            ("normal", offset_of!(Vertex, normal)),
+            ("uv", offset_of!(Vertex, uv)),
+        ],
+    );
     check(
         &rt,
         "Material",
         size_of::<GpuMaterial>(),
-        &[("base_color", 0), ("tex_offset", offset_of!(GpuMaterial, tex_offset)), ("flags", offset_of!(GpuMaterial, flags)), ("alpha_cutoff", offset_of!(GpuMaterial, alpha_cutoff))],
+        &[
+            ("base_color", 0),
+            ("tex_offset", offset_of!(GpuMaterial, tex_offset)),
+            ("flags", offset_of!(GpuMaterial, flags)),
+            ("alpha_cutoff", offset_of!(GpuMaterial, alpha_cutoff)),
+        ],
     );
-    check(&rt, "BvhNode", size_of::<BvhNode>(), &[("min", 0), ("prim_count", offset_of!(BvhNode, prim_count)), ("max", offset_of!(BvhNode, max)), ("first_index", offset_of!(BvhNode, first_index))]);
+    check(
+        &rt,
+        "BvhNode",
+        size_of::<BvhNode>(),
+        &[
+            ("min", 0),
+            ("prim_count", offset_of!(BvhNode, prim_count)),
+            ("max", offset_of!(BvhNode, max)),
+            ("first_index", offset_of!(BvhNode, first_index)),
+        ],
+    );
     check(
         &rt,
         "Frame",
         size_of::<FrameUniform>(),
-        &[("prev_view_proj", offset_of!(FrameUniform, prev_view_proj)), ("camera_pos", offset_of!(FrameUniform, camera_pos)), ("size", offset_of!(FrameUniform, size))],
+        &[
+            ("prev_view_proj", offset_of!(FrameUniform, prev_view_proj)),
+            ("camera_pos", offset_of!(FrameUniform, camera_pos)),
+            ("size", offset_of!(FrameUniform, size)),
+        ],
     );
-    check(&rt, "LightU", size_of::<LightUniform>(), &[("direction", offset_of!(LightUniform, direction)), ("kind", offset_of!(LightUniform, kind)), ("cos_cone", offset_of!(LightUniform, cos_cone)), ("eps", offset_of!(LightUniform, eps))]);
+    check(
+        &rt,
+        "LightU",
+        size_of::<LightUniform>(),
+        &[
+            ("direction", offset_of!(LightUniform, direction)),
+            ("kind", offset_of!(LightUniform, kind)),
+            ("cos_cone", offset_of!(LightUniform, cos_cone)),
+            ("eps", offset_of!(LightUniform, eps)),
+        ],
+    );
     for sm in ["sm/depth.wgsl", "sm/eval.wgsl"] {
         check(&get(sm), "SmParams", size_of::<SmParams>(), &[("texel", offset_of!(SmParams, texel)), ("bias", offset_of!(SmParams, bias))]);
     }

@@ -12,7 +12,13 @@ pub fn html(metrics: &serde_json::Value) -> Result<String> {
     // whole numbers without a trailing ".0" (parameters, counters)
     env.add_filter("num", |v: f64| if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { format!("{v}") });
     env.add_filter("bytes", |v: f64| {
-        if v >= 1048576.0 { format!("{:.2} MiB", v / 1048576.0) } else if v >= 1024.0 { format!("{:.1} KiB", v / 1024.0) } else { format!("{v} B") }
+        if v >= 1048576.0 {
+            format!("{:.2} MiB", v / 1048576.0)
+        } else if v >= 1024.0 {
+            format!("{:.1} KiB", v / 1024.0)
+        } else {
+            format!("{v} B")
+        }
     });
     Ok(env.get_template("index.html")?.render(minijinja::context! { m => metrics })?)
 }

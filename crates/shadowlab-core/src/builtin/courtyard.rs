@@ -71,10 +71,8 @@ pub fn build() -> Scene {
     let plaster = b.material(Material::solid("wall plaster", [0.80, 0.64, 0.48]));
     let grass = b.material(Material::solid("garden grass", [0.32, 0.46, 0.21]));
     let hedge = b.material(Material::solid("hedge", [0.16, 0.30, 0.12]));
-    let banners = [
-        b.material(Material::solid("banner red", [0.62, 0.09, 0.08])),
-        b.material(Material::solid("banner blue", [0.10, 0.22, 0.55])),
-    ];
+    let banners =
+        [b.material(Material::solid("banner red", [0.62, 0.09, 0.08])), b.material(Material::solid("banner blue", [0.10, 0.22, 0.55]))];
     let bronze = b.material(Material::solid("bronze", [0.45, 0.33, 0.16]));
     let water = b.material(Material::solid("water", [0.20, 0.36, 0.42]));
 

@@ -106,9 +106,7 @@ pub fn build() -> Scene {
     }
 
     let cam = Camera::new(Vec3::new(1.5, 1.7, 16.0), Vec3::new(0.5, 2.5, WALL_Z), 55.0, 0.1, 100.0);
-    let path = (0..4)
-        .map(|i| CameraKey { position: cam.position + Vec3::new(-0.7, 0.0, -0.4) * i as f32, target: cam.target })
-        .collect();
+    let path = (0..4).map(|i| CameraKey { position: cam.position + Vec3::new(-0.7, 0.0, -0.4) * i as f32, target: cam.target }).collect();
     b.finish("foliage", cam, vec![Light::Directional { direction: sun_direction() }], path)
 }
 
@@ -259,8 +257,16 @@ mod tests {
         let s = build();
         let cams = s.camera_path.iter().map(|k| Camera { position: k.position, target: k.target, ..s.camera });
         for cam in cams.chain([s.camera]) {
-            let seen = |p: Vec3| cam.project_to_pixel(p, 1024, 1024).is_some_and(|q| q.cmpgt(Vec2::splat(20.0)).all() && q.cmplt(Vec2::splat(1004.0)).all());
-            for p in [Vec3::new(0.0, 3.0, WALL_Z), LAMP + Vec3::new(1.5, 4.9, 0.0), LAMP + Vec3::Y * 0.5, FENCE.0 + Vec3::Y * 1.2, FENCE.1 + Vec3::Y * 1.2] {
+            let seen = |p: Vec3| {
+                cam.project_to_pixel(p, 1024, 1024).is_some_and(|q| q.cmpgt(Vec2::splat(20.0)).all() && q.cmplt(Vec2::splat(1004.0)).all())
+            };
+            for p in [
+                Vec3::new(0.0, 3.0, WALL_Z),
+                LAMP + Vec3::new(1.5, 4.9, 0.0),
+                LAMP + Vec3::Y * 0.5,
+                FENCE.0 + Vec3::Y * 1.2,
+                FENCE.1 + Vec3::Y * 1.2,
+            ] {
                 assert!(seen(p), "{p} not in view from {}", cam.position);
             }
             let trees = TREES.iter().filter(|&&(x, z)| seen(Vec3::new(x, 2.0, z))).count();

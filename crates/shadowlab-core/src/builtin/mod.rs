@@ -3,8 +3,8 @@
 
 mod courtyard;
 mod foliage;
-mod room;
 mod planebox;
+mod room;
 
 use glam::{Mat4, Vec2, Vec3};
 
@@ -20,10 +20,26 @@ pub struct BuiltinScene {
 }
 
 pub const BUILTIN_SCENES: &[BuiltinScene] = &[
-    BuiltinScene { name: "courtyard", summary: "Sponza-like atrium: two storeys of columns and arches, thin banners, grazing sun (perspective aliasing)", build: courtyard::build },
-    BuiltinScene { name: "room", summary: "closed interior: table, 12 chairs with thin legs, shelves; spot light (light 0) and point light (light 1)", build: room::build },
-    BuiltinScene { name: "foliage", summary: "alpha-tested leaf cards, a wire fence, a street lamp with thin wires before a wall (light leaks); sun", build: foliage::build },
-    BuiltinScene { name: "planebox", summary: "a 10 m plane and a 1 m box under a directional light: the exact-shadow test case", build: planebox::build },
+    BuiltinScene {
+        name: "courtyard",
+        summary: "Sponza-like atrium: two storeys of columns and arches, thin banners, grazing sun (perspective aliasing)",
+        build: courtyard::build,
+    },
+    BuiltinScene {
+        name: "room",
+        summary: "closed interior: table, 12 chairs with thin legs, shelves; spot light (light 0) and point light (light 1)",
+        build: room::build,
+    },
+    BuiltinScene {
+        name: "foliage",
+        summary: "alpha-tested leaf cards, a wire fence, a street lamp with thin wires before a wall (light leaks); sun",
+        build: foliage::build,
+    },
+    BuiltinScene {
+        name: "planebox",
+        summary: "a 10 m plane and a 1 m box under a directional light: the exact-shadow test case",
+        build: planebox::build,
+    },
 ];
 
 pub const DEFAULT_SCENE: &str = "courtyard";

@@ -201,7 +201,8 @@ mod tests {
     #[test]
     fn twelve_chairs_with_thin_legs() {
         let s = build();
-        let leg_tris: Vec<usize> = (0..s.triangle_count()).filter(|&i| s.materials[s.vertices[3 * i].material as usize].name == "chair legs").collect();
+        let leg_tris: Vec<usize> =
+            (0..s.triangle_count()).filter(|&i| s.materials[s.vertices[3 * i].material as usize].name == "chair legs").collect();
         assert_eq!(leg_tris.len(), 12 * 4 * LEG_SEGMENTS as usize * 4);
         for i in leg_tris {
             let t = s.triangle(i).map(|p| Vec2::new(p.x, p.z));

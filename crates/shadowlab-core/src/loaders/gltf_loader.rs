@@ -142,8 +142,7 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
             let data = match cache.entry(key) {
                 Entry::Occupied(e) => e.into_mut(),
                 Entry::Vacant(e) => e.insert(
-                    read_primitive(&prim, &buffers)
-                        .map_err(|e| fail(format!("mesh {} primitive {}: {e}", mesh.index(), prim.index())))?,
+                    read_primitive(&prim, &buffers).map_err(|e| fail(format!("mesh {} primitive {}: {e}", mesh.index(), prim.index())))?,
                 ),
             };
             let material = match prim.material().index() {
@@ -334,8 +333,7 @@ fn read_primitive(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Primiti
     if pos_acc.dimensions() != Dimensions::Vec3 {
         return Err(format!("POSITION accessor {} is {:?}, expected VEC3", pos_acc.index(), pos_acc.dimensions()));
     }
-    let positions: Vec<Vec3> =
-        read_floats(&pos_acc, buffers)?.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+    let positions: Vec<Vec3> = read_floats(&pos_acc, buffers)?.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
     let n = positions.len();
 
     let set = prim.material().pbr_metallic_roughness().base_color_texture().map_or(0, |t| t.tex_coord());
@@ -371,23 +369,21 @@ fn read_primitive(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Primiti
         Mode::TriangleStrip => (0..indices.len().saturating_sub(2))
             .map(|i| {
                 let t = [indices[i], indices[i + 1], indices[i + 2]];
-                if i % 2 == 0 { t } else { [t[1], t[0], t[2]] }
+                if i % 2 == 0 {
+                    t
+                } else {
+                    [t[1], t[0], t[2]]
+                }
             })
             .collect(),
-        Mode::TriangleFan => {
-            (1..indices.len().saturating_sub(1)).map(|i| [indices[0], indices[i], indices[i + 1]]).collect()
-        }
+        Mode::TriangleFan => (1..indices.len().saturating_sub(1)).map(|i| [indices[0], indices[i], indices[i + 1]]).collect(),
         _ => Vec::new(),
     };
     Ok(Primitive { positions, uvs, triangles })
 }
 
 /// Reads an accessor's components (`count * dimensions`), bounds-checked, sparse values applied.
-fn read_components<T: Copy + Default>(
-    acc: &gltf::Accessor,
-    buffers: &[Vec<u8>],
-    decode: impl Fn(&[u8]) -> T,
-) -> Result<Vec<T>, String> {
+fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>], decode: impl Fn(&[u8]) -> T) -> Result<Vec<T>, String> {
     let id = acc.index();
     let count = acc.count();
     let dims = acc.dimensions().multiplicity();
@@ -466,7 +462,8 @@ fn read_components<T: Copy + Default>(
 }
 
 fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&'b [u8], String> {
-    let buf = buffers.get(view.buffer().index()).ok_or_else(|| format!("bufferView {}: no buffer {}", view.index(), view.buffer().index()))?;
+    let buf =
+        buffers.get(view.buffer().index()).ok_or_else(|| format!("bufferView {}: no buffer {}", view.index(), view.buffer().index()))?;
     let end = view.offset().checked_add(view.length());
     match end {
         Some(end) if end <= buf.len() => Ok(&buf[view.offset()..end]),
@@ -489,15 +486,27 @@ fn read_floats(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<f32>, St
         DataType::U8 => read_components(acc, buffers, |b| if norm { b[0] as f32 / 255.0 } else { b[0] as f32 }),
         DataType::I8 => read_components(acc, buffers, |b| {
             let v = b[0] as i8 as f32;
-            if norm { (v / 127.0).max(-1.0) } else { v }
+            if norm {
+                (v / 127.0).max(-1.0)
+            } else {
+                v
+            }
         }),
         DataType::U16 => read_components(acc, buffers, |b| {
             let v = u16::from_le_bytes([b[0], b[1]]) as f32;
-            if norm { v / 65535.0 } else { v }
+            if norm {
+                v / 65535.0
+            } else {
+                v
+            }
         }),
         DataType::I16 => read_components(acc, buffers, |b| {
             let v = i16::from_le_bytes([b[0], b[1]]) as f32;
-            if norm { (v / 32767.0).max(-1.0) } else { v }
+            if norm {
+                (v / 32767.0).max(-1.0)
+            } else {
+                v
+            }
         }),
         DataType::U32 => read_components(acc, buffers, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32),
     }
@@ -544,7 +553,8 @@ impl Loader<'_> {
         let (bytes, mime, file, name) = match image.source() {
             gltf::image::Source::View { view, mime_type } => {
                 let bytes = view_bytes(&view, self.buffers)?.to_vec();
-                let name = image.name().map(str::to_string).unwrap_or_else(|| format!("image{} (bufferView {})", image.index(), view.index()));
+                let name =
+                    image.name().map(str::to_string).unwrap_or_else(|| format!("image{} (bufferView {})", image.index(), view.index()));
                 (bytes, Some(mime_type.to_string()), None, name)
             }
             gltf::image::Source::Uri { uri, mime_type } => {
@@ -570,7 +580,6 @@ impl Loader<'_> {
         let img = reader.decode().map_err(|e| e.to_string())?;
         Ok(texture_from_image(name, img))
     }
-
 }
 
 #[cfg(test)]

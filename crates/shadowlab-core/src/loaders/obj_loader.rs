@@ -48,13 +48,8 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
     let mtl = RefCell::new(MtlState::default());
     // more fields exist when tobj's `merging`/`reordering` features are on
     #[allow(clippy::needless_update)]
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
+    let options =
+        tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true, ..Default::default() };
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &options, |lib| mtl.borrow_mut().load_lib(&obj_dir, lib))
         .map_err(|e| LoadError::invalid(path, format!("malformed OBJ: {e}")))?;
     let MtlState { materials: mtl_materials, warnings } = mtl.into_inner();
@@ -65,8 +60,7 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
 
     // Materials: one per MTL material (tobj's material ids index this list), default last.
     let mut textures = TextureCache::default();
-    let mut materials: Vec<Material> =
-        mtl_materials.iter().map(|mm| build_material(mm, &obj_dir, &mut textures)).collect();
+    let mut materials: Vec<Material> = mtl_materials.iter().map(|mm| build_material(mm, &obj_dir, &mut textures)).collect();
     let mut default_material: Option<u32> = None;
 
     let mut sink = TriangleSink::default();
@@ -83,8 +77,7 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
                 (materials.len() - 1) as u32
             }),
         };
-        let positions: Vec<Vec3> =
-            mesh.positions.chunks_exact(3).map(|p| m.transform_point3(Vec3::new(p[0], p[1], p[2]))).collect();
+        let positions: Vec<Vec3> = mesh.positions.chunks_exact(3).map(|p| m.transform_point3(Vec3::new(p[0], p[1], p[2]))).collect();
         let texcoords: Vec<Vec2> = mesh.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], 1.0 - t[1])).collect();
         let has_uv = !mesh.texcoord_indices.is_empty();
         if has_uv && mesh.texcoord_indices.len() != mesh.indices.len() {
@@ -146,11 +139,7 @@ fn check_face_indices(text: &[u8]) -> Result<(), String> {
                         };
                         let n = counts[k];
                         if x == 0 || x > n || x < -n {
-                            return Err(format!(
-                                "line {}: face index {x} out of bounds ({n} {} defined so far)",
-                                line_no + 1,
-                                KINDS[k]
-                            ));
+                            return Err(format!("line {}: face index {x} out of bounds ({n} {} defined so far)", line_no + 1, KINDS[k]));
                         }
                     }
                 }
@@ -194,7 +183,9 @@ impl MtlState {
         let mut map: Vec<(String, usize)> = Vec::new();
         for name in names {
             let Some(file) = resolve_path(&name, &[obj_dir.to_path_buf()]) else {
-                self.warnings.push(format!("material library '{name}' not found next to the OBJ file; its materials are replaced by the default material"));
+                self.warnings.push(format!(
+                    "material library '{name}' not found next to the OBJ file; its materials are replaced by the default material"
+                ));
                 continue;
             };
             let text = match std::fs::read(&file) {
@@ -389,7 +380,10 @@ impl TextureCache {
         if !self.images.contains_key(&path) {
             let decoded = decode_image(&path);
             if let Err(e) = &decoded {
-                self.warnings.push(format!("material '{material}': texture '{}' cannot be decoded ({e}); the material is untextured", path.display()));
+                self.warnings.push(format!(
+                    "material '{material}': texture '{}' cannot be decoded ({e}); the material is untextured",
+                    path.display()
+                ));
             }
             self.images.insert(path.clone(), decoded.ok());
         }
@@ -439,8 +433,7 @@ fn build_material(mm: &MtlMaterial, obj_dir: &Path, cache: &mut TextureCache) ->
     };
 
     let d = mm.d.unwrap_or(1.0);
-    let texture_has_alpha =
-        texture.is_some_and(|t| cache.textures[t as usize].rgba.chunks_exact(4).any(|px| px[3] < 255));
+    let texture_has_alpha = texture.is_some_and(|t| cache.textures[t as usize].rgba.chunks_exact(4).any(|px| px[3] < 255));
     let alpha_tested = d_img.is_some() || texture_has_alpha || d < 1.0;
     let kd = mm.kd.unwrap_or(if texture.is_some() { [1.0; 3] } else { DEFAULT_MATERIAL_COLOR });
     Material {

@@ -85,7 +85,12 @@ impl GBufferPass {
         let raster = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("gbuffer"),
             layout: Some(&layout),
-            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: F::Depth32Float,
@@ -95,7 +100,12 @@ impl GBufferPass {
                 bias: Default::default(),
             }),
             multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &targets }),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
             multiview_mask: None,
             cache: None,
         });
@@ -113,7 +123,8 @@ impl GBufferPass {
     /// Rasterises the scene into `g` (stage `gbuffer`).
     pub fn render(&self, gpu: &Gpu, timer: &mut StageTimer, scene: &GpuScene, frame: &wgpu::Buffer, g: &GBuffer) {
         let group = binding::group(&gpu.device, "gbuffer.frame", &self.frame_layout, &[frame.as_entire_binding()]);
-        let views: Vec<wgpu::TextureView> = [&g.position, &g.normal, &g.albedo, &g.motion].iter().map(|t| t.create_view(&Default::default())).collect();
+        let views: Vec<wgpu::TextureView> =
+            [&g.position, &g.normal, &g.albedo, &g.motion].iter().map(|t| t.create_view(&Default::default())).collect();
         let depth = g.depth.create_view(&Default::default());
         timer.stage(gpu, "gbuffer", |enc| {
             let atts: Vec<Option<wgpu::RenderPassColorAttachment>> = views
@@ -154,7 +165,13 @@ impl GBufferPass {
             &gpu.device,
             "mask",
             &self.mask_layout,
-            &[frame.as_entire_binding(), light.as_entire_binding(), wgpu::BindingResource::TextureView(&pv), wgpu::BindingResource::TextureView(&nv), g.mask.as_entire_binding()],
+            &[
+                frame.as_entire_binding(),
+                light.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&pv),
+                wgpu::BindingResource::TextureView(&nv),
+                g.mask.as_entire_binding(),
+            ],
         );
         timer.stage(gpu, "mask", |enc| gpu.dispatch_2d(enc, "mask", &self.mask, &[&group], g.width, g.height));
     }

@@ -31,7 +31,15 @@ impl ShadePass {
     }
 
     /// Shades `visibility` and returns RGBA8 pixels (stage `shade`).
-    pub fn shade(&self, gpu: &Gpu, timer: &mut StageTimer, frame: &wgpu::Buffer, light: &wgpu::Buffer, g: &GBuffer, visibility: &wgpu::Buffer) -> Vec<u8> {
+    pub fn shade(
+        &self,
+        gpu: &Gpu,
+        timer: &mut StageTimer,
+        frame: &wgpu::Buffer,
+        light: &wgpu::Buffer,
+        g: &GBuffer,
+        visibility: &wgpu::Buffer,
+    ) -> Vec<u8> {
         let views: Vec<_> = [&g.position, &g.normal, &g.albedo].iter().map(|t| t.create_view(&Default::default())).collect();
         let group = binding::group(
             &gpu.device,

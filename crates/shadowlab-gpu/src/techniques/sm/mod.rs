@@ -39,12 +39,60 @@ pub const DEFAULT_SLOPE_BIAS: f64 = 0.0;
 pub const DEFAULT_NORMAL_OFFSET: f64 = 0.5;
 
 pub const PARAMS: &[ParamDef] = &[
-    ParamDef { key: "res", default: DEFAULT_RES, min: 16.0, max: 16384.0, integer: true, doc: "shadow map side (texels)", source: "seeds 000/002 evaluation: 512 with 1024x1024 output" },
-    ParamDef { key: "pcf", default: 1.0, min: 1.0, max: 7.0, integer: true, doc: "PCF kernel width N (NxN single-texel comparisons; (N-1)/2 x tan texels of bias added for the kernel); 1 = hard test", source: "Reeves et al. 1987; kernel bias: Isidoro 2006" },
-    ParamDef { key: "bias", default: DEFAULT_BIAS, min: 0.0, max: 100.0, integer: false, doc: "constant depth bias, texels; low: acne, high: peter-panning", source: "shadowlab sweep 2026-11-22 (BENCHMARKS.md)" },
-    ParamDef { key: "slope_bias", default: DEFAULT_SLOPE_BIAS, min: 0.0, max: 100.0, integer: false, doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope", source: "shadowlab sweep 2026-11-22: 0 (normal offset covers slopes)" },
-    ParamDef { key: "max_slope", default: 4.0, min: 0.0, max: 1000.0, integer: false, doc: "clamp on tan(angle to light) for the slope bias and the PCF kernel bias; high: leaks under ledges at grazing light", source: "shadowlab sweep 2026-11-22 (2, 4, 10 with pcf=3)" },
-    ParamDef { key: "normal_offset", default: DEFAULT_NORMAL_OFFSET, min: 0.0, max: 100.0, integer: false, doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows", source: "Holbert 2011 (normal offset shadows); value from the shadowlab sweep" },
+    ParamDef {
+        key: "res",
+        default: DEFAULT_RES,
+        min: 16.0,
+        max: 16384.0,
+        integer: true,
+        doc: "shadow map side (texels)",
+        source: "seeds 000/002 evaluation: 512 with 1024x1024 output",
+    },
+    ParamDef {
+        key: "pcf",
+        default: 1.0,
+        min: 1.0,
+        max: 7.0,
+        integer: true,
+        doc: "PCF kernel width N (NxN single-texel comparisons; (N-1)/2 x tan texels of bias added for the kernel); 1 = hard test",
+        source: "Reeves et al. 1987; kernel bias: Isidoro 2006",
+    },
+    ParamDef {
+        key: "bias",
+        default: DEFAULT_BIAS,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "constant depth bias, texels; low: acne, high: peter-panning",
+        source: "shadowlab sweep 2026-11-22 (BENCHMARKS.md)",
+    },
+    ParamDef {
+        key: "slope_bias",
+        default: DEFAULT_SLOPE_BIAS,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope",
+        source: "shadowlab sweep 2026-11-22: 0 (normal offset covers slopes)",
+    },
+    ParamDef {
+        key: "max_slope",
+        default: 4.0,
+        min: 0.0,
+        max: 1000.0,
+        integer: false,
+        doc: "clamp on tan(angle to light) for the slope bias and the PCF kernel bias; high: leaks under ledges at grazing light",
+        source: "shadowlab sweep 2026-11-22 (2, 4, 10 with pcf=3)",
+    },
+    ParamDef {
+        key: "normal_offset",
+        default: DEFAULT_NORMAL_OFFSET,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows",
+        source: "Holbert 2011 (normal offset shadows); value from the shadowlab sweep",
+    },
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -109,7 +157,12 @@ impl ShadowMap {
         let depth_pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("sm.depth"),
             layout: Some(&gpu.pipeline_layout("sm.depth", &[&depth_layout, &scene.layout])),
-            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: wgpu::TextureFormat::Depth32Float,
@@ -119,11 +172,20 @@ impl ShadowMap {
                 bias: Default::default(),
             }),
             multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState { module: &module, entry_point: Some("fs_main"), compilation_options: Default::default(), targets: &[] }),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
             multiview_mask: None,
             cache: None,
         });
-        let eval_layout = view_layout(gpu, "sm.eval", &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)]);
+        let eval_layout = view_layout(
+            gpu,
+            "sm.eval",
+            &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
+        );
         let eval_pipeline = gpu.compute_pipeline("sm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("sm.cmp"),
@@ -135,7 +197,19 @@ impl ShadowMap {
             ..Default::default()
         });
         let counts = gpu.storage("sm.counts", res as u64 * res as u64 * 4);
-        Ok(ShadowMap { res, pcf: p.get_u32("pcf"), params, map, counts, uniform, depth_pipeline, depth_group, eval_pipeline, eval_layout, sampler })
+        Ok(ShadowMap {
+            res,
+            pcf: p.get_u32("pcf"),
+            params,
+            map,
+            counts,
+            uniform,
+            depth_pipeline,
+            depth_group,
+            eval_pipeline,
+            eval_layout,
+            sampler,
+        })
     }
 }
 
