@@ -6,7 +6,7 @@ use wgpu::TextureFormat as F;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
 use crate::timing::StageTimer;
-use crate::{binding, Gpu};
+use crate::{binding, raster, Gpu};
 
 const GBUFFER_WGSL: &str = include_str!("gbuffer.wgsl");
 const MASK_WGSL: &str = include_str!("mask.wgsl");
@@ -56,7 +56,7 @@ impl GBuffer {
             normal: target(gpu, "gbuffer.normal", w, h, NORMAL_FORMAT, c),
             albedo: target(gpu, "gbuffer.albedo", w, h, ALBEDO_FORMAT, c),
             motion: target(gpu, "gbuffer.motion", w, h, MOTION_FORMAT, c),
-            depth: target(gpu, "gbuffer.depth", w, h, F::Depth32Float, wgpu::TextureUsages::empty()),
+            depth: target(gpu, "gbuffer.depth", w, h, raster::DEPTH_FORMAT, wgpu::TextureUsages::empty()),
             mask: gpu.storage("gbuffer.mask", (w * h * 4) as u64),
         }
     }
@@ -78,37 +78,9 @@ impl GBufferPass {
         let d = &gpu.device;
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame_layout = binding::layout(d, "gbuffer.frame", vf, &[binding::uniform()]);
-        let module = gpu.shader("gbuffer", &compose(GBUFFER_WGSL, true));
-        let layout = gpu.pipeline_layout("gbuffer", &[&frame_layout, &scene.layout]);
         let targets: Vec<Option<wgpu::ColorTargetState>> =
             [POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT, MOTION_FORMAT].iter().map(|f| Some((*f).into())).collect();
-        let raster = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: F::Depth32Float,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let raster = raster::scene_pipeline(gpu, "gbuffer", &compose(GBUFFER_WGSL, true), &[&frame_layout, &scene.layout], &targets);
         let c = wgpu::ShaderStages::COMPUTE;
         let mask_layout = binding::layout(
             d,
@@ -127,29 +99,8 @@ impl GBufferPass {
             [&g.position, &g.normal, &g.albedo, &g.motion].iter().map(|t| t.create_view(&Default::default())).collect();
         let depth = g.depth.create_view(&Default::default());
         timer.stage(gpu, "gbuffer", |enc| {
-            let atts: Vec<Option<wgpu::RenderPassColorAttachment>> = views
-                .iter()
-                .map(|v| {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: v,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-                    })
-                })
-                .collect();
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("gbuffer"),
-                color_attachments: &atts,
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let colors: Vec<&wgpu::TextureView> = views.iter().collect();
+            let mut pass = raster::begin_pass(enc, "gbuffer", &colors, &depth);
             pass.set_pipeline(&self.raster);
             pass.set_bind_group(0, &group, &[]);
             pass.set_bind_group(1, &scene.group, &[]);

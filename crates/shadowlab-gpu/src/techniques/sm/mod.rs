@@ -13,7 +13,7 @@ use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
 use crate::techniques::{compose_view, view_layout, FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, Gpu, GpuError};
+use crate::{binding, raster, Gpu, GpuError};
 
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
@@ -146,41 +146,14 @@ impl ShadowMap {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
+            format: raster::DEPTH_FORMAT,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         let uniform = gpu.uniform("sm.params", &params);
         let depth_layout = binding::layout(d, "sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_group = binding::group(d, "sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
-        let module = gpu.shader("sm.depth", &compose(DEPTH_WGSL, true));
-        let depth_pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sm.depth"),
-            layout: Some(&gpu.pipeline_layout("sm.depth", &[&depth_layout, &scene.layout])),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let depth_pipeline = raster::scene_pipeline(gpu, "sm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
         let eval_layout = view_layout(
             gpu,
             "sm.eval",
@@ -217,18 +190,7 @@ impl Technique for ShadowMap {
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         let map_view = self.map.create_view(&Default::default());
         timer.stage(gpu, "sm.render", |enc| {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("sm.render"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &map_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = raster::begin_pass(enc, "sm.render", &[], &map_view);
             pass.set_pipeline(&self.depth_pipeline);
             pass.set_bind_group(0, &self.depth_group, &[]);
             pass.set_bind_group(1, &f.scene.group, &[]);

@@ -1,0 +1,73 @@
+//! Rasterising the scene: every raster pass draws the scene's vertex triples (`vs_main` reading
+//! `vertices` from `scene.wgsl`, `fs_main`), without culling, into a Depth32Float target with a
+//! less-than test. G-buffer and shadow-map passes share this.
+
+use crate::Gpu;
+
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// A pipeline drawing the scene with `source`'s `vs_main` / `fs_main` into `targets` + depth.
+pub fn scene_pipeline(
+    gpu: &Gpu,
+    label: &str,
+    source: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
+    let module = gpu.shader(label, source);
+    let layout = gpu.pipeline_layout(label, layouts);
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Begins a render pass that clears `colors` (to transparent) and `depth` (to 1).
+pub fn begin_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    colors: &[&wgpu::TextureView],
+    depth: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    let atts: Vec<Option<wgpu::RenderPassColorAttachment>> = colors
+        .iter()
+        .map(|v| {
+            Some(wgpu::RenderPassColorAttachment {
+                view: v,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+            })
+        })
+        .collect();
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &atts,
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
