@@ -31,14 +31,13 @@ pub struct RayTraced {
     layout: wgpu::BindGroupLayout,
     rays: wgpu::Buffer,
     bvh_bytes: usize,
-    last_rays: u32,
 }
 
 impl RayTraced {
     pub fn new(gpu: &Gpu, scene: &GpuScene) -> RayTraced {
         let layout = view_layout(gpu, "rt", &[binding::storage(false)]);
         let pipeline = gpu.compute_pipeline("rt", &compose_view(RT_WGSL, true), "main", &[&layout, &scene.layout]);
-        RayTraced { pipeline, layout, rays: gpu.storage("rt.rays", 4), bvh_bytes: scene.bvh_bytes, last_rays: 0 }
+        RayTraced { pipeline, layout, rays: gpu.storage("rt.rays", 4), bvh_bytes: scene.bvh_bytes }
     }
 }
 
@@ -50,17 +49,17 @@ impl Technique for RayTraced {
 
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         let group = f.view_group(gpu, "rt", &self.layout, &[self.rays.as_entire_binding()]);
-        gpu.queue.write_buffer(&self.rays, 0, &[0u8; 4]);
         timer.stage(gpu, "rt.trace", |enc| {
+            enc.clear_buffer(&self.rays, 0, None);
             gpu.dispatch_2d(enc, "rt.trace", &self.pipeline, &[&group, &f.scene.group], f.gbuffer.width, f.gbuffer.height)
         });
-        self.last_rays = gpu.read_buffer_as::<u32>(&self.rays, 1)[0];
         Ok(())
     }
 
-    fn report(&mut self, _gpu: &Gpu) -> TechniqueReport {
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let rays = gpu.read_buffer_as::<u32>(&self.rays, 1)[0];
         let mut r = TechniqueReport { shadow_data_bytes: self.bvh_bytes as u64, ..Default::default() };
-        r.counters.insert("rays_traced".into(), self.last_rays as f64);
+        r.counters.insert("rays_traced".into(), rays as f64);
         r
     }
 }
