@@ -10,7 +10,7 @@ use shadowlab_core::builtin::BUILTIN_SCENES;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::setup::Setup;
 use shadowlab_gpu::lab::Lab;
-use shadowlab_gpu::timing::{median, TIMER_NAME};
+use shadowlab_gpu::timing::median;
 use shadowlab_gpu::Gpu;
 
 use crate::config::{load_scene, parse_size};
@@ -50,12 +50,13 @@ pub fn bench(setups: &[PathBuf], size: &str, frames: usize, out: Option<&Path>) 
     let gpu = Gpu::new()?;
     let spec = TechniqueSpec::parse("sm:res=512").map_err(|e| anyhow!(e))?;
     let mut md = format!(
-        "Machine: {} ({} cores); adapter {}; {w}x{h} output, sm 512x512; median of {frames} frames; {TIMER_NAME}.\n\n\
+        "Machine: {} ({} cores); adapter {}; {w}x{h} output, sm 512x512; median of {frames} frames; {}.\n\n\
          | scene | triangles | load ms | BVH build ms | BVH B/tri | G-buffer ms | rt ms | sm render ms | sm evaluate ms | peak RSS MiB |\n\
          |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         cpu_name(),
         std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
-        gpu.adapter_summary()
+        gpu.adapter_summary(),
+        gpu.timer_name()
     );
     for (name, setup) in &jobs {
         eprintln!("bench: {name}");

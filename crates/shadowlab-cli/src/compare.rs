@@ -7,7 +7,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use shadowlab_core::metrics::{compare as metrics_of, edge_pixels, error_image};
 use shadowlab_gpu::lab::{Lab, Run};
-use shadowlab_gpu::timing::TIMER_NAME;
 use shadowlab_gpu::Gpu;
 
 use crate::config::{resolve, RunConfig, BASELINE};
@@ -34,7 +33,7 @@ pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
     export::png(&tmp, cfg.width, cfg.height, &run.shaded)?;
     std::fs::rename(&tmp, out)?;
     if !args.quiet {
-        println!("{} -> {} ({:.1} ms, {TIMER_NAME})", run.label, out.display(), run.total_ms);
+        println!("{} -> {} ({:.1} ms, {})", run.label, out.display(), run.total_ms, gpu.timer_name());
     }
     Ok(())
 }
@@ -118,7 +117,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         "width": w,
         "height": h,
         "adapter": gpu.adapter_summary(),
-        "timer": TIMER_NAME,
+        "timer": gpu.timer_name(),
         "repeat": args.repeat,
         "bvh": {"nodes": lab.bvh.nodes.len(), "bytes": lab.bvh.bytes(), "bytes_per_triangle": lab.bvh.bytes() as f64 / cfg.scene.triangle_count() as f64, "depth": lab.bvh.depth, "build_ms": lab.bvh.build_ms},
         "gbuffer_stages_ms": view.stages_ms,
@@ -211,5 +210,5 @@ fn summary(cfg: &RunConfig, m: &serde_json::Value) {
             t["shadow_data_bytes"]
         );
     }
-    println!("times: median of {} frames, {TIMER_NAME}", m["repeat"]);
+    println!("times: median of {} frames, {}", m["repeat"], m["timer"].as_str().unwrap_or(""));
 }

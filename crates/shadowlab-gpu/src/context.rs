@@ -19,6 +19,8 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
     pub limits: wgpu::Limits,
+    /// Stage times come from GPU timestamps (else wall clock with a device wait); see `timing`.
+    pub gpu_timestamps: bool,
     errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
 }
 
@@ -35,9 +37,12 @@ impl Gpu {
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
         let limits = adapter.limits();
+        let ts = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let has_ts = adapter.features().contains(ts);
+        let gpu_timestamps = has_ts && crate::timing::want_timestamps(&info)?;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("shadowlab"),
-            required_features: wgpu::Features::empty(),
+            required_features: if has_ts { ts } else { wgpu::Features::empty() },
             required_limits: limits.clone(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
@@ -47,7 +52,7 @@ impl Gpu {
         let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(e.to_string())));
-        Ok(Gpu { device, queue, info, limits, errors })
+        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors })
     }
 
     /// Returns the first GPU validation/out-of-memory error raised since the last call.
@@ -62,6 +67,15 @@ impl Gpu {
     /// "llvmpipe (Vulkan, Cpu)" and the like, for reports.
     pub fn adapter_summary(&self) -> String {
         format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
+    }
+
+    /// Which timer the stage times come from, for every report that prints a time.
+    pub fn timer_name(&self) -> &'static str {
+        if self.gpu_timestamps {
+            crate::timing::TIMESTAMP_TIMER
+        } else {
+            crate::timing::WALL_TIMER
+        }
     }
 
     pub fn is_software(&self) -> bool {

@@ -251,3 +251,28 @@ fn rt_gpu_matches_cpu_on_real_scenes() {
         }
     }
 }
+
+#[test]
+fn both_stage_timers_give_plausible_times() {
+    use shadowlab_gpu::timing::StageTimer;
+    let Some(mut gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    for timestamps in [false, true] {
+        let ts = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        if timestamps && !gpu.device.features().contains(ts) {
+            eprintln!("adapter lacks encoder timestamps: GPU timer not exercised");
+            continue;
+        }
+        gpu.gpu_timestamps = timestamps;
+        let lab = Lab::new(&gpu, &scene).unwrap();
+        let v = view(&lab, &scene, 0, 64);
+        let run = lab.run(&v, &TechniqueSpec::parse("sm:res=1024").unwrap(), 2).unwrap();
+        for (stage, ms) in &run.stages_ms {
+            assert!(ms.is_finite() && *ms >= 0.0 && *ms < 10_000.0, "{stage}: {ms} ms with timestamps={timestamps}");
+        }
+        assert!(run.stages_ms.contains_key("sm.render") && run.stages_ms.contains_key("sm.evaluate"));
+        let mut t = StageTimer::default();
+        t.stage(&gpu, "empty", |_| ());
+        assert_eq!(t.samples["empty"].len(), 1);
+    }
+}
