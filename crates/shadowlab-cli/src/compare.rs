@@ -110,6 +110,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         "scene_source": cfg.source,
         "scene_transform": row_major(&cfg.scene.transform),
         "triangles": cfg.scene.triangle_count(),
+        "has_cutouts": cfg.scene.has_cutouts(),
         "load_report": cfg.scene.report,
         "camera": cfg.camera,
         "lights": cfg.lights,

@@ -78,10 +78,6 @@ impl Gpu {
         }
     }
 
-    pub fn is_software(&self) -> bool {
-        self.info.device_type == wgpu::DeviceType::Cpu
-    }
-
     /// Rejects output sizes of 0 or above the device's texture limit.
     pub fn check_size(&self, width: u32, height: u32, what: &str) -> Result<(), GpuError> {
         let max = self.limits.max_texture_dimension_2d;

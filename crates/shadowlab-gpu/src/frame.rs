@@ -2,7 +2,7 @@
 //! naga's reflection in `tests/shaders.rs`.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use shadowlab_core::camera::Camera;
 use shadowlab_core::light::Light;
 
@@ -58,8 +58,4 @@ impl LightUniform {
         };
         LightUniform { position: p.extend(1.0).into(), direction: d.extend(0.0).into(), kind, cos_cone, eps, _pad: 0 }
     }
-}
-
-pub fn mat(m: Mat4) -> [[f32; 4]; 4] {
-    m.to_cols_array_2d()
 }
