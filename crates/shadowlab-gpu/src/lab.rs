@@ -23,6 +23,7 @@ pub struct Lab<'a> {
     pub bvh: Bvh,
     pub gscene: GpuScene,
     gbuffer_pass: GBufferPass,
+    shade_pass: ShadePass,
 }
 
 /// One view of the scene for one light, with its G-buffer read back.
@@ -35,7 +36,8 @@ pub struct View {
     pub frame: wgpu::Buffer,
     pub light_buf: wgpu::Buffer,
     pub visibility: wgpu::Buffer,
-    pub shade: ShadePass,
+    /// Shaded colour of this view (packed RGBA8 per pixel).
+    pub color: wgpu::Buffer,
     /// xyz world position, w linear depth (0 = empty).
     pub position: Vec<[f32; 4]>,
     pub normal: Vec<[f32; 4]>,
@@ -65,8 +67,9 @@ impl<'a> Lab<'a> {
         let bvh = Bvh::build(scene).map_err(GpuError::Invalid)?;
         let gscene = GpuScene::new(gpu, scene, &bvh)?;
         let gbuffer_pass = GBufferPass::new(gpu, &gscene);
+        let shade_pass = ShadePass::new(gpu);
         gpu.take_error()?;
-        Ok(Lab { gpu, scene, bvh, gscene, gbuffer_pass })
+        Ok(Lab { gpu, scene, bvh, gscene, gbuffer_pass, shade_pass })
     }
 
     /// Renders the G-buffer and the mask for `light`, and reads them back.
@@ -86,7 +89,7 @@ impl<'a> Lab<'a> {
         let normal: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&g.normal, 16));
         let mask: Vec<u32> = gpu.read_buffer_as(&g.mask, g.pixels());
         let visibility = gpu.storage("visibility", g.pixels() as u64 * 4);
-        let shade = ShadePass::new(gpu, &g);
+        let color = ShadePass::output(gpu, &g);
         Ok(View {
             camera: *camera,
             light: *light,
@@ -96,7 +99,7 @@ impl<'a> Lab<'a> {
             frame,
             light_buf,
             visibility,
-            shade,
+            color,
             position,
             normal,
             mask,
@@ -145,7 +148,7 @@ impl<'a> Lab<'a> {
         let visibility: Vec<f32> = gpu.read_buffer_as(&view.visibility, view.gbuffer.pixels());
         let report = tech.report(gpu);
         let mut shade_timer = StageTimer::default();
-        let shaded = view.shade.shade(gpu, &mut shade_timer, &view.frame, &view.light_buf, &view.gbuffer, &view.visibility);
+        let shaded = self.shade_pass.shade(gpu, &mut shade_timer, &inputs, &view.color);
         gpu.take_error()?;
         Ok(Run { label, technique: info.name, params, visibility, shaded, report, stages_ms, total_ms, setup_ms })
     }

@@ -2,6 +2,7 @@
 
 use crate::gbuffer::GBuffer;
 use crate::shaders::compose;
+use crate::techniques::FrameInputs;
 use crate::timing::StageTimer;
 use crate::{binding, Gpu};
 
@@ -11,14 +12,14 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     vec![("shade.wgsl", compose(SHADE_WGSL, false))]
 }
 
+/// The shading pipeline, created once per lab; each view brings its own output buffer.
 pub struct ShadePass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    out: wgpu::Buffer,
 }
 
 impl ShadePass {
-    pub fn new(gpu: &Gpu, g: &GBuffer) -> ShadePass {
+    pub fn new(gpu: &Gpu) -> ShadePass {
         use binding::*;
         let layout = layout(
             &gpu.device,
@@ -27,36 +28,34 @@ impl ShadePass {
             &[uniform(), uniform(), texture_float(), texture_float(), texture_float(), storage(true), storage(true), storage(false)],
         );
         let pipeline = gpu.compute_pipeline("shade", &compose(SHADE_WGSL, false), "main", &[&layout]);
-        ShadePass { pipeline, layout, out: gpu.storage("shade.color", g.pixels() as u64 * 4) }
+        ShadePass { pipeline, layout }
     }
 
-    /// Shades `visibility` and returns RGBA8 pixels (stage `shade`).
-    pub fn shade(
-        &self,
-        gpu: &Gpu,
-        timer: &mut StageTimer,
-        frame: &wgpu::Buffer,
-        light: &wgpu::Buffer,
-        g: &GBuffer,
-        visibility: &wgpu::Buffer,
-    ) -> Vec<u8> {
+    /// A colour buffer (one packed RGBA8 word per pixel) for views of `g`'s size.
+    pub fn output(gpu: &Gpu, g: &GBuffer) -> wgpu::Buffer {
+        gpu.storage("shade.color", g.pixels() as u64 * 4)
+    }
+
+    /// Shades `visibility` into `out` (see [`ShadePass::output`]) and returns RGBA8 pixels (stage `shade`).
+    pub fn shade(&self, gpu: &Gpu, timer: &mut StageTimer, f: &FrameInputs, out: &wgpu::Buffer) -> Vec<u8> {
+        let g = f.gbuffer;
         let views: Vec<_> = [&g.position, &g.normal, &g.albedo].iter().map(|t| t.create_view(&Default::default())).collect();
         let group = binding::group(
             &gpu.device,
             "shade",
             &self.layout,
             &[
-                frame.as_entire_binding(),
-                light.as_entire_binding(),
+                f.frame.as_entire_binding(),
+                f.light_buf.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&views[0]),
                 wgpu::BindingResource::TextureView(&views[1]),
                 wgpu::BindingResource::TextureView(&views[2]),
                 g.mask.as_entire_binding(),
-                visibility.as_entire_binding(),
-                self.out.as_entire_binding(),
+                f.visibility.as_entire_binding(),
+                out.as_entire_binding(),
             ],
         );
         timer.stage(gpu, "shade", |enc| gpu.dispatch_2d(enc, "shade", &self.pipeline, &[&group], g.width, g.height));
-        gpu.read_buffer(&self.out)[..g.pixels() * 4].to_vec()
+        gpu.read_buffer(out)[..g.pixels() * 4].to_vec()
     }
 }
