@@ -45,6 +45,29 @@ pub struct CameraKey {
     pub target: Vec3,
 }
 
+/// `frames` cameras along a path: `base`'s lens at positions and targets interpolated linearly
+/// between the keys, evenly in key parameter (the first frame at the first key, the last at the
+/// last). No keys, or a single key: the camera holds still (at `base`, or at that key).
+pub fn path_cameras(base: &Camera, keys: &[CameraKey], frames: usize) -> Vec<Camera> {
+    (0..frames)
+        .map(|f| {
+            let mut c = *base;
+            match keys {
+                [] => {}
+                [k] => (c.position, c.target) = (k.position, k.target),
+                _ => {
+                    let t = if frames < 2 { 0.0 } else { f as f32 / (frames - 1) as f32 } * (keys.len() - 1) as f32;
+                    let i = (t.floor() as usize).min(keys.len() - 2);
+                    let u = t - i as f32;
+                    c.position = keys[i].position.lerp(keys[i + 1].position, u);
+                    c.target = keys[i].target.lerp(keys[i + 1].target, u);
+                }
+            }
+            c
+        })
+        .collect()
+}
+
 impl Camera {
     pub fn new(position: Vec3, target: Vec3, fov_y_deg: f32, near: f32, far: f32) -> Self {
         Camera { position, target, fov_y_deg, near, far }
@@ -97,6 +120,22 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[test]
+    fn path_interpolates_keys_and_holds_without_them() {
+        let base = Camera::new(Vec3::ZERO, Vec3::Z, 60.0, 0.1, 100.0);
+        let keys = [
+            CameraKey { position: Vec3::ZERO, target: Vec3::X },
+            CameraKey { position: Vec3::new(2.0, 0.0, 0.0), target: Vec3::X * 3.0 },
+            CameraKey { position: Vec3::new(2.0, 4.0, 0.0), target: Vec3::X * 3.0 },
+        ];
+        let c = path_cameras(&base, &keys, 5);
+        let xs: Vec<Vec3> = c.iter().map(|c| c.position).collect();
+        assert_eq!(xs, vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0, Vec3::new(2.0, 2.0, 0.0), Vec3::new(2.0, 4.0, 0.0)]);
+        assert_eq!(c[1].target, Vec3::X * 2.0);
+        assert!(path_cameras(&base, &[], 3).iter().all(|c| *c == base));
+        assert_eq!(path_cameras(&base, &keys[1..2], 2)[1].position, Vec3::X * 2.0);
+        assert_eq!(path_cameras(&base, &keys, 1)[0].position, Vec3::ZERO);
+    }
     #[test]
     fn target_projects_to_centre() {
         let c = Camera::new(Vec3::new(1.0, 2.0, 3.0), Vec3::new(4.0, 1.0, -2.0), 60.0, 0.1, 100.0);

@@ -40,6 +40,28 @@ pub fn compare(v: &[f32], v_rt: &[f32], mask: &[u32]) -> ErrorMetrics {
     }
 }
 
+/// Temporal flicker between two consecutive frames (GUIDE.md): % of pixels evaluated in both
+/// whose thresholded visibility changes while the reference's does not. Pixels are compared at
+/// the same screen position (a moving camera changes what they see; where it does, `rt`
+/// usually changes too and the pixel is not counted).
+pub fn flicker_pct(prev: &[f32], cur: &[f32], prev_rt: &[f32], cur_rt: &[f32], prev_mask: &[u32], cur_mask: &[u32]) -> f64 {
+    let n = cur.len();
+    assert!(prev.len() == n && prev_rt.len() == n && cur_rt.len() == n && prev_mask.len() == n && cur_mask.len() == n);
+    let (mut both, mut flips) = (0u64, 0u64);
+    for i in 0..n {
+        if prev_mask[i] == 0 || cur_mask[i] == 0 {
+            continue;
+        }
+        both += 1;
+        flips += ((prev[i] >= 0.5) != (cur[i] >= 0.5) && (prev_rt[i] >= 0.5) == (cur_rt[i] >= 0.5)) as u64;
+    }
+    if both == 0 {
+        0.0
+    } else {
+        100.0 * flips as f64 / both as f64
+    }
+}
+
 /// How the view samples land in a shadow map: the quantities warping aims to even out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct SamplingStats {
@@ -118,6 +140,18 @@ pub fn error_image(shaded: &[u8], v: &[f32], v_rt: &[f32], mask: &[u32], split: 
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[test]
+    fn flicker_counts_flips_the_reference_does_not_make() {
+        let m = [1, 1, 1, 1, 0];
+        let prev = [1.0, 1.0, 0.0, 0.0, 1.0];
+        let cur = [0.0, 1.0, 1.0, 0.0, 0.0];
+        let prev_rt = [1.0, 1.0, 0.0, 1.0, 1.0];
+        let cur_rt = [1.0, 1.0, 1.0, 1.0, 1.0];
+        // pixel 0 flips alone (counted), pixel 2 flips with rt (not), pixel 4 is masked
+        assert_eq!(flicker_pct(&prev, &cur, &prev_rt, &cur_rt, &m, &m), 25.0);
+        assert_eq!(flicker_pct(&prev, &prev, &prev_rt, &cur_rt, &m, &m), 0.0);
+        assert_eq!(flicker_pct(&prev, &cur, &prev_rt, &cur_rt, &[0; 5], &m), 0.0);
+    }
     #[test]
     fn compare_counts_known_cases() {
         let rt = [1.0, 1.0, 0.0, 0.0, 1.0];

@@ -46,6 +46,16 @@ pub struct View {
     pub stages_ms: BTreeMap<String, f64>,
 }
 
+/// A technique created for one light, kept across the views of a path.
+pub struct Instance {
+    pub label: String,
+    pub info: &'static TechniqueInfo,
+    pub params: ParamValues,
+    pub tech: Box<dyn techniques::Technique>,
+    /// Pipeline and resource creation (ms).
+    pub setup_ms: f64,
+}
+
 /// The result of one technique on one view.
 pub struct Run {
     pub label: String,
@@ -122,11 +132,29 @@ impl<'a> Lab<'a> {
         label: String,
         repeat: usize,
     ) -> Result<Run, GpuError> {
-        let gpu = self.gpu;
+        let mut inst = self.instantiate(info, params, label, &view.light)?;
+        self.step(view, &mut inst, true, repeat)
+    }
+
+    /// Creates a technique for `light` once, to be run on a sequence of views with
+    /// [`Lab::step`] (camera paths: techniques that keep state across frames see them in order).
+    pub fn instantiate(
+        &self,
+        info: &'static TechniqueInfo,
+        params: ParamValues,
+        label: String,
+        light: &Light,
+    ) -> Result<Instance, GpuError> {
         let t0 = std::time::Instant::now();
-        let mut tech = (info.create)(gpu, &self.gscene, &params, &view.light)?;
-        gpu.take_error()?;
-        let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let tech = (info.create)(self.gpu, &self.gscene, &params, light)?;
+        self.gpu.take_error()?;
+        Ok(Instance { label, info, params, tech, setup_ms: t0.elapsed().as_secs_f64() * 1e3 })
+    }
+
+    /// Runs `inst` on `view`: once untimed when `warm_up`, then `repeat` times timed (at least
+    /// once); then shades and reads back its visibility and report.
+    pub fn step(&self, view: &View, inst: &mut Instance, warm_up: bool, repeat: usize) -> Result<Run, GpuError> {
+        let gpu = self.gpu;
         let inputs = FrameInputs {
             scene: &self.gscene,
             gbuffer: &view.gbuffer,
@@ -135,12 +163,14 @@ impl<'a> Lab<'a> {
             frame: &view.frame,
             visibility: &view.visibility,
         };
+        let tech = inst.tech.as_mut();
+        if warm_up {
+            techniques::run_frame(tech, gpu, &inputs, &mut StageTimer::default())?;
+            gpu.take_error()?;
+        }
         let mut timer = StageTimer::default();
-        let mut warm = StageTimer::default();
-        techniques::run_frame(tech.as_mut(), gpu, &inputs, &mut warm)?;
-        gpu.take_error()?;
         for _ in 0..repeat.max(1) {
-            techniques::run_frame(tech.as_mut(), gpu, &inputs, &mut timer)?;
+            techniques::run_frame(tech, gpu, &inputs, &mut timer)?;
         }
         gpu.take_error()?;
         let stages_ms = timer.medians();
@@ -150,7 +180,17 @@ impl<'a> Lab<'a> {
         let mut shade_timer = StageTimer::default();
         let shaded = self.shade_pass.shade(gpu, &mut shade_timer, &inputs, &view.color);
         gpu.take_error()?;
-        Ok(Run { label, technique: info.name, params, visibility, shaded, report, stages_ms, total_ms, setup_ms })
+        Ok(Run {
+            label: inst.label.clone(),
+            technique: inst.info.name,
+            params: inst.params.clone(),
+            visibility,
+            shaded,
+            report,
+            stages_ms,
+            total_ms,
+            setup_ms: inst.setup_ms,
+        })
     }
 
     /// The reference on this view.
