@@ -124,10 +124,16 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[
+    &crate::reference::INFO,
+    &sm::INFO,
+];
 
+/// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
-    sm::shaders()
+    let mut v = sm::shaders();
+    v.extend(Vec::new());
+    v
 }
 
 pub fn find(name: &str) -> Result<&'static TechniqueInfo, GpuError> {
