@@ -128,7 +128,8 @@ pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
-    let mut v = sm::shaders();
+    let mut v = Vec::new();
+    v.extend(sm::shaders());
     v
 }
 
