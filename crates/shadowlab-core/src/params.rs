@@ -20,6 +20,22 @@ pub struct ParamDef {
     pub doc: &'static str,
     /// Where the default comes from.
     pub source: &'static str,
+    /// Named values (`select=sort`, `sd=true`): the parameter holds the index of the name,
+    /// `default`/`min`/`max` are indices and `integer` is true. Empty for numeric parameters.
+    pub choices: &'static [&'static str],
+}
+
+/// `choices` for on/off parameters: `false` = 0, `true` = 1 (`0`/`1` are accepted too).
+pub const BOOL: &[&str] = &["false", "true"];
+
+impl ParamDef {
+    /// The default as the user writes it (`512`, `0.5`, `sort`).
+    pub fn default_text(&self) -> String {
+        match self.choices.get(self.default as usize) {
+            Some(name) if !self.choices.is_empty() => name.to_string(),
+            _ => format!("{}", self.default),
+        }
+    }
 }
 
 /// A parsed spec: technique name, explicit key/value pairs (strings), optional label.
@@ -79,6 +95,12 @@ impl TechniqueSpec {
                     format!("technique '{}' has no parameter '{k}' (valid: {}, label)", self.name, keys.join(", "))
                 }
             })?;
+            if !def.choices.is_empty() {
+                let idx = def.choices.iter().position(|c| c == v).or_else(|| v.parse::<usize>().ok().filter(|i| *i < def.choices.len()));
+                let idx = idx.ok_or_else(|| format!("technique '{}': {k}={v} is not one of {}", self.name, def.choices.join(", ")))?;
+                values.insert(k.clone(), idx as f64);
+                continue;
+            }
             let x: f64 = v
                 .parse()
                 .ok()
@@ -108,15 +130,33 @@ impl ParamValues {
     pub fn get_u32(&self, key: &str) -> u32 {
         self.get(key) as u32
     }
+    /// An on/off parameter declared with `choices: BOOL`.
+    pub fn get_bool(&self, key: &str) -> bool {
+        self.get(key) != 0.0
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     const DEFS: &[ParamDef] = &[
-        ParamDef { key: "res", default: 512.0, min: 16.0, max: 16384.0, integer: true, doc: "", source: "" },
-        ParamDef { key: "bias", default: 0.5, min: 0.0, max: 100.0, integer: false, doc: "", source: "" },
+        ParamDef { key: "select", default: 0.0, min: 0.0, max: 1.0, integer: true, doc: "", source: "", choices: &["minmax", "sort"] },
+        ParamDef { key: "sd", default: 1.0, min: 0.0, max: 1.0, integer: true, doc: "", source: "", choices: BOOL },
+        ParamDef { key: "res", default: 512.0, min: 16.0, max: 16384.0, integer: true, doc: "", source: "", choices: &[] },
+        ParamDef { key: "bias", default: 0.5, min: 0.0, max: 100.0, integer: false, doc: "", source: "", choices: &[] },
     ];
+    #[test]
+    fn named_choices_resolve_to_indices() {
+        let v = TechniqueSpec::parse("x:select=sort,sd=false").unwrap().resolve(DEFS).unwrap();
+        assert_eq!((v.get_u32("select"), v.get_bool("sd")), (1, false));
+        let v = TechniqueSpec::parse("x:sd=1").unwrap().resolve(DEFS).unwrap();
+        assert!(v.get_bool("sd") && v.get_u32("select") == 0);
+        let e = TechniqueSpec::parse("x:select=median").unwrap().resolve(DEFS).unwrap_err();
+        assert!(e.contains("minmax, sort"), "{e}");
+        assert!(TechniqueSpec::parse("x:sd=2").unwrap().resolve(DEFS).is_err());
+        assert_eq!(DEFS[0].default_text(), "minmax");
+        assert_eq!(DEFS[2].default_text(), "512");
+    }
     #[test]
     fn parse_and_resolve() {
         let s = TechniqueSpec::parse("sm:res=2048, bias=1.5,label=big").unwrap();

@@ -47,6 +47,7 @@ pub const PARAMS: &[ParamDef] = &[
         integer: true,
         doc: "shadow map side (texels)",
         source: "seeds 000/002 evaluation: 512 with 1024x1024 output",
+        choices: &[],
     },
     ParamDef {
         key: "pcf",
@@ -56,6 +57,7 @@ pub const PARAMS: &[ParamDef] = &[
         integer: true,
         doc: "PCF kernel width N (NxN single-texel comparisons; (N-1)/2 x tan texels of bias added for the kernel); 1 = hard test",
         source: "Reeves et al. 1987; kernel bias: Isidoro 2006",
+        choices: &[],
     },
     ParamDef {
         key: "bias",
@@ -65,6 +67,7 @@ pub const PARAMS: &[ParamDef] = &[
         integer: false,
         doc: "constant depth bias, texels; low: acne, high: peter-panning",
         source: "shadowlab sweep 2026-11-22 (BENCHMARKS.md)",
+        choices: &[],
     },
     ParamDef {
         key: "slope_bias",
@@ -74,6 +77,7 @@ pub const PARAMS: &[ParamDef] = &[
         integer: false,
         doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope",
         source: "shadowlab sweep 2026-11-22: 0 (normal offset covers slopes)",
+        choices: &[],
     },
     ParamDef {
         key: "max_slope",
@@ -83,6 +87,7 @@ pub const PARAMS: &[ParamDef] = &[
         integer: false,
         doc: "clamp on tan(angle to light) for the slope bias and the PCF kernel bias; high: leaks under ledges at grazing light",
         source: "shadowlab sweep 2026-11-22 (2, 4, 10 with pcf=3)",
+        choices: &[],
     },
     ParamDef {
         key: "normal_offset",
@@ -92,6 +97,7 @@ pub const PARAMS: &[ParamDef] = &[
         integer: false,
         doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows",
         source: "Holbert 2011 (normal offset shadows); value from the shadowlab sweep",
+        choices: &[],
     },
 ];
 
