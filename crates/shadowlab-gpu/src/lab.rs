@@ -29,6 +29,7 @@ pub struct Lab<'a> {
 /// One view of the scene for one light, with its G-buffer read back.
 pub struct View {
     pub camera: Camera,
+    pub prev_camera: Camera,
     pub light: Light,
     pub width: u32,
     pub height: u32,
@@ -102,6 +103,7 @@ impl<'a> Lab<'a> {
         let color = ShadePass::output(gpu, &g);
         Ok(View {
             camera: *camera,
+            prev_camera: *prev,
             light: *light,
             width,
             height,
@@ -159,6 +161,8 @@ impl<'a> Lab<'a> {
             scene: &self.gscene,
             gbuffer: &view.gbuffer,
             light: view.light,
+            camera: view.camera,
+            prev_camera: view.prev_camera,
             light_buf: &view.light_buf,
             frame: &view.frame,
             visibility: &view.visibility,

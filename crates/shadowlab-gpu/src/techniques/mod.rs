@@ -6,6 +6,7 @@ pub mod sm;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
+use shadowlab_core::camera::Camera;
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::SamplingStats;
 use shadowlab_core::params::{ParamDef, ParamValues, TechniqueSpec};
@@ -21,6 +22,11 @@ pub struct FrameInputs<'a> {
     pub scene: &'a GpuScene,
     pub gbuffer: &'a GBuffer,
     pub light: Light,
+    /// The view's camera (CPU copy of what `frame` holds; the output size is `gbuffer.width/height`),
+    /// for techniques that fit their maps to the view frustum (cascades, tiles).
+    pub camera: Camera,
+    /// The previous frame's camera (equal to `camera` on a single view).
+    pub prev_camera: Camera,
     /// `LightUniform` of `light`.
     pub light_buf: &'a wgpu::Buffer,
     /// `FrameUniform` of the view.
