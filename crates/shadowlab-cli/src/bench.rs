@@ -63,7 +63,7 @@ pub fn bench(setups: &[PathBuf], size: &str, frames: usize, out: Option<&Path>) 
         let t0 = Instant::now();
         let scene = load_scene(&setup.scene_source().map_err(|e| anyhow!(e))?, &setup.transform())?;
         let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let camera = setup.camera.unwrap_or(scene.camera);
+        let camera = setup.camera.as_ref().map(|c| c.camera()).unwrap_or(scene.camera);
         let light = setup.lights.first().copied().unwrap_or(scene.lights[0]);
         let lab = Lab::new(&gpu, &scene)?;
         let mut gb = Vec::new();

@@ -2,14 +2,15 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-use shadowlab_core::metrics::{compare as metrics_of, edge_pixels, error_image};
+use shadowlab_core::metrics::{edge_pixels, error_image};
 use shadowlab_gpu::lab::{Lab, Run};
 use shadowlab_gpu::Gpu;
 
 use crate::config::{resolve, RunConfig, BASELINE};
+use crate::frames::{summarize, ReferenceFrame};
 use crate::output::{slug, StagedDir};
 use crate::{export, report, RunArgs};
 
@@ -23,6 +24,7 @@ fn progress(quiet: bool, len: u64) -> ProgressBar {
 }
 
 pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
+    anyhow::ensure!(args.frames == 1, "render draws one view; use compare --frames {} for a camera path", args.frames);
     let cfg = resolve(args, &["rt"])?;
     anyhow::ensure!(cfg.specs.len() == 1, "render takes one technique (got {}); use compare for several", cfg.specs.len());
     let gpu = Gpu::new()?;
@@ -39,34 +41,28 @@ pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
 }
 
 pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
+    anyhow::ensure!(args.frames >= 1, "--frames must be at least 1");
     let cfg = resolve(args, BASELINE)?;
     let t_start = std::time::Instant::now();
     let gpu = Gpu::new()?;
-    let pb = progress(args.quiet, cfg.specs.len() as u64 + 2);
+    let frames = args.frames.max(1);
+    let pb = progress(args.quiet, 1 + frames as u64 * (cfg.specs.len() as u64 + 1));
     pb.set_message("BVH + upload");
     let lab = Lab::new(&gpu, &cfg.scene)?;
-    pb.set_message("G-buffer");
-    let view = lab.view(&cfg.camera, &cfg.camera, cfg.light(), cfg.width, cfg.height)?;
     pb.inc(1);
-    pb.set_message("rt (reference)");
-    let rt = lab.reference(&view, args.repeat)?;
-    pb.inc(1);
-    let mut runs: Vec<Run> = Vec::new();
-    for spec in &cfg.specs {
-        pb.set_message(spec.label());
-        runs.push(lab.run(&view, spec, args.repeat).with_context(|| format!("technique '{}'", spec.label()))?);
-        pb.inc(1);
-    }
+    let path = crate::frames::run(&lab, &cfg, frames, args.repeat, &pb)?;
     pb.finish_and_clear();
+    let (view, rt) = (&path.view, &path.rt);
 
     let dir = StagedDir::new(out)?;
     let (w, h) = (cfg.width, cfg.height);
     export::png(&dir.path("rt.png"), w, h, &rt.shaded)?;
     let edges = edge_pixels(&rt.visibility, &view.mask, w as usize, h as usize);
     let mut techniques = Vec::new();
-    for run in &runs {
+    for t in &path.techniques {
+        let run = &t.last;
         let s = slug(&run.label);
-        let m = metrics_of(&run.visibility, &rt.visibility, &view.mask);
+        let m = summarize(&t.frames);
         export::png(&dir.path(&format!("{s}.png")), w, h, &run.shaded)?;
         export::png(
             &dir.path(&format!("{s}-error.png")),
@@ -95,16 +91,20 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
             "false_shadow_pct": m.false_shadow_pct,
             "mae": m.mae,
             "evaluated_pixels": m.evaluated_pixels,
+            "flicker_pct": m.flicker_pct,
             "shadow_data_bytes": run.report.shadow_data_bytes,
-            "stages_ms": run.stages_ms,
-            "total_ms": run.total_ms,
+            "stages_ms": m.stages_ms,
+            "total_ms": m.total_ms,
             "setup_ms": run.setup_ms,
             "counters": run.report.counters,
             "sampling": run.report.sampling,
             "images": {"shaded": format!("{s}.png"), "error": format!("{s}-error.png"), "error_split": format!("{s}-error-split.png"), "extra": images},
             "visibility_npy": export_raw.then(|| format!("visibility/{s}.npy")),
+            "frames": t.frames,
         }));
     }
+    let runs: Vec<&Run> = path.techniques.iter().map(|t| &t.last).collect();
+    let rt_total = summarize_reference(&path.reference);
     let metrics = json!({
         "scene": cfg.scene.name,
         "scene_source": cfg.source,
@@ -122,13 +122,16 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         "repeat": args.repeat,
         "bvh": {"nodes": lab.bvh.nodes.len(), "bytes": lab.bvh.bytes(), "bytes_per_triangle": lab.bvh.bytes() as f64 / cfg.scene.triangle_count() as f64, "depth": lab.bvh.depth, "build_ms": lab.bvh.build_ms},
         "gbuffer_stages_ms": view.stages_ms,
+        "frames": frames,
+        "cameras": path.cameras,
         "reference": {
             "label": "rt",
             "evaluated_pixels": view.mask.iter().filter(|m| **m != 0).count(),
             "edge_pixels": edges,
             "stages_ms": rt.stages_ms,
-            "total_ms": rt.total_ms,
+            "total_ms": rt_total,
             "counters": rt.report.counters,
+            "frames": path.reference,
         },
         "techniques": techniques,
         "peak_rss_mib": crate::bench::peak_rss_mib(),
@@ -152,18 +155,24 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
     Ok(())
 }
 
+/// The reference's time: its median over frames 1.. (or its single frame's median).
+fn summarize_reference(frames: &[ReferenceFrame]) -> f64 {
+    let timed = if frames.len() > 1 { &frames[1..] } else { frames };
+    shadowlab_gpu::timing::median(&timed.iter().map(|r| r.total_ms).collect::<Vec<_>>())
+}
+
 fn row_major(m: &glam::Mat4) -> [[f32; 4]; 4] {
     m.transpose().to_cols_array_2d()
 }
 
 const CSV_COLUMNS: &[&str] =
-    &["wrong_pct", "false_lit_pct", "false_shadow_pct", "mae", "evaluated_pixels", "shadow_data_bytes", "total_ms"];
+    &["wrong_pct", "false_lit_pct", "false_shadow_pct", "mae", "flicker_pct", "evaluated_pixels", "shadow_data_bytes", "total_ms"];
 
 fn csv(metrics: &serde_json::Value) -> String {
     let mut s = format!("label,technique,{},fetches_per_pixel,rays_traced\n", CSV_COLUMNS.join(","));
     for t in metrics["techniques"].as_array().into_iter().flatten() {
         let q = |k: &str| t["counters"].get(k).map(|v| v.to_string()).unwrap_or_default();
-        let cols: Vec<String> = CSV_COLUMNS.iter().map(|k| t[*k].to_string()).collect();
+        let cols: Vec<String> = CSV_COLUMNS.iter().map(|k| if t[*k].is_null() { String::new() } else { t[*k].to_string() }).collect();
         s += &format!(
             "\"{}\",{},{},{},{}\n",
             t["label"].as_str().unwrap_or("").replace('"', "\"\""),

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context, Result};
 use shadowlab_core::builtin::{builtin, BUILTIN_SCENES, DEFAULT_SCENE};
-use shadowlab_core::camera::Camera;
+use shadowlab_core::camera::{Camera, CameraKey};
 use shadowlab_core::light::Light;
 use shadowlab_core::loaders::{self, SceneTransform};
 use shadowlab_core::params::TechniqueSpec;
@@ -21,6 +21,9 @@ pub struct RunConfig {
     pub scene: Scene,
     pub source: String,
     pub camera: Camera,
+    /// Keyframes `--frames` follows: the setup's `[[camera.path]]` when the setup has a camera,
+    /// else the built-in scene's path (empty: the camera holds still).
+    pub camera_path: Vec<CameraKey>,
     pub lights: Vec<Light>,
     pub light_index: usize,
     pub width: u32,
@@ -106,7 +109,10 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
     for w in &scene.report.warnings {
         eprintln!("warning: {w}");
     }
-    let camera = setup.camera.unwrap_or(scene.camera);
+    let (camera, camera_path) = match &setup.camera {
+        Some(c) => (c.camera(), c.path.clone()),
+        None => (scene.camera, scene.camera_path.clone()),
+    };
     let lights = if setup.lights.is_empty() { scene.lights.clone() } else { setup.lights.clone() };
     if args.light >= lights.len() {
         bail!("--light {}: the run has {} light(s)", args.light, lights.len());
@@ -118,6 +124,7 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
         },
         scene,
         camera,
+        camera_path,
         lights,
         light_index: args.light,
         width,

@@ -4,6 +4,7 @@ mod bench;
 mod compare;
 mod config;
 mod export;
+mod frames;
 mod listing;
 mod output;
 mod report;
@@ -40,6 +41,10 @@ pub struct RunArgs {
     /// Timed repetitions per technique after one warm-up (median reported)
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
+    /// Frames along the camera path (the setup's `[[camera.path]]`, else the built-in scene's;
+    /// the camera holds still where there is none). 1 = the single view of frame 0
+    #[arg(long, default_value_t = 1)]
+    pub frames: usize,
     /// No progress bar or summary
     #[arg(long, short)]
     pub quiet: bool,

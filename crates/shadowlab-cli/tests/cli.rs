@@ -171,6 +171,36 @@ fn the_same_run_twice_gives_identical_metrics() {
 }
 
 #[test]
+fn frames_follow_the_camera_path_with_per_frame_metrics() {
+    if skip_gpu() {
+        return;
+    }
+    let out = tmp("frames");
+    let o = out.to_str().unwrap();
+    let r = run(&["compare", "-q", "--scene", "room", "--size", "96x96", "--frames", "4", "-t", "sm", "-t", "sm:res=1024", "--out", o]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["frames"], 4);
+    let cams = m["cameras"].as_array().unwrap();
+    assert_eq!(cams.len(), 4);
+    assert_ne!(cams[0]["position"], cams[3]["position"], "the room's camera walks its path");
+    assert_eq!(m["reference"]["frames"].as_array().unwrap().len(), 4);
+    for t in m["techniques"].as_array().unwrap() {
+        let fr = t["frames"].as_array().unwrap();
+        assert_eq!(fr.len(), 4);
+        assert!(fr[0]["flicker_pct"].is_null() && fr[1..].iter().all(|f| f["flicker_pct"].is_number()));
+        let mean = fr.iter().map(|f| f["wrong_pct"].as_f64().unwrap()).sum::<f64>() / 4.0;
+        assert!((t["wrong_pct"].as_f64().unwrap() - mean).abs() < 1e-9, "top-level wrong % is the mean over frames");
+        let fl = fr[1..].iter().map(|f| f["flicker_pct"].as_f64().unwrap()).sum::<f64>() / 3.0;
+        assert!((t["flicker_pct"].as_f64().unwrap() - fl).abs() < 1e-9);
+        assert!(fr.iter().any(|f| f["wrong_pct"] != fr[0]["wrong_pct"]), "frames differ");
+    }
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("<svg") && html.contains("flicker vs previous frame"), "per-frame charts in the report");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
 fn bad_input_gives_one_clear_error_and_no_report() {
     let out = tmp("bad");
     let o = out.to_str().unwrap();
@@ -192,6 +222,7 @@ fn bad_input_gives_one_clear_error_and_no_report() {
         (vec!["--setup".into(), bad_setup.display().to_string()], "scael"),
         (vec!["--scene".into(), "room".into(), "--light".into(), "1".into(), "-t".into(), "sm".into()], "point"),
         (vec!["--light".into(), "7".into()], "light"),
+        (vec!["--frames".into(), "0".into()], "--frames"),
     ];
     for (args, needle) in cases {
         let mut all = vec!["compare".to_string(), "--quiet".into(), "--out".into(), o.into()];

@@ -16,13 +16,13 @@ pub struct Camera {
     pub far: f32,
 }
 
-fn default_fov() -> f32 {
+pub(crate) fn default_fov() -> f32 {
     60.0
 }
-fn default_near() -> f32 {
+pub(crate) fn default_near() -> f32 {
     0.1
 }
-fn default_far() -> f32 {
+pub(crate) fn default_far() -> f32 {
     100.0
 }
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::camera::Camera;
+use crate::camera::{default_far, default_fov, default_near, Camera, CameraKey};
 use crate::light::Light;
 use crate::loaders::{SceneTransform, UpAxis};
 
@@ -15,13 +15,36 @@ use crate::loaders::{SceneTransform, UpAxis};
 pub struct Setup {
     pub scene: SceneSection,
     #[serde(default)]
-    pub camera: Option<Camera>,
+    pub camera: Option<CameraSection>,
     #[serde(default)]
     pub lights: Vec<Light>,
     #[serde(default)]
     pub output: OutputSection,
     #[serde(default)]
     pub techniques: Vec<TechniqueEntry>,
+}
+
+/// `[camera]`: the lens and pose of frame 0, and an optional `[[camera.path]]` of keyframes
+/// (position, target) that `--frames N` follows.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSection {
+    pub position: Vec3,
+    pub target: Vec3,
+    #[serde(default = "default_fov")]
+    pub fov_y_deg: f32,
+    #[serde(default = "default_near")]
+    pub near: f32,
+    #[serde(default = "default_far")]
+    pub far: f32,
+    #[serde(default)]
+    pub path: Vec<CameraKey>,
+}
+
+impl CameraSection {
+    pub fn camera(&self) -> Camera {
+        Camera::new(self.position, self.target, self.fov_y_deg, self.near, self.far)
+    }
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -101,7 +124,10 @@ impl Setup {
     pub fn validate(&self) -> Result<(), String> {
         self.scene_source()?;
         if let Some(c) = &self.camera {
-            c.validate()?;
+            c.camera().validate()?;
+            for (i, k) in c.path.iter().enumerate() {
+                Camera { position: k.position, target: k.target, ..c.camera() }.validate().map_err(|e| format!("camera.path[{i}]: {e}"))?;
+            }
         }
         for l in &self.lights {
             l.validate()?;
@@ -164,7 +190,19 @@ spec = "sm:res=512,pcf=3"
         assert_eq!(s.lights.len(), 2);
         assert!(matches!(s.lights[1], Light::Spot { cone_deg, .. } if cone_deg == 35.0));
         assert_eq!(s.techniques[0].spec, "sm:res=512,pcf=3");
-        assert_eq!(s.camera.unwrap().fov_y_deg, 65.0);
+        assert_eq!(s.camera.as_ref().unwrap().fov_y_deg, 65.0);
+        assert!(s.camera.unwrap().path.is_empty());
+    }
+    #[test]
+    fn camera_path_keys_parse_and_are_checked() {
+        let text = "[scene]\nbuiltin = 'room'\n[camera]\nposition = [0, 1, 0]\ntarget = [0, 1, -1]\n\
+                    [[camera.path]]\nposition = [0, 1, 0]\ntarget = [0, 1, -1]\n[[camera.path]]\nposition = [1, 1, 0]\ntarget = [1, 1, -1]\n";
+        let s = Setup::parse(text).unwrap();
+        s.validate().unwrap();
+        assert_eq!(s.camera.as_ref().unwrap().path[1].position, Vec3::new(1.0, 1.0, 0.0));
+        let bad = text.replace("target = [1, 1, -1]", "target = [1, 1, 0]");
+        assert!(Setup::parse(&bad).unwrap().validate().unwrap_err().contains("camera.path[1]"));
+        assert!(Setup::parse(&text.replace("[[camera.path]]\nposition = [0", "[[camera.path]]\nfov = 3\nposition = [0")).is_err());
     }
     #[test]
     fn defaults_are_the_identity_transform() {

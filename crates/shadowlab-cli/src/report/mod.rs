@@ -1,6 +1,8 @@
 //! The HTML report: one self-contained page (no network), rendered with minijinja from
 //! `index.html.j2` and the same JSON that goes to metrics.json.
 
+mod plots;
+
 use anyhow::Result;
 
 const TEMPLATE: &str = include_str!("index.html.j2");
@@ -20,7 +22,9 @@ pub fn html(metrics: &serde_json::Value) -> Result<String> {
             format!("{v} B")
         }
     });
-    Ok(env.get_template("index.html")?.render(minijinja::context! { m => metrics })?)
+    let charts: Vec<minijinja::Value> =
+        plots::frame_charts(metrics)?.into_iter().map(|(title, svg)| minijinja::context! { title => title, svg => svg }).collect();
+    Ok(env.get_template("index.html")?.render(minijinja::context! { m => metrics, charts => charts })?)
 }
 
 #[cfg(test)]

@@ -1,0 +1,103 @@
+//! Per-frame charts of a camera-path run (seed 004's Figure 7 style): one SVG per figure, one
+//! line per technique, drawn with plotters' SVG backend (no fonts, no network).
+
+use anyhow::{anyhow, Result};
+use plotters::prelude::*;
+use serde_json::Value;
+
+/// The per-frame figures charted, as (key in a `frames` record, title).
+pub const CHARTS: &[(&str, &str)] = &[
+    ("wrong_pct", "wrong pixels (%)"),
+    ("flicker_pct", "flicker vs previous frame (%)"),
+    ("rays_traced", "rays traced"),
+    ("total_ms", "time (ms)"),
+];
+
+const PALETTE: &[RGBColor] = &[
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+/// One SVG per chart that has data, as (title, svg). Empty for single-frame runs.
+pub fn frame_charts(metrics: &Value) -> Result<Vec<(String, String)>> {
+    let techniques = metrics["techniques"].as_array().cloned().unwrap_or_default();
+    let frames = metrics["frames"].as_u64().unwrap_or(1);
+    if frames < 2 {
+        return Ok(Vec::new());
+    }
+    let mut out = Vec::new();
+    for (key, title) in CHARTS {
+        let series: Vec<(String, Vec<(f64, f64)>)> = techniques
+            .iter()
+            .map(|t| {
+                let pts = t["frames"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|r| Some((r["frame"].as_f64()?, r[*key].as_f64()?)))
+                    .collect::<Vec<_>>();
+                (t["label"].as_str().unwrap_or("").to_string(), pts)
+            })
+            .filter(|(_, pts)| !pts.is_empty())
+            .collect();
+        if series.is_empty() {
+            continue;
+        }
+        out.push((title.to_string(), chart(title, frames as f64, &series)?));
+    }
+    Ok(out)
+}
+
+fn chart(title: &str, frames: f64, series: &[(String, Vec<(f64, f64)>)]) -> Result<String> {
+    let ymax = series.iter().flat_map(|(_, p)| p.iter().map(|q| q.1)).fold(0.0f64, f64::max);
+    let ymax = if ymax > 0.0 { ymax * 1.1 } else { 1.0 };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (560, 260)).into_drawing_area();
+        let err = |e: &dyn std::fmt::Display| anyhow!("chart '{title}': {e}");
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let mut c = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 15))
+            .margin(8)
+            .x_label_area_size(28)
+            .y_label_area_size(52)
+            .build_cartesian_2d(0f64..(frames - 1.0).max(1.0), 0f64..ymax)
+            .map_err(|e| err(&e))?;
+        c.configure_mesh().x_desc("frame").light_line_style(WHITE.mix(0.0)).draw().map_err(|e| err(&e))?;
+        for (i, (label, pts)) in series.iter().enumerate() {
+            let color = PALETTE[i % PALETTE.len()];
+            c.draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
+                .map_err(|e| err(&e))?
+                .label(label.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+        }
+        c.configure_series_labels().background_style(WHITE.mix(0.85)).border_style(BLACK.mix(0.3)).draw().map_err(|e| err(&e))?;
+        root.present().map_err(|e| err(&e))?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn one_line_per_technique_and_nothing_for_one_frame() {
+        let rec = |f: u32, w: f64| serde_json::json!({"frame": f, "wrong_pct": w, "flicker_pct": if f == 0 { Value::Null } else { (w / 2.0).into() }, "total_ms": 3.0, "rays_traced": null});
+        let t = |l: &str| serde_json::json!({"label": l, "frames": [rec(0, 1.0), rec(1, 2.0), rec(2, 1.5)]});
+        let m = serde_json::json!({"frames": 3, "techniques": [t("sm"), t("vsm:blur=5")]});
+        let charts = frame_charts(&m).unwrap();
+        let titles: Vec<&str> = charts.iter().map(|c| c.0.as_str()).collect();
+        assert_eq!(titles, ["wrong pixels (%)", "flicker vs previous frame (%)", "time (ms)"], "no rays: no ray chart");
+        let svg = &charts[0].1;
+        assert!(svg.starts_with("<svg") && svg.contains("vsm:blur=5") && svg.contains("sm"));
+        let lines = svg.lines().filter(|l| l.contains("<polyline") && l.contains("stroke-width=\"2\"")).count();
+        assert_eq!(lines, 4, "two lines and two legend marks");
+        assert!(frame_charts(&serde_json::json!({"frames": 1, "techniques": [t("sm")]})).unwrap().is_empty());
+    }
+}
