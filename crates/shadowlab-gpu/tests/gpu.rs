@@ -212,7 +212,7 @@ fn rt_gpu_matches_cpu_on_real_scenes() {
         };
         let scene = shadowlab_core::loaders::load(&path, &setup.transform()).unwrap();
         let lab = Lab::new(&gpu, &scene).unwrap();
-        let cam = setup.camera.unwrap();
+        let cam = setup.camera.as_ref().unwrap().camera();
         for light in &setup.lights {
             let v = lab.view(&cam, &cam, light, 512, 512).unwrap();
             let rt = lab.reference(&v, 1).unwrap();
