@@ -19,6 +19,8 @@ use shadowlab_gpu::timing::median;
 
 use crate::config::RunConfig;
 
+type Previous = (Vec<f32>, Vec<u32>, Vec<Vec<f32>>);
+
 /// One technique on one frame.
 #[derive(Clone, Debug, Serialize)]
 pub struct FrameRecord {
@@ -77,7 +79,8 @@ pub fn run(lab: &Lab, cfg: &RunConfig, frames: usize, repeat: usize, pb: &Progre
     }
     let mut reference = Vec::new();
     let mut records: Vec<Vec<FrameRecord>> = vec![Vec::new(); insts.len()];
-    let mut prev: Option<(Vec<f32>, Vec<u32>, Vec<Vec<f32>>)> = None;
+    // previous frame: rt's visibility, the mask, each technique's visibility
+    let mut prev: Option<Previous> = None;
     let mut last = None;
     for (f, cam) in cameras.iter().enumerate() {
         let prev_cam = if f == 0 { cam } else { &cameras[f - 1] };
