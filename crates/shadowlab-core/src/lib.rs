@@ -7,6 +7,7 @@ pub mod bvh;
 pub mod camera;
 pub mod light;
 pub mod lightspace;
+pub mod mdsm;
 pub mod loaders;
 pub mod metrics;
 pub mod params;
