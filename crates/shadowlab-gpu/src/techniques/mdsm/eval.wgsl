@@ -24,15 +24,12 @@ fn to_map(p: vec3<f32>) -> vec3<f32> {
 }
 
 // The n-shadow test (seed 003 section 4.2; shadowlab_core::mdsm::n_shadow_test): s = the number
-// of the sorted depths Z1 >= ... >= Zn in front of d (Zj < d), found by walking from Z1 to the
-// first Zi < d: then s = n - i + 1 (0-based: n - i). Coverage s/n; lit (n - s)/n.
-fn n_shadow_test(z: vec4<f32>, n: u32, d: f32) -> u32 {
-    for (var i = 0u; i < n; i++) {
-        if z[i] < d {
-            return n - i;
-        }
-    }
-    return 0u;
+// of the sorted depths Z1 >= ... >= Zn in front of d (Zj < d); coverage s/n, lit (n - s)/n.
+// The CPU walks from Z1 to the first Zi < d (the paper's i, s = n - i + 1); here the same s is
+// counted without branches over the first n channels (`lanes`). Core's unit tests prove walk ==
+// count; tests/mdsm.rs checks this shader against the CPU pixel by pixel.
+fn n_shadow_test(z: vec4<f32>, lanes: vec4<u32>, d: f32) -> u32 {
+    return dot(select(vec4<u32>(0u), lanes, z < vec4<f32>(d)), vec4<u32>(1u));
 }
 
 @compute @workgroup_size(8, 8)
@@ -75,13 +72,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let n = md.sel.x;
+    let lanes = vec4<u32>(vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(n));
     var lit = 0u;
     for (var y = 0; y < kw; y++) {
         for (var x = 0; x < kw; x++) {
             let uv = m.xy + (vec2<f32>(f32(x), f32(y)) - half) / res;
             // nearest texel, clamped to the edge (what `sm`'s nearest comparison sampler reads)
             let t = clamp(vec2<i32>(floor(uv * res)), vec2<i32>(0), vec2<i32>(ires - 1));
-            lit += n - n_shadow_test(textureLoad(nsm, t, 0), n, m.z);
+            lit += n - n_shadow_test(textureLoad(nsm, t, 0), lanes, m.z);
         }
     }
     visibility[i] = f32(lit) / f32(n * u32(kw * kw));
