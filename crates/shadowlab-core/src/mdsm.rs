@@ -250,7 +250,7 @@ mod tests {
         assert_eq!(shadow_coverage(&z, 0.5), 1.0 / 3.0); // behind Z3 only (i = 3: lit (i-1)/n = 2/3)
         assert_eq!(shadow_coverage(&z, 0.7), 2.0 / 3.0);
         assert_eq!(shadow_coverage(&z, 0.95), 1.0); // behind Z1: fully shadowed
-        // Figure 4's 2-SM: 0, 0.5, 1
+                                                    // Figure 4's 2-SM: 0, 0.5, 1
         let z2 = [0.8, 0.4];
         let v: Vec<f32> = [0.1, 0.5, 0.9].iter().map(|&d| shadow_coverage(&z2, d)).collect();
         assert_eq!(v, vec![0.0, 0.5, 1.0]);

@@ -84,9 +84,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sm16 = run(&format!("sm:res={res},pcf=4"))?;
     rows.push(row(&sm16, 1, 16));
 
-    println!("### `mdsm` on {what}: {size}x{size} output, {res}^2 map, {pixels} evaluated pixels, {} ({})", gpu.adapter_summary(), gpu.timer_name());
+    println!(
+        "### `mdsm` on {what}: {size}x{size} output, {res}^2 map, {pixels} evaluated pixels, {} ({})",
+        gpu.adapter_summary(),
+        gpu.timer_name()
+    );
     println!();
-    println!("| spec | n | k | fetches/px | distinct values (max nk+1) | MAE vs 7x7 PCF | MAE vs rt | wrong % vs rt | select ms | evaluate ms |");
+    println!(
+        "| spec | n | k | fetches/px | distinct values (max nk+1) | MAE vs 7x7 PCF | MAE vs rt | wrong % vs rt | select ms | evaluate ms |"
+    );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for r in &rows {
         println!(

@@ -140,7 +140,7 @@ fn gpu_pcf_equals_cpu_pcf_on_read_back_texels() {
             Vec3::new(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, ndc.z)
         };
         let (mut checked, mut skipped, mut fractional) = (0, 0, 0);
-        for i in 0..v.mask.len() {
+        for (i, &got) in vis.iter().enumerate() {
             if v.mask[i] == 0 {
                 continue;
             }
@@ -171,7 +171,7 @@ fn gpu_pcf_equals_cpu_pcf_on_read_back_texels() {
             }
             let slices: Vec<&[f32]> = taps.iter().map(|z| &z[..n]).collect();
             let want = pcf(&slices, m.z);
-            assert_eq!(vis[i], want, "{args} pixel {i}: GPU {} CPU {want}", vis[i]);
+            assert_eq!(got, want, "{args} pixel {i}: GPU {got} CPU {want}");
             checked += 1;
             fractional += (want > 0.0 && want < 1.0) as usize;
         }
@@ -227,4 +227,17 @@ fn bad_parameters_are_clear_errors() {
     let point = view(&lab, &scene, 1, 32);
     let e = lab.run(&point, &spec("mdsm"), 0).err().expect("point light must fail");
     assert!(e.to_string().contains("point"), "{e}");
+}
+
+/// CPU-only: the WGSL limits are the core constants (the selection array must hold the largest
+/// search region, the texel the most depths).
+#[test]
+fn wgsl_constants_match_core() {
+    use shadowlab_core::mdsm::{MAX_DEPTHS, SEARCH_SIZES};
+    let all = shadowlab_gpu::techniques::shaders();
+    let select = &all.iter().find(|(n, _)| *n == "mdsm/select.wgsl").unwrap().1;
+    let max_q = SEARCH_SIZES.iter().max().unwrap();
+    assert!(select.contains(&format!("const MAX_Q: u32 = {max_q}u;")), "select.wgsl MAX_Q must be {max_q}");
+    assert!(select.contains("var z = array<f32, 4>") && MAX_DEPTHS == 4, "one RGBA32F texel holds MAX_DEPTHS = 4 depths");
+    assert_eq!(INFO.params.iter().find(|p| p.key == "n").unwrap().max, MAX_DEPTHS as f64);
 }

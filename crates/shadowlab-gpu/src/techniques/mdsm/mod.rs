@@ -203,7 +203,8 @@ impl MultiDepthMap {
         }
         let strategy = p.get_u32("select");
         Select::from_index(strategy).ok_or_else(|| GpuError::Invalid(format!("mdsm: select index {strategy} unknown")))?;
-        let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("mdsm does not support point lights".into()))?;
+        let lp =
+            lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("mdsm does not support point lights".into()))?;
         let bias = [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32];
         let region = if n > 1 { qw } else { 1 };
         let params = MdsmParams {
@@ -248,11 +249,7 @@ impl MultiDepthMap {
             d,
             "mdsm.select",
             &select_layout,
-            &[
-                uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&base_view),
-                wgpu::BindingResource::TextureView(&nsm_view),
-            ],
+            &[uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&base_view), wgpu::BindingResource::TextureView(&nsm_view)],
         );
         let select_pipeline = gpu.compute_pipeline("mdsm.select", &compose(SELECT_WGSL, false), "main", &[&select_layout]);
         let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
@@ -302,7 +299,9 @@ impl Technique for MultiDepthMap {
             pass.set_bind_group(1, &f.scene.group, &[]);
             pass.draw(0..f.scene.triangle_count * 3, 0..1);
         });
-        timer.stage(gpu, "mdsm.select", |enc| gpu.dispatch_2d(enc, "mdsm.select", &self.select_pipeline, &[&self.select_group], self.res, self.res));
+        timer.stage(gpu, "mdsm.select", |enc| {
+            gpu.dispatch_2d(enc, "mdsm.select", &self.select_pipeline, &[&self.select_group], self.res, self.res)
+        });
         Ok(())
     }
 
