@@ -8,6 +8,7 @@ pub mod camera;
 pub mod light;
 pub mod lightspace;
 pub mod loaders;
+pub mod mdsm;
 pub mod metrics;
 pub mod params;
 pub mod scene;

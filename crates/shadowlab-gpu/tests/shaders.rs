@@ -132,3 +132,18 @@ fn shared_struct_layouts_match_rust() {
         check(&get(sm), "SmParams", size_of::<SmParams>(), &[("texel", offset_of!(SmParams, texel)), ("bias", offset_of!(SmParams, bias))]);
     }
 }
+
+#[test]
+fn mdsm_params_layout_matches_wgsl() {
+    use shadowlab_gpu::techniques::mdsm::MdsmParams;
+    let all = shadowlab_gpu::shaders::all();
+    for name in ["mdsm/select.wgsl", "mdsm/eval.wgsl"] {
+        let src = &all.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("{name} not composed")).1;
+        check(
+            &parse(name, src),
+            "MdsmParams",
+            size_of::<MdsmParams>(),
+            &[("texel", offset_of!(MdsmParams, texel)), ("bias", offset_of!(MdsmParams, bias)), ("sel", offset_of!(MdsmParams, sel))],
+        );
+    }
+}

@@ -1,0 +1,339 @@
+//! `mdsm`: multiple-depth shadow maps with PCF(k, n) (seed 003, Pagot, Comba, Oliveira 2004).
+//!
+//! Three passes: the base depth map (exactly `sm`'s depth pass and projection; post-projective
+//! depth, 0 = near the light), a selection compute pass that writes the n sorted depths of
+//! every texel into one RGBA32F texel (`select.wgsl`, the WGSL twin of
+//! [`shadowlab_core::mdsm::select`]), and the evaluation (`eval.wgsl`): `sm`'s bias model, then
+//! k taps on a sqrt(k) x sqrt(k) grid, one fetch and one n-shadow test each
+//! ([`shadowlab_core::mdsm::n_shadow_test`]), averaged to a lit fraction in steps of 1/(nk).
+//! With n = 1 the selection is a copy (search width 1) and PCF(k, 1) is `sm:pcf=sqrt(k)`.
+
+use bytemuck::{Pod, Zeroable};
+use shadowlab_core::light::Light;
+use shadowlab_core::lightspace;
+use shadowlab_core::mdsm::{max_distinct, pcf_width, search_width, Select, DEFAULT_Q, MAX_DEPTHS, PCF_TAPS, SEARCH_SIZES};
+use shadowlab_core::metrics::sampling_stats;
+use shadowlab_core::params::{ParamDef, ParamValues, BOOL};
+
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose;
+use crate::techniques::sm::{self, count_image, depth_image, SmParams};
+use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{binding, raster, Gpu, GpuError};
+
+const SELECT_WGSL: &str = include_str!("select.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("mdsm/select.wgsl", compose(SELECT_WGSL, false)), ("mdsm/eval.wgsl", compose_view(EVAL_WGSL, false))]
+}
+
+/// `sm`'s depth pass (same shader, same `SmParams`), so the base map is `sm`'s map.
+fn sm_depth_wgsl() -> Result<String, GpuError> {
+    sm::shaders()
+        .into_iter()
+        .find(|(name, _)| *name == "sm/depth.wgsl")
+        .map(|(_, src)| src)
+        .ok_or_else(|| GpuError::Invalid("mdsm: sm/depth.wgsl not found".into()))
+}
+
+/// Depths per texel. Seed 003 demonstrates 2 and 3; 2 doubles the outcomes of every kernel
+/// (Table 1) for one more channel. 1 = plain `sm`; 4 fills the RGBA32F texel.
+pub const DEFAULT_N: f64 = 2.0;
+/// PCF taps. 9 (3x3) is the paper's recommended pairing with a 2-SM (PCF(9,2) vs PCF(16,1)).
+pub const DEFAULT_K: f64 = 9.0;
+/// `select` choices, in the order of [`Select::from_index`].
+pub const SELECT_CHOICES: &[&str] = &["minmax", "sort"];
+
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef {
+        key: "res",
+        default: sm::DEFAULT_RES,
+        min: 16.0,
+        max: 16384.0,
+        integer: true,
+        doc: "shadow map side (texels)",
+        source: "seed 003 section 5: 512^2 maps",
+        choices: &[],
+    },
+    ParamDef {
+        key: "n",
+        default: DEFAULT_N,
+        min: 1.0,
+        max: MAX_DEPTHS as f64,
+        integer: true,
+        doc: "depths per texel (1 = sm); the n-shadow test gives n+1 levels per tap",
+        source: "seed 003 sections 4.2-4.4 (2-SM, 3-SM; 4 fill one RGBA32F texel)",
+        choices: &[],
+    },
+    ParamDef {
+        key: "k",
+        default: DEFAULT_K,
+        min: 1.0,
+        max: 25.0,
+        integer: true,
+        doc: "PCF taps, one of 1, 4, 9, 16, 25 (sqrt(k) x sqrt(k) grid one texel apart, centred on the sample)",
+        source: "seed 003 Table 1, Figures 6-7 (PCF 2x2, 3x3, 4x4)",
+        choices: &[],
+    },
+    ParamDef {
+        key: "select",
+        default: 0.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "how the extra depths are chosen: minmax (region extremes, O(q)) or sort (medians of n groups, O(q log q))",
+        source: "seed 003 section 4.3; section 5 uses min and max",
+        choices: SELECT_CHOICES,
+    },
+    ParamDef {
+        key: "q",
+        default: DEFAULT_Q as f64,
+        min: 9.0,
+        max: 81.0,
+        integer: true,
+        doc: "search region samples, one of 9, 25, 49, 81 (centred square); larger: wider soft zone, more selection cost",
+        source: "seed 003 section 6 cost example implies q = 9 (f > 1.28 x 512^2 with r = 7)",
+        choices: &[],
+    },
+    ParamDef {
+        key: "bias",
+        default: sm::DEFAULT_BIAS,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "constant depth bias, texels; low: acne, high: peter-panning",
+        source: "sm's default (shadowlab sweep 2026-11-22)",
+        choices: &[],
+    },
+    ParamDef {
+        key: "slope_bias",
+        default: sm::DEFAULT_SLOPE_BIAS,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope",
+        source: "sm's default",
+        choices: &[],
+    },
+    ParamDef {
+        key: "normal_offset",
+        default: sm::DEFAULT_NORMAL_OFFSET,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows",
+        source: "sm's default (Holbert 2011)",
+        choices: &[],
+    },
+    ParamDef {
+        key: "max_slope",
+        default: 4.0,
+        min: 0.0,
+        max: 1000.0,
+        integer: false,
+        doc: "clamp on tan(angle to light) for the slope, kernel and region bias",
+        source: "sm's default",
+        choices: &[],
+    },
+    ParamDef {
+        key: "region_bias",
+        default: 1.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "add (sqrt(q)-1)/2 x tan texels of bias for the search region (n > 1); false: sloped lit surfaces self-shadow by up to 1/n",
+        source: "receiver-plane bias (Isidoro 2006) extended to the search region; shadowlab measurement (docs/bench/mdsm.md)",
+        choices: BOOL,
+    },
+];
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "mdsm",
+    summary: "multiple-depth shadow map: n sorted depths per texel (RGBA32F) from a q-sample region, PCF(k,n) with the n-shadow test",
+    cost: "sm's depth pass + a selection pass of q fetches per texel + k fetches per pixel",
+    quality: "up to nk+1 shadow levels from k fetches; soft zone about sqrt(q) texels wider than the kernel",
+    source: "Pagot, Comba, Oliveira 2004 (seed 003)",
+    lights: &["directional", "spot"],
+    params: PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(MultiDepthMap::new(gpu, scene, p, light)?)),
+};
+
+/// WGSL `MdsmParams` (select.wgsl and eval.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct MdsmParams {
+    pub light_view_proj: [[f32; 4]; 4],
+    /// texel world size, perspective flag, resolution, PCF grid width sqrt(k)
+    pub texel: [f32; 4],
+    /// constant bias, slope bias, normal offset (texels), max slope
+    pub bias: [f32; 4],
+    /// n, search width sqrt(q) (1 when n = 1), select index, region bias flag
+    pub sel: [u32; 4],
+}
+
+pub struct MultiDepthMap {
+    res: u32,
+    k: u32,
+    n: u32,
+    params: MdsmParams,
+    base: wgpu::Texture,
+    nsm: wgpu::Texture,
+    counts: wgpu::Buffer,
+    uniform: wgpu::Buffer,
+    depth_pipeline: wgpu::RenderPipeline,
+    depth_group: wgpu::BindGroup,
+    select_pipeline: wgpu::ComputePipeline,
+    select_group: wgpu::BindGroup,
+    eval_pipeline: wgpu::ComputePipeline,
+    eval_layout: wgpu::BindGroupLayout,
+}
+
+impl MultiDepthMap {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<MultiDepthMap, GpuError> {
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "shadow map")?;
+        let (k, n, q) = (p.get_u32("k"), p.get_u32("n"), p.get_u32("q"));
+        let kw = pcf_width(k).ok_or_else(|| GpuError::Invalid(format!("mdsm: k={k} is not one of {PCF_TAPS:?} (square PCF grids)")))?;
+        let qw = search_width(q)
+            .ok_or_else(|| GpuError::Invalid(format!("mdsm: q={q} is not one of {SEARCH_SIZES:?} (centred square regions)")))?;
+        if !(1..=MAX_DEPTHS as u32).contains(&n) {
+            return Err(GpuError::Invalid(format!("mdsm: n={n} must be 1 to {MAX_DEPTHS}")));
+        }
+        let strategy = p.get_u32("select");
+        Select::from_index(strategy).ok_or_else(|| GpuError::Invalid(format!("mdsm: select index {strategy} unknown")))?;
+        let lp =
+            lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("mdsm does not support point lights".into()))?;
+        let bias = [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32];
+        let region = if n > 1 { qw } else { 1 };
+        let params = MdsmParams {
+            light_view_proj: lp.view_proj.to_cols_array_2d(),
+            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, kw as f32],
+            bias,
+            sel: [n, region, strategy, (p.get_bool("region_bias") && n > 1) as u32],
+        };
+        // the depth pass reads only light_view_proj; the rest mirrors what sm would hold
+        let sm_params = SmParams { light_view_proj: params.light_view_proj, texel: params.texel, bias };
+        let d = &gpu.device;
+        let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: usage | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let base = texture("mdsm.base", raster::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let nsm = texture("mdsm.nsm", wgpu::TextureFormat::Rgba32Float, wgpu::TextureUsages::STORAGE_BINDING);
+
+        let depth_uniform = gpu.uniform("mdsm.depth_params", &sm_params);
+        let depth_layout = binding::layout(d, "mdsm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
+        let depth_group = binding::group(d, "mdsm.depth", &depth_layout, &[depth_uniform.as_entire_binding()]);
+        let depth_pipeline = raster::scene_pipeline(gpu, "mdsm.depth", &sm_depth_wgsl()?, &[&depth_layout, &scene.layout], &[]);
+
+        let uniform = gpu.uniform("mdsm.params", &params);
+        let storage_out = wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: wgpu::TextureFormat::Rgba32Float,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        };
+        let select_layout =
+            binding::layout(d, "mdsm.select", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::texture_depth(), storage_out]);
+        let (base_view, nsm_view) = (base.create_view(&Default::default()), nsm.create_view(&Default::default()));
+        let select_group = binding::group(
+            d,
+            "mdsm.select",
+            &select_layout,
+            &[uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&base_view), wgpu::BindingResource::TextureView(&nsm_view)],
+        );
+        let select_pipeline = gpu.compute_pipeline("mdsm.select", &compose(SELECT_WGSL, false), "main", &[&select_layout]);
+        let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
+        let eval_pipeline = gpu.compute_pipeline("mdsm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let counts = gpu.storage("mdsm.counts", res as u64 * res as u64 * 4);
+        Ok(MultiDepthMap {
+            res,
+            k,
+            n,
+            params,
+            base,
+            nsm,
+            counts,
+            uniform,
+            depth_pipeline,
+            depth_group,
+            select_pipeline,
+            select_group,
+            eval_pipeline,
+            eval_layout,
+        })
+    }
+
+    /// The uniform as uploaded (projection, bias, selection settings).
+    pub fn params(&self) -> &MdsmParams {
+        &self.params
+    }
+
+    /// Reads back the base depth map (row-major, `res x res`).
+    pub fn read_base(&self, gpu: &Gpu) -> Vec<f32> {
+        bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.base, 4))
+    }
+
+    /// Reads back the n-SM: per texel Z1 >= ... >= Zn, unused channels repeating Zn.
+    pub fn read_selected(&self, gpu: &Gpu) -> Vec<[f32; 4]> {
+        bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.nsm, 16))
+    }
+}
+
+impl Technique for MultiDepthMap {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let base_view = self.base.create_view(&Default::default());
+        timer.stage(gpu, "mdsm.render", |enc| {
+            let mut pass = raster::begin_pass(enc, "mdsm.render", &[], &base_view);
+            pass.set_pipeline(&self.depth_pipeline);
+            pass.set_bind_group(0, &self.depth_group, &[]);
+            pass.set_bind_group(1, &f.scene.group, &[]);
+            pass.draw(0..f.scene.triangle_count * 3, 0..1);
+        });
+        timer.stage(gpu, "mdsm.select", |enc| {
+            gpu.dispatch_2d(enc, "mdsm.select", &self.select_pipeline, &[&self.select_group], self.res, self.res)
+        });
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let nsm_view = self.nsm.create_view(&Default::default());
+        let group = f.view_group(
+            gpu,
+            "mdsm.eval",
+            &self.eval_layout,
+            &[self.uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&nsm_view), self.counts.as_entire_binding()],
+        );
+        timer.stage(gpu, "mdsm.evaluate", |enc| {
+            enc.clear_buffer(&self.counts, 0, None);
+            gpu.dispatch_2d(enc, "mdsm.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let texels = (self.res * self.res) as usize;
+        let counts: Vec<u32> = gpu.read_buffer_as(&self.counts, texels);
+        let depth = self.read_base(gpu);
+        // base Depth32Float map + the RGBA32F n-SM
+        let bytes = texels as u64 * (4 + 16);
+        let mut r = TechniqueReport { shadow_data_bytes: bytes, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+        let region = self.params.sel[1];
+        r.counters.insert("fetches_per_pixel".into(), self.k as f64);
+        r.counters.insert("select_fetches_per_texel".into(), (region * region) as f64);
+        r.counters.insert("max_distinct_values".into(), max_distinct(self.k, self.n) as f64);
+        r.counters.insert("shadow_map_texels".into(), texels as f64);
+        r.images.push(depth_image("base shadow map (depth)", self.res, &depth));
+        r.images.push(count_image("view samples per texel", self.res, &counts));
+        r
+    }
+}
