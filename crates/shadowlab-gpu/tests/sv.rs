@@ -41,3 +41,99 @@ fn sv_agrees_with_rt_on_every_opaque_builtin_scene_and_light() {
         }
     }
 }
+
+/// The GPU's silhouette and side counts equal the CPU's from the same edge list and facings
+/// (shadowlab-core `edges`), for a directional, a spot and a point light.
+#[test]
+fn sv_silhouette_counts_match_the_cpu_edge_list() {
+    use shadowlab_core::edges::{facing, EdgeList};
+    let Some(gpu) = gpu() else { return };
+    for (name, li) in [("courtyard", 0), ("room", 0), ("room", 1)] {
+        let scene = builtin(name).unwrap();
+        let lab = Lab::new(&gpu, &scene).unwrap();
+        let v = view(&lab, &scene, li, 64);
+        let sv = lab.run(&v, &TechniqueSpec::parse("sv").unwrap(), 1).unwrap();
+        let pos: Vec<[f32; 3]> = scene.vertices.iter().map(|v| v.pos).collect();
+        let list = EdgeList::build(&pos);
+        let f: Vec<i32> = (0..scene.triangle_count()).map(|t| facing(scene.triangle(t), &scene.lights[li])).collect();
+        let m: Vec<i32> = list.edges.iter().map(|e| list.multiplicity(e, &f)).collect();
+        let sil = m.iter().filter(|m| **m != 0).count() as f64;
+        let records: i32 = m.iter().map(|m| m.abs()).sum();
+        let c = &sv.report.counters;
+        assert_eq!(c["edges"], list.edges.len() as f64, "{name}");
+        assert_eq!(c["silhouette_edges"], sil, "{name} light {li}");
+        assert_eq!(c["side_records"], records as f64, "{name} light {li}");
+        let per_record = if li == 0 && name == "courtyard" { 1.0 } else { 2.0 };
+        assert_eq!(c["side_triangles"], records as f64 * per_record, "{name} light {li}: indirect vertex count");
+        let casting = f.iter().filter(|f| **f != 0).count() as f64;
+        assert_eq!(c["cap_triangles"], casting * per_record, "{name} light {li}");
+        assert!(sil > 0.0 && sil < list.edges.len() as f64);
+    }
+}
+
+/// On foliage `sv` casts the alpha-masked leaves as solid: it matches the CPU reference on a copy
+/// of the scene whose cut-outs are solid, and where it differs from `rt` the shadow ray crosses a
+/// cut-out texel (rt lit, solid reference shadowed).
+#[test]
+fn sv_casts_cutouts_as_solid_on_foliage() {
+    use shadowlab_core::bvh::{cpu_visibility, Bvh};
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("foliage").unwrap();
+    assert!(scene.has_cutouts());
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let sv = lab.run(&v, &TechniqueSpec::parse("sv").unwrap(), 1).unwrap();
+    let mut solid = scene.clone();
+    for m in &mut solid.materials {
+        m.alpha_cutoff = None;
+    }
+    let bvh = Bvh::build(&solid).unwrap();
+    let solid_ref = cpu_visibility(&bvh, &solid, &scene.lights[0], &v.position, &v.normal, &v.mask, lab.gscene.eps);
+    let a = agreement(&sv.visibility, &solid_ref, &v.mask);
+    assert!(a >= 99.9, "sv agrees with the solid-cut-out reference on {a:.4}%");
+    let m = compare(&sv.visibility, &rt.visibility, &v.mask);
+    eprintln!("foliage: sv vs rt {:.3}% wrong ({:.3}% false shadow); vs solid reference {a:.4}% agree", m.wrong_pct, m.false_shadow_pct);
+    assert!(m.false_shadow_pct > 0.5, "the leaves' holes should make sv darker than rt");
+    // every sv/rt difference is a cut-out difference (up to the 0.1% the agreement allows)
+    let (mut diff, mut explained) = (0, 0);
+    for i in 0..v.mask.len() {
+        if v.mask[i] != 0 && (sv.visibility[i] >= 0.5) != (rt.visibility[i] >= 0.5) {
+            diff += 1;
+            explained += ((rt.visibility[i] >= 0.5) && solid_ref[i] < 0.5) as u32;
+        }
+    }
+    assert!(explained as f64 >= 0.98 * diff as f64, "{explained} of {diff} differences explained by cut-outs");
+    let masked = scene.vertices.chunks_exact(3).filter(|t| scene.materials[t[0].material as usize].alpha_cutoff.is_some()).count();
+    assert_eq!(sv.report.counters["cutout_triangles"], masked as f64);
+    assert!(masked > 0);
+}
+
+/// Finite extrusion (far = 1.5 scene diagonals, inside the camera's far plane on planebox) gives
+/// the same shadows as infinite extrusion; a receiver depth offset of a few ulps changes nothing.
+#[test]
+fn sv_finite_extrusion_and_depth_offset_agree_with_rt() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    for spec in ["sv:far=1.5", "sv:depth_offset=8"] {
+        let sv = lab.run(&v, &TechniqueSpec::parse(spec).unwrap(), 1).unwrap();
+        let a = agreement(&sv.visibility, &rt.visibility, &v.mask);
+        assert!(a >= 99.9, "{spec}: {a:.4}%");
+    }
+    let sv = lab.run(&v, &TechniqueSpec::parse("sv:far=1.5").unwrap(), 1).unwrap();
+    assert_eq!(sv.report.counters["extrusion_infinite"], 0.0);
+    assert!(sv.report.shadow_data_bytes > 256 * 256 * 5);
+}
+
+#[test]
+fn sv_rejects_a_too_short_extrusion() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 32);
+    let err = lab.run(&v, &TechniqueSpec::parse("sv:far=0.5").unwrap(), 1).err().expect("far=0.5 must be rejected");
+    assert!(err.to_string().contains("far=0.5"), "{err}");
+}
