@@ -97,10 +97,10 @@ fn sv_casts_cutouts_as_solid_on_foliage() {
     assert!(m.false_shadow_pct > 0.5, "the leaves' holes should make sv darker than rt");
     // every sv/rt difference is a cut-out difference (up to the 0.1% the agreement allows)
     let (mut diff, mut explained) = (0, 0);
-    for i in 0..v.mask.len() {
+    for (i, s) in solid_ref.iter().enumerate() {
         if v.mask[i] != 0 && (sv.visibility[i] >= 0.5) != (rt.visibility[i] >= 0.5) {
             diff += 1;
-            explained += ((rt.visibility[i] >= 0.5) && solid_ref[i] < 0.5) as u32;
+            explained += ((rt.visibility[i] >= 0.5) && *s < 0.5) as u32;
         }
     }
     assert!(explained as f64 >= 0.98 * diff as f64, "{explained} of {diff} differences explained by cut-outs");

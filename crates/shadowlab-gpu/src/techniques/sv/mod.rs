@@ -129,7 +129,7 @@ impl ShadowVolumes {
             counts: [scene.triangle_count, list.edges.len() as u32, vps, p.get_u32("depth_offset")],
             extrude: [if infinite { 0.0 } else { (far * scene.bounds.diagonal() as f64) as f32 }, 0.0, 0.0, 0.0],
         };
-        let max = gpu.limits.max_storage_buffer_binding_size as u64;
+        let max = gpu.limits.max_storage_buffer_binding_size;
         if list.bytes() > max || list.adj.len() as u64 * 4 > max {
             return Err(GpuError::Invalid(format!("sv: edge list of {} bytes is over this device's storage binding limit", list.bytes())));
         }
@@ -304,7 +304,6 @@ impl Technique for ShadowVolumes {
         c("cutout_triangles", stats[0] as f64);
         c("extrusion_infinite", self.infinite as u32 as f64);
         c("depth_offset_ulps", self.params.counts[3] as f64);
-        let _ = vps;
         r
     }
 }
