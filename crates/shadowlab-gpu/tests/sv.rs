@@ -137,3 +137,35 @@ fn sv_rejects_a_too_short_extrusion() {
     let err = lab.run(&v, &TechniqueSpec::parse("sv:far=0.5").unwrap(), 1).err().expect("far=0.5 must be rejected");
     assert!(err.to_string().contains("far=0.5"), "{err}");
 }
+
+/// z-fail is robust to the camera standing inside a shadow volume (where z-pass counting would
+/// be off by one everywhere): planebox with the camera in the box's shadow, for the directional
+/// light and for a point light.
+#[test]
+fn sv_agrees_with_rt_with_the_camera_inside_a_shadow_volume() {
+    use glam::Vec3;
+    use shadowlab_core::camera::Camera;
+    use shadowlab_core::light::Light;
+    let Some(gpu) = gpu() else { return };
+    let mut scene = builtin("planebox").unwrap();
+    let inside_box = Vec3::new(0.3, 0.8, 0.3);
+    let lp = Vec3::new(-2.0, 3.0, -1.2);
+    scene.lights = vec![Light::Directional { direction: Vec3::new(0.5, -1.0, 0.3) }, Light::Point { position: lp }];
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    for (li, eye) in [(0, inside_box + 0.5 * Vec3::new(0.5, -1.0, 0.3)), (1, inside_box + 0.15 * (inside_box - lp))] {
+        assert!(eye.x > 0.5, "the eye must be outside the box");
+        let ray = shadowlab_core::bvh::shadow_ray(&scene.lights[li], eye, Vec3::Y, 0.0);
+        assert!(shadowlab_core::bvh::occluded(&lab.bvh, &scene, &ray), "light {li}: the eye must be in shadow");
+        let cam = Camera::new(eye, Vec3::new(3.0, 0.0, 1.5), 70.0, 0.02, 50.0);
+        let v = lab.view(&cam, &cam, &scene.lights[li], 256, 256).unwrap();
+        let rt = lab.reference(&v, 1).unwrap();
+        let sv = lab.run(&v, &TechniqueSpec::parse("sv").unwrap(), 1).unwrap();
+        let lit = rt.visibility.iter().zip(&v.mask).filter(|(x, m)| **m != 0 && **x > 0.5).count();
+        let evaluated = v.mask.iter().filter(|m| **m != 0).count();
+        assert!(lit > 1000 && lit + 1000 < evaluated, "light {li}: need both light and shadow in view ({lit} of {evaluated} lit)");
+        let a = agreement(&sv.visibility, &rt.visibility, &v.mask);
+        if a < 99.9 {
+            panic!("light {li}: camera in shadow: sv agrees with rt on {a:.4}%; {}", save_images(&format!("sv-inside-{li}"), &v, &sv, &rt));
+        }
+    }
+}
