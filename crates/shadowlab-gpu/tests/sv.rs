@@ -169,3 +169,47 @@ fn sv_agrees_with_rt_with_the_camera_inside_a_shadow_volume() {
         }
     }
 }
+
+/// Non-manifold and open geometry on the GPU: three blades sharing one edge (multiplicity up to
+/// 3), a single-sided open quad wound away from the light, a closed box, over a floor.
+#[test]
+fn sv_agrees_with_rt_on_a_fin_and_open_surfaces() {
+    use glam::{Vec2, Vec3};
+    use shadowlab_core::builtin::MeshBuilder;
+    use shadowlab_core::camera::Camera;
+    use shadowlab_core::light::Light;
+    use shadowlab_core::scene::Material;
+    let Some(gpu) = gpu() else { return };
+    let mut b = MeshBuilder::default();
+    let m = b.material(Material::solid("grey", [0.7, 0.7, 0.7]));
+    b.quad(Vec3::new(-6.0, 0.0, 6.0), Vec3::new(12.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -12.0), Vec2::ONE, m);
+    let (a, e) = (Vec3::new(-1.0, 1.5, 0.0), Vec3::new(1.0, 1.5, 0.0));
+    let uv = [Vec2::ZERO; 3];
+    b.tri([a, e, Vec3::new(0.0, 2.5, 0.0)], uv, m);
+    b.tri([e, a, Vec3::new(0.0, 2.2, 0.8)], uv, m);
+    b.tri([a, e, Vec3::new(0.0, 1.0, -0.9)], uv, m);
+    // open quad, wound so its normal points down (away from the lights above)
+    b.quad(Vec3::new(2.0, 1.2, -1.0), Vec3::new(0.0, 0.0, 1.5), Vec3::new(1.5, 0.0, 0.0), Vec2::ONE, m);
+    b.cuboid(Vec3::new(-3.0, 0.0, -2.0), Vec3::new(-2.2, 0.8, -1.2), m);
+    let cam = Camera::new(Vec3::new(2.0, 9.0, 9.0), Vec3::new(0.5, 0.0, 0.5), 55.0, 0.1, 60.0);
+    let lights = vec![
+        Light::Directional { direction: Vec3::new(0.3, -1.0, 0.2) },
+        Light::Point { position: Vec3::new(-1.0, 5.0, -1.5) },
+        Light::Spot { position: Vec3::new(1.0, 6.0, 2.0), direction: Vec3::new(-0.1, -1.0, -0.3), cone_deg: 50.0 },
+    ];
+    let scene = b.finish("fin", cam, lights, vec![]);
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    for li in 0..scene.lights.len() {
+        let v = view(&lab, &scene, li, 256);
+        let rt = lab.reference(&v, 1).unwrap();
+        let sv = lab.run(&v, &TechniqueSpec::parse("sv").unwrap(), 1).unwrap();
+        let c = &sv.report.counters;
+        assert_eq!((c["edges_nonmanifold"], c["edges_open"] > 0.0), (1.0, true));
+        let lit = rt.visibility.iter().zip(&v.mask).filter(|(x, m)| **m != 0 && **x > 0.5).count();
+        assert!(lit > 0 && (lit as u64) < compare(&sv.visibility, &rt.visibility, &v.mask).evaluated_pixels);
+        let a = agreement(&sv.visibility, &rt.visibility, &v.mask);
+        if a < 99.9 {
+            panic!("fin light {li}: sv agrees with rt on {a:.4}%; {}", save_images(&format!("sv-fin-{li}"), &v, &sv, &rt));
+        }
+    }
+}
