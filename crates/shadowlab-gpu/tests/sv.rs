@@ -68,6 +68,10 @@ fn sv_silhouette_counts_match_the_cpu_edge_list() {
         let casting = f.iter().filter(|f| **f != 0).count() as f64;
         assert_eq!(c["cap_triangles"], casting * per_record, "{name} light {li}");
         assert!(sil > 0.0 && sil < list.edges.len() as f64);
+        // every pixel with geometry is covered at least by its own triangle's light cap
+        let covered = v.position.iter().filter(|p| p[3] > 0.0).count() as f64;
+        let fill = c["volume_fragments_per_pixel"] * (64 * 64) as f64;
+        assert!(fill >= 0.99 * covered && fill > 0.0, "{name} light {li}: {fill} volume fragments, {covered} covered pixels");
     }
 }
 

@@ -107,6 +107,8 @@ pub struct ShadowVolumes {
     depth_format: wgpu::TextureFormat,
     infinite: bool,
     targets: Option<Targets>,
+    /// The last frame's volume and scene bind groups and vertex count, for the fill count.
+    last: Option<(wgpu::BindGroup, wgpu::BindGroup, u32)>,
 }
 
 impl ShadowVolumes {
@@ -145,7 +147,22 @@ impl ShadowVolumes {
         let stats = gpu.storage("sv.stats", 16);
         let p = Pipelines::new(gpu, &scene.layout, depth_format, unclipped);
         let uniform = gpu.uniform("sv.params", &params);
-        Ok(ShadowVolumes { params, uniform, list, edges, adj, facing, sides, draw, stats, p, depth_format, infinite, targets: None })
+        Ok(ShadowVolumes {
+            params,
+            uniform,
+            list,
+            edges,
+            adj,
+            facing,
+            sides,
+            draw,
+            stats,
+            p,
+            depth_format,
+            infinite,
+            targets: None,
+            last: None,
+        })
     }
 
     fn targets(&mut self, gpu: &Gpu, w: u32, h: u32) -> &Targets {
@@ -167,6 +184,48 @@ impl ShadowVolumes {
             self.targets = Some(Targets { width: w, height: h, depth, lit });
         }
         self.targets.as_ref().unwrap()
+    }
+}
+
+impl ShadowVolumes {
+    /// Fragments the last frame's volume geometry rasterises (sides and caps, every sample
+    /// counted whatever its depth): an occlusion query over the same draws with the tests off.
+    fn fill_fragments(&self, gpu: &Gpu) -> Option<u64> {
+        let (vol_group, scene_group, verts) = self.last.as_ref()?;
+        let t = self.targets.as_ref()?;
+        let set =
+            gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("sv.fill"), ty: wgpu::QueryType::Occlusion, count: 1 });
+        let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sv.fill"),
+            size: 8,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let ds = t.depth.create_view(&Default::default());
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("sv.fill"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: &ds, depth_ops: None, stencil_ops: None }),
+                timestamp_writes: None,
+                occlusion_query_set: Some(&set),
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, vol_group, &[]);
+            pass.set_bind_group(1, scene_group, &[]);
+            pass.begin_occlusion_query(0);
+            pass.set_pipeline(&self.p.fill[0]);
+            pass.draw_indirect(&self.draw, 0);
+            pass.set_pipeline(&self.p.fill[1]);
+            pass.draw(0..*verts, 0..1);
+            pass.set_pipeline(&self.p.fill[2]);
+            pass.draw(0..*verts, 0..1);
+            pass.end_occlusion_query();
+        }
+        enc.resolve_query_set(&set, 0..1, &resolve, 0);
+        gpu.queue.submit([enc.finish()]);
+        Some(gpu.read_buffer_as::<u64>(&resolve, 1)[0])
     }
 }
 
@@ -250,6 +309,7 @@ impl Technique for ShadowVolumes {
             pass.set_pipeline(&self.p.caps_cw);
             pass.draw(0..verts, 0..1);
         });
+        self.last = Some((vol_group, f.scene.group.clone(), verts));
         let eval_group = f.view_group(gpu, "sv.eval", &self.p.eval_layout, &[wgpu::BindingResource::TextureView(&lit)]);
         timer.stage(gpu, "sv.resolve", |enc| {
             {
@@ -306,6 +366,9 @@ impl Technique for ShadowVolumes {
         c("cutout_triangles", stats[0] as f64);
         c("extrusion_infinite", self.infinite as u32 as f64);
         c("depth_offset_ulps", self.params.counts[3] as f64);
+        if let Some(fill) = self.fill_fragments(gpu) {
+            c("volume_fragments_per_pixel", fill as f64 / pixels.max(1) as f64);
+        }
         r
     }
 }

@@ -29,6 +29,9 @@ pub struct Pipelines {
     pub sides: wgpu::RenderPipeline,
     pub caps_ccw: wgpu::RenderPipeline,
     pub caps_cw: wgpu::RenderPipeline,
+    /// The same three draws with every fragment passing and no stencil writes, for counting the
+    /// volumes' fill with an occlusion query (report only).
+    pub fill: [wgpu::RenderPipeline; 3],
     pub resolve_layout: wgpu::BindGroupLayout,
     pub copy_depth: wgpu::RenderPipeline,
     pub lit: wgpu::RenderPipeline,
@@ -119,7 +122,7 @@ impl Pipelines {
             binding::layout(d, "sv.volumes", vf, &[uniform(), uniform(), uniform(), storage(true), storage(true), storage(true)]);
         let vol_module = gpu.shader("sv.volumes", &compose(VOLUME_WGSL, true));
         let vol_pl = gpu.pipeline_layout("sv.volumes", &[&vol_layout, scene_layout]);
-        let volume = |label, vs, front_face| {
+        let volume = |label, vs, front_face, count_only: bool| {
             raster(
                 gpu,
                 depth_format,
@@ -132,15 +135,20 @@ impl Pipelines {
                     front_face,
                     unclipped,
                     depth_write: false,
-                    depth_compare: C::Less,
-                    stencil: zfail_stencil(),
+                    depth_compare: if count_only { C::Always } else { C::Less },
+                    stencil: if count_only { wgpu::StencilState::default() } else { zfail_stencil() },
                     color: None,
                 },
             )
         };
-        let sides = volume("sv.sides", "vs_sides", wgpu::FrontFace::Ccw);
-        let caps_ccw = volume("sv.caps_ccw", "vs_caps_ccw", wgpu::FrontFace::Ccw);
-        let caps_cw = volume("sv.caps_cw", "vs_caps_cw", wgpu::FrontFace::Cw);
+        let sides = volume("sv.sides", "vs_sides", wgpu::FrontFace::Ccw, false);
+        let caps_ccw = volume("sv.caps_ccw", "vs_caps_ccw", wgpu::FrontFace::Ccw, false);
+        let caps_cw = volume("sv.caps_cw", "vs_caps_cw", wgpu::FrontFace::Cw, false);
+        let fill = [
+            volume("sv.fill_sides", "vs_sides", wgpu::FrontFace::Ccw, true),
+            volume("sv.fill_caps_ccw", "vs_caps_ccw", wgpu::FrontFace::Ccw, true),
+            volume("sv.fill_caps_cw", "vs_caps_cw", wgpu::FrontFace::Cw, true),
+        ];
 
         let resolve_layout = binding::layout(d, "sv.resolve", vf, &[texture_depth(), uniform()]);
         let res_module = gpu.shader("sv.resolve", &compose(RESOLVE_WGSL, false));
@@ -169,7 +177,21 @@ impl Pipelines {
 
         let eval_layout = view_layout(gpu, "sv.eval", &[texture_float()]);
         let eval = gpu.compute_pipeline("sv.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
-        Pipelines { sil_layout, facing, edges, vol_layout, sides, caps_ccw, caps_cw, resolve_layout, copy_depth, lit, eval_layout, eval }
+        Pipelines {
+            sil_layout,
+            facing,
+            edges,
+            vol_layout,
+            sides,
+            caps_ccw,
+            caps_cw,
+            fill,
+            resolve_layout,
+            copy_depth,
+            lit,
+            eval_layout,
+            eval,
+        }
     }
 
     /// The scene's vertex positions (xyz) read back for the edge list.
