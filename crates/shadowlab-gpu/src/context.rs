@@ -42,7 +42,9 @@ impl Gpu {
         let gpu_timestamps = has_ts && crate::timing::want_timestamps(&info)?;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("shadowlab"),
-            required_features: if has_ts { ts } else { wgpu::Features::empty() },
+            // sv: unclipped depth (infinite extrusion) and a float depth-stencil target, where offered
+            required_features: (if has_ts { ts } else { wgpu::Features::empty() })
+                | (adapter.features() & (wgpu::Features::DEPTH_CLIP_CONTROL | wgpu::Features::DEPTH32FLOAT_STENCIL8)),
             required_limits: limits.clone(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,

@@ -147,3 +147,18 @@ fn mdsm_params_layout_matches_wgsl() {
         );
     }
 }
+
+#[test]
+fn sv_struct_layouts_match_rust() {
+    use shadowlab_core::edges::Edge;
+    use shadowlab_gpu::techniques::sv::SvParams;
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    for f in ["sv/silhouette.wgsl", "sv/volume.wgsl", "sv/resolve.wgsl"] {
+        check(&get(f), "SvParams", size_of::<SvParams>(), &[("counts", 0), ("extrude", offset_of!(SvParams, extrude))]);
+    }
+    for f in ["sv/silhouette.wgsl", "sv/volume.wgsl"] {
+        let offsets = [("a", 0), ("b", offset_of!(Edge, b)), ("first", offset_of!(Edge, first)), ("count", offset_of!(Edge, count))];
+        check(&get(f), "Edge", size_of::<Edge>(), &offsets);
+    }
+}

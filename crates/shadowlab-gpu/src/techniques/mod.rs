@@ -3,6 +3,7 @@
 
 pub mod mdsm;
 pub mod sm;
+pub mod sv;
 
 use std::collections::BTreeMap;
 
@@ -131,13 +132,14 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &mdsm::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &mdsm::INFO, &sv::INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
     let mut v = Vec::new();
     v.extend(sm::shaders());
     v.extend(mdsm::shaders());
+    v.extend(sv::shaders());
     v
 }
 
