@@ -41,7 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     if let Some(s) = &setup {
-        scene.camera = s.camera.unwrap_or(scene.camera);
+        scene.camera = s.camera.as_ref().map(|c| c.camera()).unwrap_or(scene.camera);
         if !s.lights.is_empty() {
             scene.lights = s.lights.clone();
         }

@@ -28,6 +28,8 @@ fn run_direct(gpu: &Gpu, lab: &Lab, v: &View, args: &str) -> (MultiDepthMap, Vec
         scene: &lab.gscene,
         gbuffer: &v.gbuffer,
         light: v.light,
+        camera: v.camera,
+        prev_camera: v.prev_camera,
         light_buf: &v.light_buf,
         frame: &v.frame,
         visibility: &v.visibility,
