@@ -3,6 +3,7 @@
 //! parameters, and the CPU halves of techniques.
 
 pub mod builtin;
+pub mod cascades;
 pub mod bvh;
 pub mod camera;
 pub mod light;
