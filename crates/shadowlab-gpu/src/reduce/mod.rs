@@ -9,6 +9,8 @@ use bytemuck::{Pod, Zeroable};
 use crate::{binding, Gpu};
 
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
+/// Pixels per thread side (`PER_THREAD` in reduce.wgsl).
+const PER_THREAD: u32 = 4;
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![("reduce/reduce.wgsl", REDUCE_WGSL.to_string())]
@@ -55,7 +57,7 @@ impl MinMax {
             &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), mask.as_entire_binding(), self.result.as_entire_binding()],
         );
         enc.clear_buffer(&self.result, 0, None);
-        gpu.dispatch_2d(enc, label, &self.pipeline, &[&group], src.width(), src.height());
+        gpu.dispatch_2d(enc, label, &self.pipeline, &[&group], src.width().div_ceil(PER_THREAD), src.height().div_ceil(PER_THREAD));
     }
 
     /// Reads the result back (blocking: a device sync).

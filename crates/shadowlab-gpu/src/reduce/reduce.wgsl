@@ -1,6 +1,7 @@
 // Min and max of one channel of a float texture over the pixels whose mask word is non-zero
-// (e.g. the G-buffer's linear view depth over the evaluated pixels). One thread per pixel, a
-// workgroup tree reduction in shared memory, then two atomics per workgroup on keys that
+// (e.g. the G-buffer's linear view depth over the evaluated pixels). Each thread folds a
+// PER_THREAD x PER_THREAD block of pixels (a workgroup covers 32 x 32), then a workgroup tree
+// reduction in shared memory, then two atomics per workgroup on keys that
 // order like the floats (`order_key`). The min is kept as the complement of its key so that
 // both words start at 0 (`clear_buffer`) and both reduce with atomicMax.
 
@@ -30,16 +31,23 @@ fn order_key(x: f32) -> u32 {
     return b | 0x80000000u;
 }
 
+const PER_THREAD: u32 = 4u;
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let size = textureDimensions(src);
     // neutral elements: ~key = 0 (min) and key = 0 (max)
     var a = 0u;
     var b = 0u;
-    if id.x < size.x && id.y < size.y && mask[id.y * size.x + id.x] != 0u {
-        let k = order_key(textureLoad(src, id.xy, 0)[params.channel]);
-        a = ~k;
-        b = k;
+    for (var dy = 0u; dy < PER_THREAD; dy++) {
+        for (var dx = 0u; dx < PER_THREAD; dx++) {
+            let p = id.xy * PER_THREAD + vec2<u32>(dx, dy);
+            if p.x < size.x && p.y < size.y && mask[p.y * size.x + p.x] != 0u {
+                let k = order_key(textureLoad(src, p, 0)[params.channel]);
+                a = max(a, ~k);
+                b = max(b, k);
+            }
+        }
     }
     lo[li] = a;
     hi[li] = b;
