@@ -2,11 +2,12 @@
 //! distances along the view, one orthographic light box per slice of the view frustum, texel
 //! snapping, and tightening to the depth range the G-buffer actually holds.
 //!
-//! Fitting: each slice gets its **bounding sphere** (not a tight box): the box side (2 x radius)
-//! depends only on the slice's near/far distances and the lens, not on the camera's rotation,
-//! so the texel size stays fixed while the camera turns and snapping the box origin to whole
-//! texels removes shimmering entirely (Valient 2008, "Stable cascaded shadow maps"). A tight
-//! box would use up to ~30 % fewer texels per slice but changes size with every rotation.
+//! Fitting ([`Fit`]): each slice gets its **bounding sphere** or its tight light-space bounding
+//! square. With the sphere the box side (2 x radius) depends only on the slice's near/far
+//! distances and the lens, not on the camera's rotation, so the texel size stays fixed while
+//! the camera turns and snapping the box origin to whole texels removes shimmering entirely
+//! (Valient 2008, "Stable cascaded shadow maps"). The tight square has smaller texels but
+//! changes size as the camera turns.
 //!
 //! The light view is fixed in world space (origin at the world origin, looking along the
 //! light), so a texel grid in light space is a grid fixed in the world. Depth is orthographic
@@ -168,20 +169,48 @@ pub struct CascadeBox {
     pub d1: f32,
 }
 
-/// Fits the light box of the slice `[d0, d1]`: bounding sphere plus one texel of margin (so
-/// that snapping, which moves the box by at most half a texel, keeps the sphere inside); x/y
-/// centre snapped to whole texels when `snap`; depth from the scene's nearest point to the
-/// light (every caster) to the far side of the sphere (clamped to the scene).
-pub fn fit_cascade(frustum: &ViewFrustum, dir: Vec3, scene: &Bounds, d0: f32, d1: f32, res: u32, snap: bool) -> CascadeBox {
+/// How a slice is enclosed in light space.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fit {
+    /// Bounding sphere: the box side depends only on the slice and the lens, so it is the same
+    /// in every frame and snapping removes all shimmer. Wastes area (up to ~2x the box's).
+    Sphere,
+    /// Light-space bounding square of the slice's corners: smaller texels, but the side changes
+    /// as the camera turns (quantized to steps of 2^-10, so it changes in jumps: some shimmer).
+    Box,
+}
+
+/// Fits the light box of the slice `[d0, d1]`: the slice's bounding sphere or light-space
+/// square (`fit`) plus one texel of margin (so that snapping, which moves the box by at most
+/// half a texel, keeps the slice inside); x/y centre snapped to whole texels when `snap`;
+/// depth from the scene's nearest point to the light (every caster) to the far side of the
+/// slice (clamped to the scene).
+#[allow(clippy::too_many_arguments)]
+pub fn fit_cascade(frustum: &ViewFrustum, dir: Vec3, scene: &Bounds, d0: f32, d1: f32, res: u32, snap: bool, fit: Fit) -> CascadeBox {
     let view = light_view(dir);
-    let (center, r) = slice_sphere(&frustum.slice_corners(d0, d1));
+    let corners = frustum.slice_corners(d0, d1);
+    let (center, r, recv_far) = match fit {
+        Fit::Sphere => {
+            let (center, r) = slice_sphere(&corners);
+            let c = (view * center.extend(1.0)).xyz();
+            (Vec2::new(c.x, c.y), r, c.z - r)
+        }
+        Fit::Box => {
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for p in corners {
+                let q = (view * p.extend(1.0)).xyz();
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+            (Vec2::new(lo.x + hi.x, lo.y + hi.y) * 0.5, 0.5 * (hi.x - lo.x).max(hi.y - lo.y), lo.z)
+        }
+    };
     let r = quantize_radius(r);
     let res_f = res as f32;
     // one texel of margin: half = r + texel, texel = 2 half / res
     let half = r * res_f / (res_f - 2.0);
     let texel = 2.0 * half / res_f;
-    let c = (view * center.extend(1.0)).xyz();
-    let mut origin = Vec2::new(c.x, c.y);
+    let mut origin = center;
     if snap {
         origin = Vec2::new(snap_to_texel(origin.x, texel), snap_to_texel(origin.y, texel));
     }
@@ -192,16 +221,16 @@ pub fn fit_cascade(frustum: &ViewFrustum, dir: Vec3, scene: &Bounds, d0: f32, d1
         zhi = zhi.max(z);
     }
     let margin = scene.diagonal().max(1e-6) * 1e-3;
-    let near_z = zhi.max(c.z + r) + margin; // towards the light: every caster
-    let far_z = (c.z - r).max(zlo) - margin; // away from it: the receivers in the sphere
+    let near_z = zhi + margin; // towards the light: every caster in the scene
+    let far_z = recv_far.max(zlo) - margin; // away from it: the receivers of the slice
     let far_z = far_z.min(near_z - margin);
     let proj = orthographic(origin.x - half, origin.x + half, origin.y - half, origin.y + half, -near_z, -far_z);
     CascadeBox { view_proj: proj * view, texel, origin, half, d0, d1 }
 }
 
 /// Every cascade of `splits` (n + 1 distances -> n boxes).
-pub fn fit_cascades(frustum: &ViewFrustum, dir: Vec3, scene: &Bounds, splits: &[f32], res: u32, snap: bool) -> Vec<CascadeBox> {
-    splits.windows(2).map(|w| fit_cascade(frustum, dir, scene, w[0], w[1], res, snap)).collect()
+pub fn fit_cascades(frustum: &ViewFrustum, dir: Vec3, scene: &Bounds, splits: &[f32], res: u32, snap: bool, fit: Fit) -> Vec<CascadeBox> {
+    splits.windows(2).map(|w| fit_cascade(frustum, dir, scene, w[0], w[1], res, snap, fit)).collect()
 }
 
 #[cfg(test)]
@@ -267,15 +296,15 @@ mod tests {
         let cam = Camera::new(Vec3::new(3.0, 1.7, 5.0), Vec3::new(-8.0, 1.0, -20.0), 70.0, 0.1, 120.0);
         let f = frustum(&cam);
         let dir = Vec3::new(0.4, -1.0, 0.3);
-        for snap in [false, true] {
+        for (snap, fit) in [(false, Fit::Sphere), (true, Fit::Sphere), (false, Fit::Box), (true, Fit::Box)] {
             let splits = practical_splits(f.near, f.far, 4, DEFAULT_LAMBDA);
-            let boxes = fit_cascades(&f, dir, &scene, &splits, 512, snap);
+            let boxes = fit_cascades(&f, dir, &scene, &splits, 512, snap, fit);
             for (i, b) in boxes.iter().enumerate() {
                 for p in f.slice_corners(splits[i], splits[i + 1]) {
                     let n = b.view_proj.project_point3(p);
                     // inside, with the margin of at least half a texel left after snapping
                     let lim = 1.0 - 1.0 / 512.0;
-                    assert!(n.x.abs() <= lim && n.y.abs() <= lim, "cascade {i} snap {snap}: {n}");
+                    assert!(n.x.abs() <= lim && n.y.abs() <= lim, "cascade {i} snap {snap} {fit:?}: {n}");
                     // depth: receivers exist only inside the scene, and the box ends there
                     let inside = p.cmpge(scene.min).all() && p.cmple(scene.max).all();
                     assert!(!inside || (0.0..=1.0).contains(&n.z), "cascade {i} snap {snap}: {p} at depth {n}");
@@ -296,12 +325,12 @@ mod tests {
         let scene = Bounds { min: Vec3::splat(-50.0), max: Vec3::splat(50.0) };
         let dir = Vec3::new(0.3, -1.0, 0.5);
         let base = Camera::new(Vec3::new(0.0, 2.0, 0.0), Vec3::new(10.0, 1.0, -10.0), 60.0, 0.1, 60.0);
-        let b0 = fit_cascade(&frustum(&base), dir, &scene, 2.0, 12.0, 1024, true);
+        let b0 = fit_cascade(&frustum(&base), dir, &scene, 2.0, 12.0, 1024, true, Fit::Sphere);
         for k in 1..20 {
             // translate and turn the camera a little
             let off = Vec3::new(0.0137 * k as f32, 0.003 * k as f32, -0.021 * k as f32);
             let cam = Camera { position: base.position + off, target: base.target + off * 1.5, ..base };
-            let b = fit_cascade(&frustum(&cam), dir, &scene, 2.0, 12.0, 1024, true);
+            let b = fit_cascade(&frustum(&cam), dir, &scene, 2.0, 12.0, 1024, true, Fit::Sphere);
             assert_eq!(b.texel, b0.texel, "the sphere keeps the texel size under motion");
             let steps = (b.origin - b0.origin) / b.texel;
             assert!((steps - steps.round()).abs().max_element() < 1e-2, "frame {k}: moved {steps} texels");
@@ -312,7 +341,11 @@ mod tests {
             assert_eq!(snap_to_texel(b.origin.x, b.texel), b.origin.x);
             assert_eq!(snap_to_texel(b.origin.y, b.texel), b.origin.y);
         }
-        let u = fit_cascade(&frustum(&base), dir, &scene, 2.0, 12.0, 1024, false);
+        let u = fit_cascade(&frustum(&base), dir, &scene, 2.0, 12.0, 1024, false, Fit::Sphere);
+        // the box fit is snapped to its own (quantized) texel grid, and smaller than the sphere
+        let bx = fit_cascade(&frustum(&base), dir, &scene, 2.0, 12.0, 1024, true, Fit::Box);
+        let g = bx.origin / bx.texel;
+        assert!((g - g.round()).abs().max_element() < 1e-3 && bx.texel < b0.texel, "{g} {} {}", bx.texel, b0.texel);
         assert!((u.origin - b0.origin).abs().max_element() <= 0.5 * b0.texel + 1e-5);
         assert_eq!(quantize_radius(quantize_radius(3.3)), quantize_radius(3.3));
         assert!(quantize_radius(3.3) >= 3.3 && quantize_radius(3.3) < 3.3 * 1.002);

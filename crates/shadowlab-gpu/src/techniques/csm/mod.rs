@@ -15,7 +15,7 @@ mod report;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
-use shadowlab_core::cascades::{self, CascadeBox, ViewFrustum, MAX_CASCADES};
+use shadowlab_core::cascades::{self, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 
@@ -81,6 +81,7 @@ pub struct Cascaded {
     lambda: f32,
     manual: Vec<f32>,
     snap: bool,
+    fit: Fit,
     tighten: bool,
     pcf: u32,
     dir: Vec3,
@@ -174,6 +175,7 @@ impl Cascaded {
             lambda: p.get("lambda") as f32,
             manual,
             snap: p.get_bool("snap"),
+            fit: if p.get_u32("fit") == 0 { Fit::Sphere } else { Fit::Box },
             tighten: p.get_bool("tighten"),
             pcf: p.get_u32("pcf"),
             dir: direction,
@@ -250,7 +252,7 @@ impl Technique for Cascaded {
         } else {
             cascades::manual_splits(frustum.near, frustum.far, &self.manual).map_err(|e| GpuError::Invalid(format!("csm: {e}")))?
         };
-        self.boxes = cascades::fit_cascades(&frustum, self.dir, &f.scene.bounds, &splits, self.res, self.snap);
+        self.boxes = cascades::fit_cascades(&frustum, self.dir, &f.scene.bounds, &splits, self.res, self.snap, self.fit);
         for (i, b) in self.boxes.iter().enumerate() {
             self.params.cascades[i] = CascadeU { view_proj: b.view_proj.to_cols_array_2d(), info: [b.texel, b.d0, b.d1, 0.0] };
             gpu.queue.write_buffer(&self.depth_uniforms[i], 0, bytemuck::bytes_of(&b.view_proj.to_cols_array_2d()));

@@ -16,6 +16,10 @@ pub const DEFAULT_LAMBDA: f64 = shadowlab_core::cascades::DEFAULT_LAMBDA as f64;
 /// Blend band, as a fraction of each slice's depth range at its far end. Off: with hard
 /// thresholded visibility a band only moves the switch; with PCF it hides the seam.
 pub const DEFAULT_BLEND: f64 = 0.0;
+/// Names of `fit` (index = `shadowlab_core::cascades::Fit` order).
+pub const FITS: &[&str] = &["sphere", "box"];
+/// Sphere: stable under camera rotation (see docs/bench/csm.md for the quality it costs).
+pub const DEFAULT_FIT: f64 = 0.0;
 /// Constant bias and normal offset in texels of the chosen cascade: `sm`'s sweep values (the
 /// same texel-relative trade-off: low = acne, high = peter-panning / shifted shadows).
 pub const DEFAULT_BIAS: f64 = sm::DEFAULT_BIAS;
@@ -103,6 +107,16 @@ pub const PARAMS: &[ParamDef] = &[
         doc: "snap each box origin to whole texels in light space (no shimmering while the camera moves)",
         source: "Valient 2008 (stable CSM); flicker measured in docs/bench/csm.md",
         choices: BOOL,
+    },
+    ParamDef {
+        key: "fit",
+        default: DEFAULT_FIT,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "slice enclosure: sphere (fixed texel size, no shimmer when snapped) or box (tight light-space square: finer texels, size changes as the camera turns)",
+        source: "Valient 2008 (sphere, stable CSM); box: Engel 2006; measured in docs/bench/csm.md",
+        choices: FITS,
     },
     ParamDef {
         key: "tighten",
