@@ -3,9 +3,9 @@
 //! parameters, and the CPU halves of techniques.
 
 pub mod builtin;
-pub mod cascades;
 pub mod bvh;
 pub mod camera;
+pub mod cascades;
 pub mod light;
 pub mod lightspace;
 pub mod loaders;

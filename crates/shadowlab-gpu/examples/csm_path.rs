@@ -3,11 +3,13 @@
 //! flips between consecutive frames while `rt`'s does not), each technique instance kept across
 //! the frames (`Lab::instantiate` + `Lab::step`).
 //!
-//! `cargo run -p shadowlab-gpu --example csm_path -- [scene] [frames] [size] [spec...]`
-//! (defaults: courtyard, 24, 512, and csm with/without snapping and tightening, the box fit, sm).
+//! `cargo run -p shadowlab-gpu --example csm_path -- [scene] [frames] [size] [span] [spec...]`
+//! (defaults: courtyard, 24, 512, span 1, and csm with/without snapping and tightening, the box
+//! fit, sm). `span` < 1 walks only that fraction of the path's first segment: small, sub-texel
+//! steps, where the screen barely changes and shimmering shows alone in the flicker.
 
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::camera::path_cameras;
+use shadowlab_core::camera::{path_cameras, CameraKey};
 use shadowlab_core::metrics::{compare, flicker_pct};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
@@ -30,13 +32,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scene_name = args.first().map(String::as_str).unwrap_or("courtyard");
     let frames: usize = args.get(1).map(|s| s.parse()).transpose()?.unwrap_or(24);
     let size: u32 = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(512);
-    let specs: Vec<String> = if args.len() > 3 { args[3..].to_vec() } else { DEFAULT_SPECS.iter().map(|s| s.to_string()).collect() };
+    let span: f32 = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(1.0);
+    let specs: Vec<String> = if args.len() > 4 { args[4..].to_vec() } else { DEFAULT_SPECS.iter().map(|s| s.to_string()).collect() };
 
     let gpu = Gpu::new()?;
     let scene = builtin(scene_name).ok_or("no such built-in scene")?;
     let lab = Lab::new(&gpu, &scene)?;
     let light = scene.lights[0];
-    let cams = path_cameras(&scene.camera, &scene.camera_path, frames);
+    let keys = match (span < 1.0, scene.camera_path.as_slice()) {
+        (true, [a, b, ..]) => vec![*a, CameraKey { position: a.position.lerp(b.position, span), target: a.target.lerp(b.target, span) }],
+        _ => scene.camera_path.clone(),
+    };
+    let cams = path_cameras(&scene.camera, &keys, frames);
+    let step = if cams.len() > 1 { (cams[1].position - cams[0].position).length() } else { 0.0 };
 
     let mut insts = Vec::new();
     for s in &specs {
@@ -75,7 +83,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
     let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
-    println!("{scene_name}, {frames} frames of its camera path at {size}x{size}, {}", gpu.adapter_summary());
+    println!(
+        "{scene_name}, {frames} frames of its camera path (span {span}, {step:.4} per frame) at {size}x{size}, {}",
+        gpu.adapter_summary()
+    );
     println!("rt itself flips {:.3} % of the pixels per frame pair (mean)\n", mean(&rt_flips));
     println!("| technique | wrong % (mean) | wrong % (max) | flicker % (mean) | flicker % (max) |");
     println!("|---|---:|---:|---:|---:|");

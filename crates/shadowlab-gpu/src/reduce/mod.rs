@@ -54,7 +54,12 @@ impl MinMax {
             &gpu.device,
             label,
             &self.layout,
-            &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), mask.as_entire_binding(), self.result.as_entire_binding()],
+            &[
+                self.params.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view),
+                mask.as_entire_binding(),
+                self.result.as_entire_binding(),
+            ],
         );
         enc.clear_buffer(&self.result, 0, None);
         gpu.dispatch_2d(enc, label, &self.pipeline, &[&group], src.width().div_ceil(PER_THREAD), src.height().div_ceil(PER_THREAD));

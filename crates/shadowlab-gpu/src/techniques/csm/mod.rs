@@ -217,7 +217,8 @@ impl Cascaded {
 impl Technique for Cascaded {
     /// Camera copy + depth reduction on the GPU, one readback, the fit on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let group = binding::group(&gpu.device, "csm.camera", &self.camera_layout, &[f.frame.as_entire_binding(), self.probe.as_entire_binding()]);
+        let group =
+            binding::group(&gpu.device, "csm.camera", &self.camera_layout, &[f.frame.as_entire_binding(), self.probe.as_entire_binding()]);
         timer.stage(gpu, "csm.analyze", |enc| {
             enc.clear_buffer(&self.probe, 0, None);
             {
@@ -282,10 +283,9 @@ impl Technique for Cascaded {
             self.chosen = Some((gpu.storage("csm.chosen", w as u64 * h as u64 * 4), w, h));
         }
         let chosen = &self.chosen.as_ref().expect("allocated above").0;
-        let maps_view = self.maps.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let maps_view = self
+            .maps
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
         let group = f.view_group(
             gpu,
             "csm.eval",

@@ -15,11 +15,8 @@ const COLOURS: [[u8; 3]; 8] =
 pub(super) fn report(t: &Cascaded, gpu: &Gpu) -> TechniqueReport {
     let texels = t.res as usize * t.res as usize;
     let counts: Vec<u32> = gpu.read_buffer_as(&t.counts, t.count * texels);
-    let mut r = TechniqueReport {
-        shadow_data_bytes: (t.count * texels * 4) as u64,
-        sampling: Some(sampling_stats(&counts)),
-        ..Default::default()
-    };
+    let mut r =
+        TechniqueReport { shadow_data_bytes: (t.count * texels * 4) as u64, sampling: Some(sampling_stats(&counts)), ..Default::default() };
     let c = &mut r.counters;
     c.insert("cascades".into(), t.count as f64);
     c.insert("shadow_map_texels".into(), (t.count * texels) as f64);
@@ -91,7 +88,12 @@ fn read_layer(gpu: &Gpu, tex: &wgpu::Texture, layer: u32) -> Vec<u8> {
     });
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     enc.copy_texture_to_texture(
-        wgpu::TexelCopyTextureInfo { texture: tex, mip_level: 0, origin: wgpu::Origin3d { x: 0, y: 0, z: layer }, aspect: wgpu::TextureAspect::All },
+        wgpu::TexelCopyTextureInfo {
+            texture: tex,
+            mip_level: 0,
+            origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
+            aspect: wgpu::TextureAspect::All,
+        },
         tmp.as_image_copy(),
         size,
     );
