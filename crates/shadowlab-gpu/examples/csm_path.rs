@@ -6,10 +6,12 @@
 //! `cargo run -p shadowlab-gpu --example csm_path -- [scene] [frames] [size] [span] [spec...]`
 //! (defaults: courtyard, 24, 512, span 1, and csm with/without snapping and tightening, the box
 //! fit, sm). `span` < 1 walks only that fraction of the path's first segment: small, sub-texel
-//! steps, where the screen barely changes and shimmering shows alone in the flicker.
+//! steps, where the screen barely changes and shimmering shows alone in the flicker; a negative
+//! `span` instead turns the camera at the path's first key by |span| degrees per frame about
+//! the vertical (the case where a sphere-fitted box keeps its size and a tight box does not).
 
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::camera::{path_cameras, CameraKey};
+use shadowlab_core::camera::{path_cameras, Camera, CameraKey};
 use shadowlab_core::metrics::{compare, flicker_pct};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
@@ -43,7 +45,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (true, [a, b, ..]) => vec![*a, CameraKey { position: a.position.lerp(b.position, span), target: a.target.lerp(b.target, span) }],
         _ => scene.camera_path.clone(),
     };
-    let cams = path_cameras(&scene.camera, &keys, frames);
+    let cams = if span < 0.0 {
+        let k = scene.camera_path.first().map(|k| (k.position, k.target)).unwrap_or((scene.camera.position, scene.camera.target));
+        (0..frames)
+            .map(|f| {
+                let rot = glam::Quat::from_rotation_y((-span * f as f32).to_radians());
+                Camera { position: k.0, target: k.0 + rot * (k.1 - k.0), ..scene.camera }
+            })
+            .collect()
+    } else {
+        path_cameras(&scene.camera, &keys, frames)
+    };
     let step = if cams.len() > 1 { (cams[1].position - cams[0].position).length() } else { 0.0 };
 
     let mut insts = Vec::new();

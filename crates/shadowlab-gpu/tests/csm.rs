@@ -100,14 +100,16 @@ fn cascades_beat_one_map_of_the_same_texels_on_courtyard() {
     let v = view(&lab, &scene, 0, 512);
     let rt = lab.reference(&v, 1).unwrap();
     // 3 x 512^2 texels against one map of side sqrt(3) x 512
-    let csm = lab.run(&v, &spec("csm:res=512"), 1).unwrap();
     let sm = lab.run(&v, &spec("sm:res=887"), 1).unwrap();
-    assert!(csm.report.shadow_data_bytes <= sm.report.shadow_data_bytes);
-    let (wc, ws) =
-        (compare(&csm.visibility, &rt.visibility, &v.mask).wrong_pct, compare(&sm.visibility, &rt.visibility, &v.mask).wrong_pct);
-    // measured 0.706 % vs 0.877 % (courtyard's view spans most of the scene, so one fitted map
-    // is not far off; the cascades' gain grows with the scene, see docs/bench/csm.md)
-    assert!(wc < 0.9 * ws, "csm {wc:.3}% wrong vs sm {ws:.3}% at the same texel budget");
+    let ws = compare(&sm.visibility, &rt.visibility, &v.mask).wrong_pct;
+    // measured (2026-11-22): sphere 0.743 %, box 0.477 %, sm 0.877 %. Courtyard's view spans
+    // most of the scene, so one fitted map is not far off; see docs/bench/csm.md
+    for (s, factor) in [("csm:res=512", 0.95), ("csm:res=512,fit=box", 0.7)] {
+        let csm = lab.run(&v, &spec(s), 1).unwrap();
+        assert!(csm.report.shadow_data_bytes <= sm.report.shadow_data_bytes);
+        let wc = compare(&csm.visibility, &rt.visibility, &v.mask).wrong_pct;
+        assert!(wc < factor * ws, "{s}: {wc:.3}% wrong vs sm {ws:.3}% at the same texel budget");
+    }
 }
 
 #[test]
