@@ -11,8 +11,9 @@ use crate::techniques::sm;
 pub const DEFAULT_CASCADES: f64 = 3.0;
 /// Texels per cascade side (seed 001: 1024).
 pub const DEFAULT_RES: f64 = 1024.0;
-/// Split blend (see `shadowlab_core::cascades::DEFAULT_LAMBDA`).
-pub const DEFAULT_LAMBDA: f64 = shadowlab_core::cascades::DEFAULT_LAMBDA as f64;
+/// Split blend: `shadowlab_core::cascades::DEFAULT_LAMBDA` (0.85, seed 004's code), written as
+/// an f64 literal so that listings show 0.85 rather than the f32's 0.8500000238.
+pub const DEFAULT_LAMBDA: f64 = 0.85;
 /// Blend band, as a fraction of each slice's depth range at its far end. Off: with hard
 /// thresholded visibility a band only moves the switch; with PCF it hides the seam.
 pub const DEFAULT_BLEND: f64 = 0.0;
@@ -64,7 +65,7 @@ pub const PARAMS: &[ParamDef] = &[
         min: 0.0,
         max: 1e6,
         integer: false,
-        doc: "manual split distances split1 < split2 < split3 (view depth, scene units; 0 = practical scheme); give cascades-1 of them",
+        doc: "manual split distances split1 < split2 < split3 (view depth, scene units; 0 = practical scheme); give cascades-1 of them (manual splits: up to 4 cascades)",
         source: "manual partitioning (Engel 2006)",
         choices: &[],
     },
