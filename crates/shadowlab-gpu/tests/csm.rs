@@ -8,6 +8,7 @@ use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::reduce::MinMax;
 
 mod common;
+mod csm_city;
 use common::*;
 
 fn spec(s: &str) -> TechniqueSpec {
@@ -110,6 +111,20 @@ fn cascades_beat_one_map_of_the_same_texels_on_courtyard() {
         let wc = compare(&csm.visibility, &rt.visibility, &v.mask).wrong_pct;
         assert!(wc < factor * ws, "{s}: {wc:.3}% wrong vs sm {ws:.3}% at the same texel budget");
     }
+}
+
+#[test]
+fn cascades_beat_one_map_by_far_on_a_city() {
+    let Some(gpu) = gpu() else { return };
+    let scene = csm_city::city();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 384);
+    let rt = lab.reference(&v, 1).unwrap();
+    let sm = lab.run(&v, &spec("sm:res=887"), 1).unwrap();
+    let csm = lab.run(&v, &spec("csm:res=512"), 1).unwrap();
+    let (wc, ws) =
+        (compare(&csm.visibility, &rt.visibility, &v.mask).wrong_pct, compare(&sm.visibility, &rt.visibility, &v.mask).wrong_pct);
+    assert!(wc < 0.5 * ws, "city: csm {wc:.3}% wrong vs sm {ws:.3}% at the same texel budget");
 }
 
 #[test]
