@@ -178,6 +178,29 @@ pub struct CascadeBox {
     /// The slice of view depths it serves.
     pub d0: f32,
     pub d1: f32,
+    /// The light view ([`light_view`]) and the light-view z of the box's near (towards the
+    /// light) and far planes.
+    pub light_view: Mat4,
+    pub near_z: f32,
+    pub far_z: f32,
+}
+
+impl CascadeBox {
+    /// Whether `p` (world) lies inside the box.
+    pub fn contains(&self, p: Vec3) -> bool {
+        let q = (self.light_view * p.extend(1.0)).xyz();
+        let d = (Vec2::new(q.x, q.y) - self.origin).abs();
+        d.x <= self.half && d.y <= self.half && q.z <= self.near_z && q.z >= self.far_z
+    }
+
+    /// The same box with its side scaled by `factor` about its centre (leak tracing's cascade
+    /// reuse enlarges each box by 15 % and re-renders it only when the slice leaves it).
+    pub fn enlarged(&self, factor: f32, res: u32) -> CascadeBox {
+        let half = self.half * factor;
+        let (o, v) = (self.origin, self.light_view);
+        let proj = orthographic(o.x - half, o.x + half, o.y - half, o.y + half, -self.near_z, -self.far_z);
+        CascadeBox { view_proj: proj * v, texel: 2.0 * half / res as f32, half, ..*self }
+    }
 }
 
 /// How a slice is enclosed in light space.
@@ -241,7 +264,7 @@ pub fn fit_cascade(frustum: &ViewFrustum, dir: Vec3, scene: &Bounds, d0: f32, d1
     let far_z = recv_far.max(zlo) - margin; // away from it: the receivers of the slice
     let far_z = far_z.min(near_z - margin);
     let proj = orthographic(origin.x - half, origin.x + half, origin.y - half, origin.y + half, -near_z, -far_z);
-    CascadeBox { view_proj: proj * view, texel, origin, half, d0, d1 }
+    CascadeBox { view_proj: proj * view, texel, origin, half, d0, d1, light_view: view, near_z, far_z }
 }
 
 /// Every cascade of `splits` (n + 1 distances -> n boxes).
@@ -381,6 +404,24 @@ mod tests {
         assert!((u.origin - b0.origin).abs().max_element() <= 0.5 * b0.texel + 1e-5);
         assert_eq!(quantize_radius(quantize_radius(3.3)), quantize_radius(3.3));
         assert!(quantize_radius(3.3) >= 3.3 && quantize_radius(3.3) < 3.3 * 1.002);
+    }
+
+    #[test]
+    fn an_enlarged_box_holds_a_slice_that_moved_a_little() {
+        let scene = Bounds { min: Vec3::splat(-50.0), max: Vec3::splat(50.0) };
+        let dir = Vec3::new(0.3, -1.0, 0.5);
+        let cam = Camera::new(Vec3::new(0.0, 2.0, 0.0), Vec3::new(10.0, 1.0, -10.0), 60.0, 0.1, 60.0);
+        let b = fit_cascade(&frustum(&cam), dir, &scene, 2.0, 12.0, 1024, true, Fit::Box);
+        let big = b.enlarged(1.15, 1024);
+        assert!((big.texel / b.texel - 1.15).abs() < 1e-5);
+        let moved = Camera { position: cam.position + Vec3::new(0.4, 0.0, -0.3), target: cam.target + Vec3::new(0.4, 0.0, -0.3), ..cam };
+        let corners = frustum(&moved).slice_corners(2.0, 12.0);
+        assert!(corners.iter().all(|p| big.contains(*p)), "the 15 % box still holds the moved slice");
+        assert!(!corners.iter().all(|p| b.contains(*p)), "the tight box does not");
+        for p in corners {
+            let n = big.view_proj.project_point3(p);
+            assert!(n.x.abs() <= 1.0 && n.y.abs() <= 1.0 && (0.0..=1.0).contains(&n.z), "{n}");
+        }
     }
 
     #[test]
