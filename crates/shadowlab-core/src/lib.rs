@@ -5,6 +5,7 @@
 pub mod builtin;
 pub mod bvh;
 pub mod camera;
+pub mod cascades;
 pub mod edges;
 pub mod light;
 pub mod lightspace;

@@ -11,6 +11,7 @@ pub mod frame;
 pub mod gbuffer;
 pub mod lab;
 pub mod raster;
+pub mod reduce;
 pub mod reference;
 pub mod scene_gpu;
 pub mod shade;

@@ -162,3 +162,21 @@ fn sv_struct_layouts_match_rust() {
         check(&get(f), "Edge", size_of::<Edge>(), &offsets);
     }
 }
+
+#[test]
+fn csm_and_reduce_layouts_match_rust() {
+    use shadowlab_gpu::reduce::ReduceParams;
+    use shadowlab_gpu::techniques::csm::{CascadeU, CsmParams};
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    let eval = get("csm/eval.wgsl");
+    check(&eval, "Cascade", size_of::<CascadeU>(), &[("view_proj", 0), ("info", offset_of!(CascadeU, info))]);
+    check(
+        &eval,
+        "CsmParams",
+        size_of::<CsmParams>(),
+        &[("cascades", 0), ("cfg", offset_of!(CsmParams, cfg)), ("bias", offset_of!(CsmParams, bias))],
+    );
+    check(&get("csm/depth.wgsl"), "CsmDepth", size_of::<[[f32; 4]; 4]>(), &[("view_proj", 0)]);
+    check(&get("reduce/reduce.wgsl"), "ReduceParams", size_of::<ReduceParams>(), &[("channel", 0)]);
+}

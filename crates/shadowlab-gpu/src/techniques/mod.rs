@@ -1,6 +1,7 @@
 //! The technique trait and the one registry. A technique is a folder with its `mod.rs` and
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
+pub mod csm;
 pub mod mdsm;
 pub mod sm;
 pub mod sv;
@@ -132,7 +133,7 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &mdsm::INFO, &sv::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &mdsm::INFO, &sv::INFO, &csm::INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
@@ -140,6 +141,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(sm::shaders());
     v.extend(mdsm::shaders());
     v.extend(sv::shaders());
+    v.extend(csm::shaders());
     v
 }
 

@@ -1,0 +1,311 @@
+//! `csm`: cascaded shadow maps for directional lights (Engel 2006; seed 001 chapter 2.3 and its
+//! CSM comparison in chapter 4). The view frustum is split along the view depth (practical
+//! scheme or manual distances), each slice gets an orthographic map in one depth texture array,
+//! fitted around the slice's bounding sphere, extended towards the light over the scene bounds,
+//! texel-snapped; optionally only the depth range present in the G-buffer is split.
+//! Stored depth: orthographic (linear), 0 = near the light.
+//!
+//! Per frame: `prepare` copies the camera out of the frame uniform and reduces the G-buffer's
+//! linear depth to [min, max] on the GPU, reads both back (one device sync, timed as
+//! `csm.readback`) and fits the boxes on the CPU (`shadowlab_core::cascades`); `render` draws
+//! the scene once per cascade; `evaluate` picks the cascade per pixel by view depth.
+
+mod params;
+mod report;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3, Vec4};
+use shadowlab_core::cascades::{self, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
+use shadowlab_core::light::Light;
+use shadowlab_core::params::ParamValues;
+
+pub use params::*;
+
+use crate::reduce::{decode, MinMax};
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose;
+use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{binding, raster, Gpu, GpuError};
+
+const DEPTH_WGSL: &str = include_str!("depth.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+const CAMERA_WGSL: &str = include_str!("camera.wgsl");
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![
+        ("csm/depth.wgsl", compose(DEPTH_WGSL, true)),
+        ("csm/eval.wgsl", compose_view(EVAL_WGSL, false)),
+        ("csm/camera.wgsl", compose(CAMERA_WGSL, false)),
+    ]
+}
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "csm",
+    summary: "cascaded shadow maps: the view frustum split in depth, one snapped orthographic map per slice, cascade chosen per pixel",
+    cost: "one G-buffer depth reduction + readback (a sync), one scene pass per cascade, N^2 fetches per pixel (x2 in the blend band)",
+    quality: "texel size grows with distance like the view's footprint; seams at cascade switches; no shimmer when snapped",
+    source: "Engel 2006; Zhang et al. 2006 (practical splits); seed 001 chapter 2.3 and 4; SDSM (Lauritzen 2011) for tightening",
+    lights: &["directional"],
+    params: PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, p, light)?)),
+};
+
+/// WGSL `Cascade` (eval.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CascadeU {
+    pub view_proj: [[f32; 4]; 4],
+    /// x: world texel size, y/z: slice near/far view depth.
+    pub info: [f32; 4],
+}
+
+/// WGSL `CsmParams` (eval.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CsmParams {
+    pub cascades: [CascadeU; MAX_CASCADES],
+    /// x: count, y: res, z: pcf, w: blend band.
+    pub cfg: [f32; 4],
+    /// x: constant bias, y: normal offset, z: max slope.
+    pub bias: [f32; 4],
+}
+
+/// Bytes of the probe buffer the CPU reads each frame: camera (5 vec4) + min/max words.
+const PROBE_CAMERA: u64 = 80;
+const PROBE_BYTES: u64 = PROBE_CAMERA + 8;
+
+pub struct Cascaded {
+    count: usize,
+    res: u32,
+    lambda: f32,
+    manual: Vec<f32>,
+    snap: bool,
+    fit: Fit,
+    tighten: bool,
+    pcf: u32,
+    dir: Vec3,
+    params: CsmParams,
+    boxes: Vec<CascadeBox>,
+    depth_range: Option<(f32, f32)>,
+    maps: wgpu::Texture,
+    counts: wgpu::Buffer,
+    /// Per pixel cascade tags of the last evaluation, with its size.
+    chosen: Option<(wgpu::Buffer, u32, u32)>,
+    uniform: wgpu::Buffer,
+    depth_uniforms: Vec<wgpu::Buffer>,
+    depth_groups: Vec<wgpu::BindGroup>,
+    depth_pipeline: wgpu::RenderPipeline,
+    eval_pipeline: wgpu::ComputePipeline,
+    eval_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    camera_pipeline: wgpu::ComputePipeline,
+    camera_layout: wgpu::BindGroupLayout,
+    reduce: MinMax,
+    probe: wgpu::Buffer,
+}
+
+fn texture_depth_array() -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Depth,
+        view_dimension: wgpu::TextureViewDimension::D2Array,
+        multisampled: false,
+    }
+}
+
+impl Cascaded {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<Cascaded, GpuError> {
+        let Light::Directional { direction } = *light else {
+            return Err(GpuError::Invalid(format!("csm supports directional lights only (got a {} light)", light.kind())));
+        };
+        let count = p.get_u32("cascades") as usize;
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "cascade map")?;
+        let manual: Vec<f32> = ["split1", "split2", "split3"].iter().map(|k| p.get(k) as f32).filter(|x| *x > 0.0).collect();
+        if !manual.is_empty() && manual.len() != count - 1 {
+            return Err(GpuError::Invalid(format!(
+                "csm: {} cascades need {} manual split distances (split1..), got {}",
+                count,
+                count - 1,
+                manual.len()
+            )));
+        }
+        let d = &gpu.device;
+        let maps = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("csm.maps"),
+            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: count as u32 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: raster::DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let params = CsmParams {
+            cascades: [CascadeU::zeroed(); MAX_CASCADES],
+            cfg: [count as f32, res as f32, p.get("pcf") as f32, p.get("blend") as f32],
+            bias: [p.get("bias") as f32, p.get("normal_offset") as f32, MAX_SLOPE, 0.0],
+        };
+        let uniform = gpu.uniform("csm.params", &params);
+        let depth_layout = binding::layout(d, "csm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
+        let depth_uniforms: Vec<_> = (0..count).map(|_| gpu.uniform("csm.cascade", &Mat4::IDENTITY.to_cols_array_2d())).collect();
+        let depth_groups = depth_uniforms.iter().map(|u| binding::group(d, "csm.depth", &depth_layout, &[u.as_entire_binding()])).collect();
+        let depth_pipeline = raster::scene_pipeline(gpu, "csm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
+        let eval_layout = view_layout(
+            gpu,
+            "csm.eval",
+            &[binding::uniform(), texture_depth_array(), binding::comparison_sampler(), binding::storage(false), binding::storage(false)],
+        );
+        let eval_pipeline = gpu.compute_pipeline("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let camera_layout = binding::layout(d, "csm.camera", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
+        let camera_pipeline = gpu.compute_pipeline("csm.camera", &compose(CAMERA_WGSL, false), "main", &[&camera_layout]);
+        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("csm.cmp"),
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            mag_filter: wgpu::FilterMode::Nearest,
+            min_filter: wgpu::FilterMode::Nearest,
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            ..Default::default()
+        });
+        let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
+        Ok(Cascaded {
+            count,
+            res,
+            lambda: p.get("lambda") as f32,
+            manual,
+            snap: p.get_bool("snap"),
+            fit: if p.get_u32("fit") == 0 { Fit::Sphere } else { Fit::Box },
+            tighten: p.get_bool("tighten"),
+            pcf: p.get_u32("pcf"),
+            dir: direction,
+            params,
+            boxes: Vec::new(),
+            depth_range: None,
+            maps,
+            counts,
+            chosen: None,
+            uniform,
+            depth_uniforms,
+            depth_groups,
+            depth_pipeline,
+            eval_pipeline,
+            eval_layout,
+            sampler,
+            camera_pipeline,
+            camera_layout,
+            reduce: MinMax::new(gpu, "csm.reduce", 3),
+            probe: gpu.storage("csm.probe", PROBE_BYTES),
+        })
+    }
+
+    /// The boxes of the last frame (for tests and leak tracing).
+    pub fn boxes(&self) -> &[CascadeBox] {
+        &self.boxes
+    }
+
+    fn layer_view(&self, layer: u32) -> wgpu::TextureView {
+        self.maps.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        })
+    }
+}
+
+impl Technique for Cascaded {
+    /// Camera copy + depth reduction on the GPU, one readback, the fit on the CPU.
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let group =
+            binding::group(&gpu.device, "csm.camera", &self.camera_layout, &[f.frame.as_entire_binding(), self.probe.as_entire_binding()]);
+        timer.stage(gpu, "csm.analyze", |enc| {
+            enc.clear_buffer(&self.probe, 0, None);
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("csm.camera"), timestamp_writes: None });
+                pass.set_pipeline(&self.camera_pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                pass.dispatch_workgroups(1, 1, 1);
+            }
+            if self.tighten {
+                self.reduce.record(gpu, enc, "csm.reduce", &f.gbuffer.position, &f.gbuffer.mask);
+                enc.copy_buffer_to_buffer(&self.reduce.result, 0, &self.probe, PROBE_CAMERA, 8);
+            }
+        });
+        let t0 = std::time::Instant::now();
+        let words: Vec<u32> = gpu.read_buffer_as(&self.probe, (PROBE_BYTES / 4) as usize);
+        timer.add("csm.readback", t0.elapsed().as_secs_f64() * 1e3);
+
+        let t0 = std::time::Instant::now();
+        let v: Vec<f32> = words[..20].iter().map(|w| f32::from_bits(*w)).collect();
+        let view_proj = Mat4::from_cols(
+            Vec4::from_slice(&v[0..4]),
+            Vec4::from_slice(&v[4..8]),
+            Vec4::from_slice(&v[8..12]),
+            Vec4::from_slice(&v[12..16]),
+        );
+        let frustum = ViewFrustum::from_view_proj(view_proj, Vec3::from_slice(&v[16..19]))
+            .ok_or_else(|| GpuError::Invalid("csm: the view's projection is not a perspective frustum".into()))?;
+        self.depth_range = if self.tighten { decode([words[20], words[21]]) } else { None };
+        let (near, far) = cascades::depth_range(frustum.near, frustum.far, self.depth_range);
+        let splits = if self.manual.is_empty() {
+            cascades::practical_splits(near, far, self.count, self.lambda)
+        } else {
+            cascades::manual_splits(frustum.near, frustum.far, &self.manual).map_err(|e| GpuError::Invalid(format!("csm: {e}")))?
+        };
+        self.boxes = cascades::fit_cascades(&frustum, self.dir, &f.scene.bounds, &splits, self.res, self.snap, self.fit);
+        for (i, b) in self.boxes.iter().enumerate() {
+            self.params.cascades[i] = CascadeU { view_proj: b.view_proj.to_cols_array_2d(), info: [b.texel, b.d0, b.d1, 0.0] };
+            gpu.queue.write_buffer(&self.depth_uniforms[i], 0, bytemuck::bytes_of(&b.view_proj.to_cols_array_2d()));
+        }
+        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        timer.add("csm.fit", t0.elapsed().as_secs_f64() * 1e3);
+        Ok(())
+    }
+
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let views: Vec<_> = (0..self.count as u32).map(|c| self.layer_view(c)).collect();
+        timer.stage(gpu, "csm.render", |enc| {
+            for (c, view) in views.iter().enumerate() {
+                let mut pass = raster::begin_pass(enc, "csm.render", &[], view);
+                pass.set_pipeline(&self.depth_pipeline);
+                pass.set_bind_group(0, &self.depth_groups[c], &[]);
+                pass.set_bind_group(1, &f.scene.group, &[]);
+                pass.draw(0..f.scene.triangle_count * 3, 0..1);
+            }
+        });
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let (w, h) = (f.gbuffer.width, f.gbuffer.height);
+        if !matches!(self.chosen, Some((_, cw, ch)) if cw == w && ch == h) {
+            self.chosen = Some((gpu.storage("csm.chosen", w as u64 * h as u64 * 4), w, h));
+        }
+        let chosen = &self.chosen.as_ref().expect("allocated above").0;
+        let maps_view = self
+            .maps
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let group = f.view_group(
+            gpu,
+            "csm.eval",
+            &self.eval_layout,
+            &[
+                self.uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&maps_view),
+                wgpu::BindingResource::Sampler(&self.sampler),
+                self.counts.as_entire_binding(),
+                chosen.as_entire_binding(),
+            ],
+        );
+        timer.stage(gpu, "csm.evaluate", |enc| {
+            enc.clear_buffer(&self.counts, 0, None);
+            gpu.dispatch_2d(enc, "csm.evaluate", &self.eval_pipeline, &[&group], w, h)
+        });
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        report::report(self, gpu)
+    }
+}
