@@ -140,5 +140,6 @@ fn bad_csm_requests_are_errors() {
     let v = view(&lab, &scene, 0, 32);
     assert!(lab.run(&v, &spec("csm:cascades=9"), 1).is_err());
     assert!(lab.run(&v, &spec("csm:cascades=4,split1=3"), 1).is_err(), "4 cascades need 3 manual splits");
+    assert!(lab.run(&v, &spec("csm:cascades=1,split1=3"), 1).is_err(), "1 cascade takes no manual split");
     assert!(lab.run(&v, &spec("csm:split1=9,split2=3"), 1).is_err(), "manual splits must increase");
 }

@@ -122,7 +122,7 @@ impl Cascaded {
         let res = p.get_u32("res");
         gpu.check_size(res, res, "cascade map")?;
         let manual: Vec<f32> = ["split1", "split2", "split3"].iter().map(|k| p.get(k) as f32).filter(|x| *x > 0.0).collect();
-        if !manual.is_empty() && manual.len() != count - 1 {
+        if !manual.is_empty() && manual.len() + 1 != count {
             return Err(GpuError::Invalid(format!(
                 "csm: {} cascades need {} manual split distances (split1..), got {}",
                 count,
