@@ -6,6 +6,7 @@ pub mod builtin;
 pub mod bvh;
 pub mod camera;
 pub mod light;
+pub mod iasm;
 pub mod lightspace;
 pub mod loaders;
 pub mod metrics;
