@@ -132,3 +132,27 @@ fn shared_struct_layouts_match_rust() {
         check(&get(sm), "SmParams", size_of::<SmParams>(), &[("texel", offset_of!(SmParams, texel)), ("bias", offset_of!(SmParams, bias))]);
     }
 }
+
+#[test]
+fn iasm_layouts_match_wgsl() {
+    use shadowlab_gpu::techniques::iasm::{IasmParams, TileParams};
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    for n in ["iasm/analysis.wgsl", "iasm/eval.wgsl"] {
+        check(
+            &get(n),
+            "IasmParams",
+            size_of::<IasmParams>(),
+            &[
+                ("up", offset_of!(IasmParams, up)),
+                ("dir", offset_of!(IasmParams, dir)),
+                ("imp", offset_of!(IasmParams, imp)),
+                ("res", offset_of!(IasmParams, res)),
+                ("off", offset_of!(IasmParams, off)),
+                ("near", offset_of!(IasmParams, near)),
+                ("far", offset_of!(IasmParams, far)),
+            ],
+        );
+    }
+    check(&get("iasm/render.wgsl"), "TileParams", size_of::<TileParams>(), &[("tile", offset_of!(TileParams, tile))]);
+}

@@ -1,0 +1,464 @@
+//! GPU side of `iasm`: resources, the per-frame plan (from the analysis read back) and the
+//! passes. Stage names (timing keys): `iasm.camera` (copy of the view's camera to the CPU, an
+//! artifact of the lab handing techniques only the frame uniform), `iasm.importance` (analysis
+//! pass), `iasm.readback` (waiting for and mapping the 16 tiles' stats: the sync cost),
+//! `iasm.shadows.clear`, `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
+
+use glam::{Mat4, Vec3};
+use shadowlab_core::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
+use shadowlab_core::light::Light;
+use shadowlab_core::params::ParamValues;
+
+use super::{analysis_src, eval_src, IasmParams, TileParams, BOUNDS_WGSL, RENDER_WGSL};
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose;
+use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{binding, Gpu, GpuError};
+
+const TILE_STRIDE: u64 = 256;
+const DUMMY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+
+/// What the analysis found per tile.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TileStats {
+    pub importance: [f64; TILE_COUNT],
+    pub samples: [u32; TILE_COUNT],
+    pub depth_min: [f32; TILE_COUNT],
+    pub depth_max: [f32; TILE_COUNT],
+}
+
+fn unkey(k: u32) -> f32 {
+    f32::from_bits(if k & 0x8000_0000 != 0 { k & 0x7fff_ffff } else { !k })
+}
+
+impl TileStats {
+    fn parse(w: &[u32]) -> TileStats {
+        let mut s = TileStats::default();
+        for t in 0..TILE_COUNT {
+            let b = &w[t * 8..t * 8 + 8];
+            s.importance[t] = ((b[1] as u64) << 32 | b[0] as u64) as f64 / 64.0;
+            s.samples[t] = b[2];
+            s.depth_min[t] = unkey(b[3]);
+            s.depth_max[t] = unkey(b[4]);
+        }
+        s
+    }
+}
+
+/// The plan of one frame: placement, per-tile resolution (0 = empty), layout, planes, draws.
+#[derive(Clone, Debug, Default)]
+pub struct Plan {
+    pub stats: TileStats,
+    pub order: [usize; TILE_COUNT],
+    pub res: [u32; TILE_COUNT],
+    pub empty: [bool; TILE_COUNT],
+    pub off: [u32; TILE_COUNT],
+    pub near: [f32; TILE_COUNT],
+    pub far: [f32; TILE_COUNT],
+    /// Vertex ranges drawn per tile.
+    pub draws: Vec<Vec<(u32, u32)>>,
+}
+
+pub struct Iasm {
+    pub(super) m: f32,
+    pub(super) k: f32,
+    size: f32,
+    bias: f32,
+    normal_offset: f32,
+    delayed: bool,
+    snap: bool,
+    anchor: Anchor,
+    chunk: u32,
+    triangles: u32,
+    light_dir: Vec3,
+    /// Light-space (x, y, depth) boxes of the chunks (None: empty chunk).
+    boxes: Vec<(Vec3, Vec3)>,
+    pub placement: Placement,
+    pub plan: Plan,
+    /// Delayed: the analysis of the previous frame is in `stats_buf`.
+    pending: bool,
+    pub(super) params_buf: wgpu::Buffer,
+    stats_buf: wgpu::Buffer,
+    camera_buf: wgpu::Buffer,
+    pub(super) shadow: wgpu::Buffer,
+    pub(super) counts: wgpu::Buffer,
+    pub(super) probe: wgpu::Buffer,
+    tile_buf: wgpu::Buffer,
+    tile_groups: Vec<wgpu::BindGroup>,
+    dummy: wgpu::TextureView,
+    analysis_layout: wgpu::BindGroupLayout,
+    analysis: wgpu::ComputePipeline,
+    copy_camera: wgpu::ComputePipeline,
+    render: wgpu::RenderPipeline,
+    eval_layout: wgpu::BindGroupLayout,
+    eval: wgpu::ComputePipeline,
+    probe_pipeline: wgpu::ComputePipeline,
+}
+
+impl Iasm {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<Iasm, GpuError> {
+        let Light::Directional { direction } = *light else {
+            return Err(GpuError::Invalid(format!("iasm supports directional lights only, not {}", light.kind())));
+        };
+        let d = &gpu.device;
+        let texels = core::texels(&THESIS_RESOLUTIONS);
+        if texels * 4 > gpu.limits.max_storage_buffer_binding_size as u64 {
+            return Err(GpuError::Invalid("iasm shadow buffer exceeds this device's storage binding limit".into()));
+        }
+        let chunk = p.get_u32("chunk").max(1);
+        let triangles = scene.triangle_count;
+        let (right, up, dir) = core::light_basis(direction);
+        let basis = Placement { right, up, dir, origin: glam::Vec2::ZERO, size: 1.0 };
+        let boxes = chunk_bounds(gpu, scene, chunk)?.into_iter().map(|(a, b)| core::light_box(&basis, a, b)).collect();
+        let sb = core::light_box(&basis, scene.bounds.min, scene.bounds.max);
+        let size = match p.get("size") as f32 {
+            s if s > 0.0 => s,
+            _ => (sb.1.x - sb.0.x).max(sb.1.y - sb.0.y).max(1e-3),
+        };
+
+        let params_buf = gpu.uniform("iasm.params", &<IasmParams as bytemuck::Zeroable>::zeroed());
+        let stats_buf = gpu.storage("iasm.stats", TILE_COUNT as u64 * 32);
+        let camera_buf = gpu.storage("iasm.camera", 80);
+        let shadow = gpu.storage("iasm.shadow", texels * core::TEXEL_BYTES);
+        let counts = gpu.storage("iasm.counts", texels * 4);
+        let probe = gpu.storage("iasm.probe", 16);
+        let tile_buf = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("iasm.tiles"),
+            size: TILE_STRIDE * TILE_COUNT as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let render_layout = binding::layout(d, "iasm.render", wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform(), binding::storage(false)]);
+        let tile_groups = (0..TILE_COUNT as u64)
+            .map(|t| {
+                let tb = wgpu::BufferBinding { buffer: &tile_buf, offset: t * TILE_STRIDE, size: wgpu::BufferSize::new(80) };
+                binding::group(d, "iasm.render", &render_layout, &[wgpu::BindingResource::Buffer(tb), shadow.as_entire_binding()])
+            })
+            .collect();
+        let max_res = THESIS_RESOLUTIONS[0];
+        let dummy = d
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("iasm.dummy"),
+                size: wgpu::Extent3d { width: max_res, height: max_res, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DUMMY_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        let analysis_layout = view_layout(gpu, "iasm.analysis", &[binding::uniform(), binding::storage(false), binding::storage(false)]);
+        let analysis = gpu.compute_pipeline("iasm.analysis", &analysis_src(), "main", &[&analysis_layout]);
+        let copy_camera = gpu.compute_pipeline("iasm.camera", &analysis_src(), "copy_camera", &[&analysis_layout]);
+        let eval_layout =
+            view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false), binding::storage(false)]);
+        let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
+        let probe_pipeline = gpu.compute_pipeline("iasm.probe", &eval_src(), "probe_index", &[&eval_layout]);
+        let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
+        Ok(Iasm {
+            m: p.get("m") as f32,
+            k: p.get("k") as f32,
+            size,
+            bias: p.get("bias") as f32,
+            normal_offset: p.get("normal_offset") as f32,
+            delayed: p.get_bool("delayed"),
+            snap: p.get_bool("snap"),
+            anchor: if p.get_u32("anchor") == 1 { Anchor::TileCentre } else { Anchor::Circle },
+            chunk,
+            triangles,
+            light_dir: direction,
+            boxes,
+            placement: basis,
+            plan: Plan::default(),
+            pending: false,
+            params_buf,
+            stats_buf,
+            camera_buf,
+            shadow,
+            counts,
+            probe,
+            tile_buf,
+            tile_groups,
+            dummy,
+            analysis_layout,
+            analysis,
+            copy_camera,
+            render,
+            eval_layout,
+            eval,
+            probe_pipeline,
+        })
+    }
+
+    pub fn size(&self) -> f32 {
+        self.size
+    }
+
+    /// The uniform of this frame (placement and plan).
+    pub fn params(&self) -> IasmParams {
+        let p = &self.placement;
+        let k = if self.k > 0.0 { self.k } else { 0.5 * p.size };
+        let res = std::array::from_fn(|t| if self.plan.empty[t] { 0 } else { self.plan.res[t] });
+        IasmParams {
+            right: p.right.extend(p.origin.x).into(),
+            up: p.up.extend(p.origin.y).into(),
+            dir: p.dir.extend(p.size).into(),
+            imp: [self.m, k, self.bias, self.normal_offset],
+            res,
+            off: self.plan.off,
+            near: self.plan.near,
+            far: self.plan.far,
+        }
+    }
+
+    /// Places the square for the camera of `f` (read back from the frame uniform).
+    fn place(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
+        let group = f.view_group(gpu, "iasm.camera", &self.analysis_layout, &self.analysis_extra());
+        let t0 = std::time::Instant::now();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.copy_camera);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let cam: Vec<[f32; 4]> = gpu.read_buffer_as(&self.camera_buf, 5);
+        timer.add("iasm.camera", t0.elapsed().as_secs_f64() * 1e3);
+        let vp = Mat4::from_cols_array_2d(&[cam[0], cam[1], cam[2], cam[3]]);
+        let inv = vp.inverse();
+        let forward = (inv.project_point3(Vec3::new(0.0, 0.0, 1.0)) - inv.project_point3(Vec3::ZERO)).normalize_or_zero();
+        let min_res = *THESIS_RESOLUTIONS.iter().min().unwrap_or(&16) as f32;
+        let step = self.snap.then_some(self.size / core::TILES_PER_SIDE as f32 / min_res);
+        let pos = Vec3::new(cam[4][0], cam[4][1], cam[4][2]);
+        self.placement = core::place(self.light_dir, pos, forward, self.size, step, self.anchor);
+    }
+
+    fn analysis_extra(&self) -> [wgpu::BindingResource<'_>; 3] {
+        [self.params_buf.as_entire_binding(), self.stats_buf.as_entire_binding(), self.camera_buf.as_entire_binding()]
+    }
+
+    /// Dispatches the analysis of `f` with the current placement into `stats_buf`.
+    fn analyse(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
+        gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params()));
+        let init: Vec<u32> = (0..TILE_COUNT).flat_map(|_| [0, 0, 0, u32::MAX, 0, 0, 0, 0]).collect();
+        gpu.queue.write_buffer(&self.stats_buf, 0, bytemuck::cast_slice(&init));
+        let group = f.view_group(gpu, "iasm.analysis", &self.analysis_layout, &self.analysis_extra());
+        timer.stage(gpu, "iasm.importance", |enc| {
+            gpu.dispatch_2d(enc, "iasm.importance", &self.analysis, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
+    }
+
+    /// Ranks, assigns, lays out, sets planes and culls (thesis 3.4, 3.5) from `stats`.
+    pub fn make_plan(&mut self, stats: TileStats) {
+        let p = self.placement;
+        let mut plan = Plan { stats, ..Default::default() };
+        let mut empty: [bool; TILE_COUNT] = std::array::from_fn(|t| stats.samples[t] == 0);
+        for t in 0..TILE_COUNT {
+            let (mut near, far) = (stats.depth_min[t], stats.depth_max[t]);
+            let mut draws = Vec::new();
+            if !empty[t] {
+                // chunks over the tile that can cast onto its receivers (not wholly beyond them)
+                let culled: Vec<usize> = core::cull(&p, t, &self.boxes).into_iter().filter(|&c| self.boxes[c].0.z <= far).collect();
+                for &c in &culled {
+                    near = near.min(self.boxes[c].0.z);
+                }
+                let tris = self.triangles;
+                draws = core::runs(&culled)
+                    .into_iter()
+                    .map(|(a, b)| (a as u32 * self.chunk * 3, (b as u32 * self.chunk).min(tris) * 3))
+                    .collect();
+                empty[t] = culled.is_empty();
+            }
+            let margin = 1e-3 * (far - near).abs().max(1e-3 * p.size);
+            plan.near[t] = near - margin;
+            plan.far[t] = far + margin;
+            plan.draws.push(if empty[t] { Vec::new() } else { draws });
+        }
+        let imp: [f64; TILE_COUNT] = std::array::from_fn(|t| if empty[t] { 0.0 } else { stats.importance[t] });
+        plan.order = core::rank(&imp, &empty);
+        plan.res = core::assign(&plan.order, &THESIS_RESOLUTIONS);
+        plan.off = core::offsets(&plan.res);
+        plan.empty = empty;
+        self.plan = plan;
+    }
+
+    fn read_stats(&self, gpu: &Gpu, timer: &mut StageTimer) -> TileStats {
+        let t0 = std::time::Instant::now();
+        let words: Vec<u32> = gpu.read_buffer_as(&self.stats_buf, TILE_COUNT * 8);
+        timer.add("iasm.readback", t0.elapsed().as_secs_f64() * 1e3);
+        TileStats::parse(&words)
+    }
+
+    fn write_tiles(&self, gpu: &Gpu) {
+        for t in 0..TILE_COUNT {
+            let tp = TileParams {
+                view_proj: self.placement.tile_matrix(t, self.plan.near[t], self.plan.far[t]).to_cols_array_2d(),
+                tile: [self.plan.res[t], self.plan.off[t], 0, 0],
+            };
+            gpu.queue.write_buffer(&self.tile_buf, t as u64 * TILE_STRIDE, bytemuck::bytes_of(&tp));
+        }
+        gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params()));
+    }
+
+    /// The GPU's texel index and tile (equations 3.2-3.5 in eval.wgsl) of buffer coordinates
+    /// `uvs` for resolutions `res` (offsets accumulated from them). For tests.
+    pub fn probe_indices(&self, gpu: &Gpu, f: &FrameInputs, res: &[u32; TILE_COUNT], uvs: &[glam::Vec2]) -> Vec<(u32, u32)> {
+        let mut params = self.params();
+        params.res = *res;
+        params.off = core::offsets(res);
+        let ub = gpu.uniform("iasm.probe_params", &params);
+        let data: Vec<[f32; 4]> = uvs.iter().map(|u| [u.x, u.y, 0.0, 0.0]).collect();
+        let probe = gpu.buffer_init(
+            "iasm.probe",
+            bytemuck::cast_slice(&data),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        );
+        let extra =
+            [ub.as_entire_binding(), self.shadow.as_entire_binding(), self.counts.as_entire_binding(), probe.as_entire_binding()];
+        let group = f.view_group(gpu, "iasm.probe", &self.eval_layout, &extra);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.probe_pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups((uvs.len() as u32).div_ceil(64), 1, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let out: Vec<[f32; 4]> = gpu.read_buffer_as(&probe, uvs.len());
+        out.iter().map(|v| (v[2].to_bits(), v[3].to_bits())).collect()
+    }
+
+    pub(super) fn eval_group(&self, gpu: &Gpu, f: &FrameInputs) -> wgpu::BindGroup {
+        let extra = [
+            self.params_buf.as_entire_binding(),
+            self.shadow.as_entire_binding(),
+            self.counts.as_entire_binding(),
+            self.probe.as_entire_binding(),
+        ];
+        f.view_group(gpu, "iasm.eval", &self.eval_layout, &extra)
+    }
+}
+
+impl Technique for Iasm {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        self.place(gpu, f, timer);
+        if !(self.delayed && self.pending) {
+            self.analyse(gpu, f, timer);
+        }
+        let stats = self.read_stats(gpu, timer);
+        self.make_plan(stats);
+        self.write_tiles(gpu);
+        Ok(())
+    }
+
+    fn render(&mut self, gpu: &Gpu, _f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        timer.stage(gpu, "iasm.shadows.clear", |enc| enc.clear_buffer(&self.shadow, 0, None));
+        for t in 0..TILE_COUNT {
+            if self.plan.empty[t] {
+                continue;
+            }
+            let r = self.plan.res[t];
+            timer.stage(gpu, &format!("iasm.shadows.t{t:02}"), |enc| {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("iasm.shadows"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &self.dummy,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Discard },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.render);
+                pass.set_bind_group(0, &self.tile_groups[t], &[]);
+                pass.set_bind_group(1, &_f.scene.group, &[]);
+                pass.set_viewport(0.0, 0.0, r as f32, r as f32, 0.0, 1.0);
+                for &(a, b) in &self.plan.draws[t] {
+                    pass.draw(a..b, 0..1);
+                }
+            });
+        }
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let group = self.eval_group(gpu, f);
+        timer.stage(gpu, "iasm.evaluate", |enc| {
+            enc.clear_buffer(&self.counts, 0, None);
+            gpu.dispatch_2d(enc, "iasm.evaluate", &self.eval, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
+        if self.delayed {
+            // this frame's analysis feeds the next frame (thesis 4.3: copied after the shadows)
+            self.analyse(gpu, f, timer);
+            self.pending = true;
+        }
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        super::images::report(self, gpu)
+    }
+}
+
+fn render_pipeline(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
+    let module = gpu.shader("iasm.render", &compose(RENDER_WGSL, true));
+    let layout = gpu.pipeline_layout("iasm.render", layouts);
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("iasm.render"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState { format: DUMMY_FORMAT, blend: None, write_mask: wgpu::ColorWrites::empty() })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// World AABBs of chunks of `chunk` triangles in vertex order, computed once on the GPU (the
+/// lab keeps no CPU copy of the vertices). Returns the boxes.
+fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Vec<(Vec3, Vec3)>, GpuError> {
+    let n = scene.triangle_count.div_ceil(chunk).max(1) as usize;
+    let d = &gpu.device;
+    let init: Vec<u32> = (0..n).flat_map(|_| [u32::MAX, u32::MAX, u32::MAX, 0, 0, 0]).collect();
+    let boxes = gpu.buffer_init(
+        "iasm.chunks",
+        bytemuck::cast_slice(&init),
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+    );
+    let cp = gpu.uniform("iasm.chunk_params", &[chunk, scene.triangle_count, 0, 0]);
+    let layout = binding::layout(d, "iasm.bounds", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
+    let group = binding::group(d, "iasm.bounds", &layout, &[cp.as_entire_binding(), boxes.as_entire_binding()]);
+    let pipeline = gpu.compute_pipeline("iasm.bounds", &compose(BOUNDS_WGSL, true), "main", &[&layout, &scene.layout]);
+    let groups = scene.triangle_count.div_ceil(64).max(1);
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.set_bind_group(1, &scene.group, &[]);
+        pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+    }
+    gpu.queue.submit([enc.finish()]);
+    gpu.take_error()?;
+    let w: Vec<u32> = gpu.read_buffer_as(&boxes, n * 6);
+    Ok(w.chunks_exact(6)
+        .map(|c| {
+            let lo = Vec3::new(unkey(c[0]), unkey(c[1]), unkey(c[2]));
+            let hi = Vec3::new(unkey(c[3]), unkey(c[4]), unkey(c[5]));
+            (lo, hi)
+        })
+        .collect())
+}

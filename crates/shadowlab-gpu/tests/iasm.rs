@@ -1,0 +1,111 @@
+//! GPU tests of `iasm` (seed 001 chapter 3).
+
+use glam::Vec2;
+use shadowlab_core::builtin::builtin;
+use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS};
+use shadowlab_core::params::TechniqueSpec;
+use shadowlab_gpu::lab::Lab;
+use shadowlab_gpu::techniques::iasm::Iasm;
+use shadowlab_gpu::techniques::{self, FrameInputs};
+
+mod common;
+use common::*;
+
+#[test]
+fn iasm_matches_rt_on_planebox_and_memory_is_exact() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let run = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
+    let a = agreement(&run.visibility, &rt.visibility, &v.mask);
+    if a < 99.0 {
+        panic!("iasm agrees with rt on {a:.3}%; {}", save_images("iasm-planebox", &v, &run, &rt));
+    }
+    assert_eq!(run.report.shadow_data_bytes, 6_860_800);
+    let c = &run.report.counters;
+    let empty = c["empty_tiles"] as usize;
+    let rendered: Vec<f64> = (0..16).map(|t| c[&format!("tile{t:02}.res")]).filter(|r| *r > 0.0).collect();
+    assert_eq!(rendered.len() + empty, 16);
+    assert!(!rendered.is_empty());
+    // the rendered tiles got the top of the set, in rank order
+    let mut sorted = rendered.clone();
+    sorted.sort_by(|a, b| b.total_cmp(a));
+    let want: Vec<f64> = THESIS_RESOLUTIONS[..rendered.len()].iter().map(|r| *r as f64).collect();
+    assert_eq!(sorted, want);
+    // empty tiles draw nothing; rendered ones draw something
+    for t in 0..16 {
+        let draws = c[&format!("tile{t:02}.draws")];
+        assert_eq!(draws > 0.0, c[&format!("tile{t:02}.res")] > 0.0, "tile {t}");
+    }
+    assert_eq!(run.report.images.len(), 2);
+}
+
+#[test]
+fn gpu_texel_index_matches_cpu_equations() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 64);
+    let values = techniques::resolve(&TechniqueSpec::parse("iasm").unwrap(), Some(&v.light)).unwrap().1;
+    let tech = Iasm::new(&gpu, &lab.gscene, &values, &v.light).unwrap();
+    let f = FrameInputs {
+        scene: &lab.gscene,
+        gbuffer: &v.gbuffer,
+        light: v.light,
+        light_buf: &v.light_buf,
+        frame: &v.frame,
+        visibility: &v.visibility,
+    };
+    // a scrambled assignment
+    let order = core::rank(&std::array::from_fn(|i| ((i * 11) % 16) as f64), &[false; 16]);
+    let res = core::assign(&order, &THESIS_RESOLUTIONS);
+    let off = core::offsets(&res);
+    let mut uvs = Vec::new();
+    let n = 1999;
+    for y in 0..n {
+        for x in (0..n).step_by(7) {
+            uvs.push(Vec2::new((x as f32 + 0.37) / n as f32, (y as f32 + 0.61) / n as f32));
+        }
+    }
+    uvs.extend([Vec2::ZERO, Vec2::new(0.25, 0.5), Vec2::new(0.999_999, 0.0), Vec2::new(0.5, 0.75)]);
+    let got = tech.probe_indices(&gpu, &f, &res, &uvs);
+    let mut mismatches = 0;
+    for (uv, (idx, tile)) in uvs.iter().zip(&got) {
+        let (t, _) = core::tile_of(*uv);
+        assert_eq!(*tile as usize, t, "tile of {uv}");
+        if *idx != core::texel_index(*uv, &res, &off) {
+            mismatches += 1;
+        }
+    }
+    // f32 rounding may move a point on a texel border by one texel; none are expected here
+    assert_eq!(mismatches, 0, "{mismatches} of {} indices differ", uvs.len());
+}
+
+#[test]
+fn delayed_iasm_on_a_still_camera_equals_iasm_after_the_first_frame() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let make = |spec: &str| {
+        let (info, p) = techniques::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
+        lab.instantiate(info, p, spec.into(), &v.light).unwrap()
+    };
+    let mut now = make("iasm");
+    let mut late = make("iasm:delayed=true");
+    let mut prev = None;
+    for frame in 0..3 {
+        let a = lab.step(&v, &mut now, false, 1).unwrap();
+        let b = lab.step(&v, &mut late, false, 1).unwrap();
+        assert_eq!(a.visibility, b.visibility, "frame {frame}");
+        for t in 0..16 {
+            let k = format!("tile{t:02}.res");
+            assert_eq!(a.report.counters[&k], b.report.counters[&k], "frame {frame} {k}");
+        }
+        if let Some(p) = prev.replace(a.visibility.clone()) {
+            assert_eq!(p, a.visibility, "still camera: frames differ");
+        }
+    }
+}
