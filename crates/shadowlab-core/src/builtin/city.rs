@@ -1,9 +1,10 @@
 //! A city block grid several hundred metres across under a low sun, for partitioned shadow maps
-//! over a wide area (seed 001, issue 6): 9 x 9 blocks of 2 x 2 buildings (10-60 m tall) on a
-//! 50 m pitch (450 m across), 14 m streets lined with thin street lamps, a ground paved per cell.
+//! over a wide area (seed 001, issue 6): 9 x 9 blocks of 2 x 2 buildings (5-20 m, some 30-60 m
+//! towers) on a 50 m pitch (450 m across), 20 m streets lined with thin street lamps, a ground paved per cell.
 //! The camera walks down a north-south street at eye height looking along it (near lamps large
 //! on screen, towers hundreds of metres away small), then turns into a cross street. The sun is
-//! 20 degrees high and diagonal to the grid, so long shadows cross the streets.
+//! 25 degrees high, travelling mostly along the camera's street towards it, so long shadows of
+//! lamps and buildings cross the streets and point at the viewer.
 
 use glam::{Vec2, Vec3};
 
@@ -17,13 +18,14 @@ pub const BLOCKS: i32 = 9;
 /// Block pitch (block + street), metres.
 pub const PITCH: f32 = 50.0;
 /// Street width, metres.
-pub const STREET: f32 = 14.0;
+pub const STREET: f32 = 20.0;
 /// Half the city's side.
 pub const HALF: f32 = BLOCKS as f32 * PITCH / 2.0;
 
-/// Where the sunlight travels: 20 degrees above the horizon, 35 degrees off the grid.
+/// Where the sunlight travels: 25 degrees above the horizon, 60 degrees off the x axis (mostly
+/// along the north-south streets, towards the starting camera: shadows point at the viewer).
 pub fn sun_direction() -> Vec3 {
-    let (el, az) = (20f32.to_radians(), 35f32.to_radians());
+    let (el, az) = (25f32.to_radians(), 60f32.to_radians());
     Vec3::new(el.cos() * az.cos(), -el.sin(), el.cos() * az.sin())
 }
 
@@ -70,11 +72,12 @@ pub fn build() -> Scene {
             let inner = PITCH - STREET;
             b.cuboid(Vec3::new(x0, 0.0, z0), Vec3::new(x0 + inner, 0.15, z0 + inner), walk);
             // 2 x 2 buildings set back 2 m, 3 m apart
-            let foot = (inner - 4.0 - 3.0) / 2.0;
+            let foot = (inner - 4.0 - 3.0) / 2.0; // 11.5 m
             for (a, c) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                 let bx = x0 + 2.0 + a as f32 * (foot + 3.0);
                 let bz = z0 + 2.0 + c as f32 * (foot + 3.0);
-                let h = 10.0 + 50.0 * rnd() * rnd();
+                // mostly 5-20 m, one in ten a 30-60 m tower
+                let h = if rnd() < 0.1 { 30.0 + 30.0 * rnd() } else { 5.0 + 15.0 * rnd() * rnd() };
                 let m = walls[(rnd() * 3.0) as usize % 3];
                 let shrink = 2.0 * rnd();
                 b.cuboid(Vec3::new(bx + shrink, 0.15, bz), Vec3::new(bx + foot, h, bz + foot - shrink), m);
@@ -124,7 +127,7 @@ mod tests {
         assert!(ext.x > 400.0 && ext.z > 400.0 && ext.y > 20.0, "{ext}");
         let Light::Directional { direction } = s.lights[0] else { panic!() };
         let elev = (-direction.normalize().y).asin().to_degrees();
-        assert!((elev - 20.0).abs() < 0.01);
+        assert!((elev - 25.0).abs() < 0.01);
         // the camera stands in a street: outside every block's pavement square
         for k in &s.camera_path {
             let p = k.position;

@@ -43,7 +43,7 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     },
     BuiltinScene {
         name: "city",
-        summary: "9 x 9 blocks of towers, 450 m across, street lamps, street-level camera, sun 20 degrees high (IASM/CSM wide area)",
+        summary: "9 x 9 blocks of towers, 450 m across, street lamps, street-level camera, sun 25 degrees high (IASM/CSM wide area)",
         build: city::build,
     },
 ];
