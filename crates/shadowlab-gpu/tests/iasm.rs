@@ -6,7 +6,7 @@ use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::techniques::iasm::Iasm;
-use shadowlab_gpu::techniques::{self, FrameInputs};
+use shadowlab_gpu::techniques;
 
 mod common;
 use common::*;
@@ -50,14 +50,6 @@ fn gpu_texel_index_matches_cpu_equations() {
     let v = view(&lab, &scene, 0, 64);
     let values = techniques::resolve(&TechniqueSpec::parse("iasm").unwrap(), Some(&v.light)).unwrap().1;
     let tech = Iasm::new(&gpu, &lab.gscene, &values, &v.light).unwrap();
-    let f = FrameInputs {
-        scene: &lab.gscene,
-        gbuffer: &v.gbuffer,
-        light: v.light,
-        light_buf: &v.light_buf,
-        frame: &v.frame,
-        visibility: &v.visibility,
-    };
     // a scrambled assignment
     let order = core::rank(&std::array::from_fn(|i| ((i * 11) % 16) as f64), &[false; 16]);
     let res = core::assign(&order, &THESIS_RESOLUTIONS);
@@ -70,7 +62,7 @@ fn gpu_texel_index_matches_cpu_equations() {
         }
     }
     uvs.extend([Vec2::ZERO, Vec2::new(0.25, 0.5), Vec2::new(0.999_999, 0.0), Vec2::new(0.5, 0.75)]);
-    let got = tech.probe_indices(&gpu, &f, &res, &uvs);
+    let got = tech.probe_indices(&gpu, &res, &uvs);
     let mut mismatches = 0;
     for (uv, (idx, tile)) in uvs.iter().zip(&got) {
         let (t, _) = core::tile_of(*uv);

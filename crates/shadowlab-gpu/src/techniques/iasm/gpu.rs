@@ -9,7 +9,7 @@ use shadowlab_core::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, 
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 
-use super::{analysis_src, eval_src, IasmParams, TileParams, BOUNDS_WGSL, RENDER_WGSL};
+use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, BOUNDS_WGSL, RENDER_WGSL};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
@@ -83,7 +83,6 @@ pub struct Iasm {
     camera_buf: wgpu::Buffer,
     pub(super) shadow: wgpu::Buffer,
     pub(super) counts: wgpu::Buffer,
-    pub(super) probe: wgpu::Buffer,
     tile_buf: wgpu::Buffer,
     tile_groups: Vec<wgpu::BindGroup>,
     dummy: wgpu::TextureView,
@@ -93,7 +92,6 @@ pub struct Iasm {
     render: wgpu::RenderPipeline,
     eval_layout: wgpu::BindGroupLayout,
     eval: wgpu::ComputePipeline,
-    probe_pipeline: wgpu::ComputePipeline,
 }
 
 impl Iasm {
@@ -122,7 +120,6 @@ impl Iasm {
         let camera_buf = gpu.storage("iasm.camera", 80);
         let shadow = gpu.storage("iasm.shadow", texels * core::TEXEL_BYTES);
         let counts = gpu.storage("iasm.counts", texels * 4);
-        let probe = gpu.storage("iasm.probe", 16);
         let tile_buf = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("iasm.tiles"),
             size: TILE_STRIDE * TILE_COUNT as u64,
@@ -162,9 +159,8 @@ impl Iasm {
         let analysis = gpu.compute_pipeline("iasm.analysis", &analysis_src(), "main", &[&analysis_layout]);
         let copy_camera = gpu.compute_pipeline("iasm.camera", &analysis_src(), "copy_camera", &[&analysis_layout]);
         let eval_layout =
-            view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false), binding::storage(false)]);
+            view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false)]);
         let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
-        let probe_pipeline = gpu.compute_pipeline("iasm.probe", &eval_src(), "probe_index", &[&eval_layout]);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
         Ok(Iasm {
             m: p.get("m") as f32,
@@ -187,7 +183,6 @@ impl Iasm {
             camera_buf,
             shadow,
             counts,
-            probe,
             tile_buf,
             tile_groups,
             dummy,
@@ -197,7 +192,6 @@ impl Iasm {
             render,
             eval_layout,
             eval,
-            probe_pipeline,
         })
     }
 
@@ -314,7 +308,7 @@ impl Iasm {
 
     /// The GPU's texel index and tile (equations 3.2-3.5 in eval.wgsl) of buffer coordinates
     /// `uvs` for resolutions `res` (offsets accumulated from them). For tests.
-    pub fn probe_indices(&self, gpu: &Gpu, f: &FrameInputs, res: &[u32; TILE_COUNT], uvs: &[glam::Vec2]) -> Vec<(u32, u32)> {
+    pub fn probe_indices(&self, gpu: &Gpu, res: &[u32; TILE_COUNT], uvs: &[glam::Vec2]) -> Vec<(u32, u32)> {
         let mut params = self.params();
         params.res = *res;
         params.off = core::offsets(res);
@@ -325,13 +319,13 @@ impl Iasm {
             bytemuck::cast_slice(&data),
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         );
-        let extra =
-            [ub.as_entire_binding(), self.shadow.as_entire_binding(), self.counts.as_entire_binding(), probe.as_entire_binding()];
-        let group = f.view_group(gpu, "iasm.probe", &self.eval_layout, &extra);
+        let layout = binding::layout(&gpu.device, "iasm.probe", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
+        let group = binding::group(&gpu.device, "iasm.probe", &layout, &[ub.as_entire_binding(), probe.as_entire_binding()]);
+        let pipeline = gpu.compute_pipeline("iasm.probe", &probe_src(), "probe_index", &[&layout]);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.probe_pipeline);
+            pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &group, &[]);
             pass.dispatch_workgroups((uvs.len() as u32).div_ceil(64), 1, 1);
         }
@@ -345,7 +339,6 @@ impl Iasm {
             self.params_buf.as_entire_binding(),
             self.shadow.as_entire_binding(),
             self.counts.as_entire_binding(),
-            self.probe.as_entire_binding(),
         ];
         f.view_group(gpu, "iasm.eval", &self.eval_layout, &extra)
     }

@@ -25,12 +25,16 @@ const ANALYSIS_WGSL: &str = include_str!("analysis.wgsl");
 const RENDER_WGSL: &str = include_str!("render.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
+const PROBE_WGSL: &str = include_str!("probe.wgsl");
 
 fn analysis_src() -> String {
     compose_view(&format!("{PARAMS_WGSL}{ANALYSIS_WGSL}"), false)
 }
 fn eval_src() -> String {
     compose_view(&format!("{PARAMS_WGSL}{EVAL_WGSL}"), false)
+}
+fn probe_src() -> String {
+    compose(&format!("{PARAMS_WGSL}{PROBE_WGSL}"), false)
 }
 
 pub fn shaders() -> Vec<(&'static str, String)> {
@@ -39,6 +43,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("iasm/render.wgsl", compose(RENDER_WGSL, true)),
         ("iasm/eval.wgsl", eval_src()),
         ("iasm/bounds.wgsl", compose(BOUNDS_WGSL, true)),
+        ("iasm/probe.wgsl", probe_src()),
     ]
 }
 
