@@ -184,6 +184,30 @@ pub fn fragment_index(frag: Vec2, r: u32, i0: u32) -> u32 {
     i0 + frag.y.floor() as u32 * r + frag.x.floor() as u32
 }
 
+/// The conventional alternative to the linear buffer: the 16 tiles as squares in one depth
+/// atlas of 2 r0 x r0 texels (r0 = the largest resolution), placed by buddy allocation (powers
+/// of two, largest first). Returns (width, height, top-left corner per rank), or None when the
+/// set is not powers of two or does not fit.
+pub fn atlas_layout(set: &[u32; TILE_COUNT]) -> Option<(u32, u32, [[u32; 2]; TILE_COUNT])> {
+    let s0 = set[0];
+    if set.iter().any(|r| !r.is_power_of_two()) || set.windows(2).any(|w| w[0] < w[1]) {
+        return None;
+    }
+    // free squares (x, y, side)
+    let mut free = vec![(0u32, 0u32, s0), (s0, 0, s0)];
+    let mut out = [[0u32; 2]; TILE_COUNT];
+    for (i, &r) in set.iter().enumerate() {
+        let best = free.iter().enumerate().filter(|(_, f)| f.2 >= r).min_by_key(|(_, f)| (f.2, f.1, f.0))?.0;
+        let (x, y, mut side) = free.swap_remove(best);
+        while side > r {
+            side /= 2;
+            free.extend([(x + side, y, side), (x, y + side, side), (x + side, y + side, side)]);
+        }
+        out[i] = [x, y];
+    }
+    Some((2 * s0, s0, out))
+}
+
 /// Which of `boxes` (light-space (x, y, depth) min/max) overlap tile `t`'s column: the four side
 /// planes (thesis 3.5, near and far ignored).
 pub fn cull(p: &Placement, t: usize, boxes: &[(Vec3, Vec3)]) -> Vec<usize> {
@@ -379,6 +403,27 @@ mod tests {
             let c = world(0.5 * (min.x + max.x), 0.5 * (min.y + max.y), 0.0);
             assert_eq!(tile_of(p.uv(c)).0, t);
         }
+    }
+
+    #[test]
+    fn atlas_layout_packs_without_overlap() {
+        let (w, h, pos) = atlas_layout(&THESIS_RESOLUTIONS).unwrap();
+        assert_eq!((w, h), (2048, 1024));
+        let mut used = vec![false; (w * h) as usize];
+        for (i, p) in pos.iter().enumerate() {
+            let r = THESIS_RESOLUTIONS[i];
+            assert!(p[0] + r <= w && p[1] + r <= h);
+            assert!(p[0] % r == 0 && p[1] % r == 0, "aligned like a buddy block");
+            for y in p[1]..p[1] + r {
+                for x in p[0]..p[0] + r {
+                    assert!(!std::mem::replace(&mut used[(y * w + x) as usize], true), "overlap at {x},{y}");
+                }
+            }
+        }
+        assert_eq!(used.iter().filter(|u| **u).count() as u64, texels(&THESIS_RESOLUTIONS));
+        assert_eq!(pos[0], [0, 0]);
+        assert!(atlas_layout(&[1024, 512, 512, 256, 128, 128, 128, 128, 64, 64, 32, 32, 16, 16, 16, 12]).is_none());
+        assert!(atlas_layout(&[1024; 16]).is_none(), "16 x 1024 does not fit in 2048 x 1024");
     }
 
     #[test]

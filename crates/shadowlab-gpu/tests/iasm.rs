@@ -101,3 +101,23 @@ fn delayed_iasm_on_a_still_camera_equals_iasm_after_the_first_frame() {
         }
     }
 }
+
+#[test]
+fn atlas_store_matches_buffer_store() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let buf = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
+    let atl = lab.run(&v, &TechniqueSpec::parse("iasm:store=atlas").unwrap(), 1).unwrap();
+    // the same tiles, frusta and depths; only where the depth lives differs
+    let a = agreement(&atl.visibility, &buf.visibility, &v.mask);
+    assert!(a >= 99.9, "atlas and buffer agree on {a:.3}%");
+    for t in 0..16 {
+        let k = format!("tile{t:02}.res");
+        assert_eq!(atl.report.counters[&k], buf.report.counters[&k], "{k}");
+    }
+    // 2048 x 1024 depth texels (buddy-packed thesis set) against the buffer's exact set
+    assert_eq!(atl.report.shadow_data_bytes, 2048 * 1024 * 4);
+    assert_eq!(buf.report.shadow_data_bytes, 6_860_800);
+}

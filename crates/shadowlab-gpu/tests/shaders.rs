@@ -138,7 +138,7 @@ fn iasm_layouts_match_wgsl() {
     use shadowlab_gpu::techniques::iasm::{IasmParams, TileParams};
     let all = shadowlab_gpu::shaders::all();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
-    for n in ["iasm/analysis.wgsl", "iasm/eval.wgsl"] {
+    for n in ["iasm/analysis.wgsl", "iasm/eval.wgsl", "iasm/eval_atlas.wgsl", "iasm/probe.wgsl"] {
         check(
             &get(n),
             "IasmParams",
@@ -151,8 +151,11 @@ fn iasm_layouts_match_wgsl() {
                 ("off", offset_of!(IasmParams, off)),
                 ("near", offset_of!(IasmParams, near)),
                 ("far", offset_of!(IasmParams, far)),
+                ("slot", offset_of!(IasmParams, slot)),
             ],
         );
     }
-    check(&get("iasm/render.wgsl"), "TileParams", size_of::<TileParams>(), &[("tile", offset_of!(TileParams, tile))]);
+    for n in ["iasm/render.wgsl", "iasm/atlas.wgsl"] {
+        check(&get(n), "TileParams", size_of::<TileParams>(), &[("tile", offset_of!(TileParams, tile))]);
+    }
 }

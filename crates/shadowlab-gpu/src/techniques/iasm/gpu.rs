@@ -9,12 +9,12 @@ use shadowlab_core::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, 
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 
-use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, BOUNDS_WGSL, RENDER_WGSL};
+use super::{analysis_src, eval_atlas_src, eval_src, probe_src, IasmParams, TileParams, ATLAS_WGSL, BOUNDS_WGSL, RENDER_WGSL};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, Gpu, GpuError};
+use crate::{binding, raster, Gpu, GpuError};
 
 const TILE_STRIDE: u64 = 256;
 const DUMMY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
@@ -60,6 +60,17 @@ pub struct Plan {
     pub draws: Vec<Vec<(u32, u32)>>,
 }
 
+/// The conventional alternative: the tiles in a depth atlas (store=atlas).
+pub struct Atlas {
+    pub texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    /// Top-left corner per rank.
+    pub slots: [[u32; 2]; TILE_COUNT],
+    pipeline: wgpu::RenderPipeline,
+    eval_layout: wgpu::BindGroupLayout,
+    eval: wgpu::ComputePipeline,
+}
+
 pub struct Iasm {
     pub(super) m: f32,
     pub(super) k: f32,
@@ -76,6 +87,7 @@ pub struct Iasm {
     boxes: Vec<(Vec3, Vec3)>,
     pub placement: Placement,
     pub plan: Plan,
+    pub atlas: Option<Atlas>,
     /// Delayed: the analysis of the previous frame is in `stats_buf`.
     pending: bool,
     pub(super) params_buf: wgpu::Buffer,
@@ -162,6 +174,7 @@ impl Iasm {
             view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false)]);
         let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
+        let atlas = (p.get_u32("store") == 1).then(|| make_atlas(gpu, &[&render_layout, &scene.layout])).transpose()?;
         Ok(Iasm {
             m: p.get("m") as f32,
             k: p.get("k") as f32,
@@ -177,6 +190,7 @@ impl Iasm {
             boxes,
             placement: basis,
             plan: Plan::default(),
+            atlas,
             pending: false,
             params_buf,
             stats_buf,
@@ -204,6 +218,12 @@ impl Iasm {
         let p = &self.placement;
         let k = if self.k > 0.0 { self.k } else { 0.5 * p.size };
         let res = std::array::from_fn(|t| if self.plan.empty[t] { 0 } else { self.plan.res[t] });
+        let mut slot = [0; TILE_COUNT];
+        if let Some(a) = &self.atlas {
+            for (rank, &t) in self.plan.order.iter().enumerate() {
+                slot[t] = a.slots[rank][0] | a.slots[rank][1] << 16;
+            }
+        }
         IasmParams {
             right: p.right.extend(p.origin.x).into(),
             up: p.up.extend(p.origin.y).into(),
@@ -213,6 +233,7 @@ impl Iasm {
             off: self.plan.off,
             near: self.plan.near,
             far: self.plan.far,
+            slot,
         }
     }
 
@@ -335,12 +356,52 @@ impl Iasm {
     }
 
     pub(super) fn eval_group(&self, gpu: &Gpu, f: &FrameInputs) -> wgpu::BindGroup {
+        if let Some(a) = &self.atlas {
+            let extra = [self.params_buf.as_entire_binding(), wgpu::BindingResource::TextureView(&a.view), self.counts.as_entire_binding()];
+            return f.view_group(gpu, "iasm.eval", &a.eval_layout, &extra);
+        }
         let extra = [
             self.params_buf.as_entire_binding(),
             self.shadow.as_entire_binding(),
             self.counts.as_entire_binding(),
         ];
         f.view_group(gpu, "iasm.eval", &self.eval_layout, &extra)
+    }
+}
+
+impl Iasm {
+    fn render_atlas(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer, a: &Atlas) {
+        timer.stage(gpu, "iasm.shadows.clear", |enc| {
+            drop(raster::begin_pass(enc, "iasm.shadows.clear", &[], &a.view));
+        });
+        for (rank, &t) in self.plan.order.iter().enumerate() {
+            if self.plan.empty[t] {
+                continue;
+            }
+            let (r, [x, y]) = (self.plan.res[t], a.slots[rank]);
+            timer.stage(gpu, &format!("iasm.shadows.t{t:02}"), |enc| {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("iasm.shadows"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &a.view,
+                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&a.pipeline);
+                pass.set_bind_group(0, &self.tile_groups[t], &[]);
+                pass.set_bind_group(1, &f.scene.group, &[]);
+                pass.set_viewport(x as f32, y as f32, r as f32, r as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, r, r);
+                for &(a, b) in &self.plan.draws[t] {
+                    pass.draw(a..b, 0..1);
+                }
+            });
+        }
     }
 }
 
@@ -357,6 +418,10 @@ impl Technique for Iasm {
     }
 
     fn render(&mut self, gpu: &Gpu, _f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        if let Some(a) = &self.atlas {
+            self.render_atlas(gpu, _f, timer, a);
+            return Ok(());
+        }
         timer.stage(gpu, "iasm.shadows.clear", |enc| enc.clear_buffer(&self.shadow, 0, None));
         for t in 0..TILE_COUNT {
             if self.plan.empty[t] {
@@ -393,7 +458,8 @@ impl Technique for Iasm {
         let group = self.eval_group(gpu, f);
         timer.stage(gpu, "iasm.evaluate", |enc| {
             enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, "iasm.evaluate", &self.eval, &[&group], f.gbuffer.width, f.gbuffer.height)
+            let pipeline = self.atlas.as_ref().map_or(&self.eval, |a| &a.eval);
+            gpu.dispatch_2d(enc, "iasm.evaluate", pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
         });
         if self.delayed {
             // this frame's analysis feeds the next frame (thesis 4.3: copied after the shadows)
@@ -406,6 +472,26 @@ impl Technique for Iasm {
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
         super::images::report(self, gpu)
     }
+}
+
+fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Result<Atlas, GpuError> {
+    let (w, h, slots) = core::atlas_layout(&THESIS_RESOLUTIONS).ok_or_else(|| GpuError::Invalid("iasm: resolution set does not fit an atlas".into()))?;
+    gpu.check_size(w, h, "iasm atlas")?;
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("iasm.atlas"),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: raster::DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose(ATLAS_WGSL, true), layouts, &[]);
+    let eval_layout = view_layout(gpu, "iasm.eval_atlas", &[binding::uniform(), binding::texture_depth(), binding::storage(false)]);
+    let eval = gpu.compute_pipeline("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout]);
+    Ok(Atlas { texture, view, slots, pipeline, eval_layout, eval })
 }
 
 fn render_pipeline(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {

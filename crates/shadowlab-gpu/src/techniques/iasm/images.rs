@@ -15,9 +15,12 @@ const CELL: u32 = 128;
 pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
     let texels = core::texels(&THESIS_RESOLUTIONS);
     let counts: Vec<u32> = gpu.read_buffer_as(&t.counts, texels as usize);
-    let shadow: Vec<u32> = gpu.read_buffer_as(&t.shadow, texels as usize);
     let plan = &t.plan;
-    let mut r = TechniqueReport { shadow_data_bytes: texels * core::TEXEL_BYTES, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+    let (shadow, bytes) = match &t.atlas {
+        None => (gpu.read_buffer_as(&t.shadow, texels as usize), texels * core::TEXEL_BYTES),
+        Some(a) => (atlas_as_buffer(t, a, gpu), a.texture.width() as u64 * a.texture.height() as u64 * 4),
+    };
+    let mut r = TechniqueReport { shadow_data_bytes: bytes, sampling: Some(sampling_stats(&counts)), ..Default::default() };
     let c = &mut r.counters;
     c.insert("fetches_per_pixel".into(), 1.0);
     c.insert("shadow_buffer_texels".into(), texels as f64);
@@ -42,6 +45,27 @@ pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
     r.images.push(mosaic(t, &shadow));
     r.images.push(resolution_picture(t));
     r
+}
+
+/// The atlas's tiles copied into the linear layout in the buffer's encoding (bits of 1 - z; 0 =
+/// nothing), for the same picture.
+fn atlas_as_buffer(t: &Iasm, a: &super::gpu::Atlas, gpu: &Gpu) -> Vec<u32> {
+    let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&a.texture, 4));
+    let w = a.texture.width();
+    let plan = &t.plan;
+    let mut out = vec![0u32; core::texels(&THESIS_RESOLUTIONS) as usize];
+    for (rank, &i) in plan.order.iter().enumerate() {
+        let (r, [x0, y0]) = (plan.res[i], a.slots[rank]);
+        for y in 0..r {
+            for x in 0..r {
+                let z = depth[((y0 + y) * w + x0 + x) as usize];
+                if z < 1.0 {
+                    out[(plan.off[i] + y * r + x) as usize] = (1.0 - z).to_bits();
+                }
+            }
+        }
+    }
+    out
 }
 
 /// The tiles' stored depth in light-space units (comparable across tiles), each tile resampled

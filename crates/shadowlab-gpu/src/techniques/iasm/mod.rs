@@ -26,12 +26,17 @@ const RENDER_WGSL: &str = include_str!("render.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
 const PROBE_WGSL: &str = include_str!("probe.wgsl");
+const ATLAS_WGSL: &str = include_str!("atlas.wgsl");
+const EVAL_ATLAS_WGSL: &str = include_str!("eval_atlas.wgsl");
 
 fn analysis_src() -> String {
     compose_view(&format!("{PARAMS_WGSL}{ANALYSIS_WGSL}"), false)
 }
 fn eval_src() -> String {
     compose_view(&format!("{PARAMS_WGSL}{EVAL_WGSL}"), false)
+}
+fn eval_atlas_src() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{EVAL_ATLAS_WGSL}"), false)
 }
 fn probe_src() -> String {
     compose(&format!("{PARAMS_WGSL}{PROBE_WGSL}"), false)
@@ -44,6 +49,8 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("iasm/eval.wgsl", eval_src()),
         ("iasm/bounds.wgsl", compose(BOUNDS_WGSL, true)),
         ("iasm/probe.wgsl", probe_src()),
+        ("iasm/atlas.wgsl", compose(ATLAS_WGSL, true)),
+        ("iasm/eval_atlas.wgsl", eval_atlas_src()),
     ]
 }
 
@@ -150,6 +157,16 @@ pub const PARAMS: &[ParamDef] = &[
         choices: &["circle", "tile"],
     },
     ParamDef {
+        key: "store",
+        default: 0.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)",
+        source: "seed 001 3.2/3.5; issue 6 asks for both (docs/bench/iasm.md)",
+        choices: &["buffer", "atlas"],
+    },
+    ParamDef {
         key: "chunk",
         default: DEFAULT_CHUNK,
         min: 1.0,
@@ -184,6 +201,8 @@ pub struct IasmParams {
     pub off: [u32; 16],
     pub near: [f32; 16],
     pub far: [f32; 16],
+    /// store=atlas: top-left corner of each tile's square, x | y << 16.
+    pub slot: [u32; 16],
 }
 
 /// WGSL `TileParams` (render.wgsl).

@@ -18,6 +18,8 @@ struct IasmParams {
     // per-tile near / far light depth of the tile frustum
     near: array<vec4<f32>, 4>,
     far: array<vec4<f32>, 4>,
+    // store=atlas: per-tile top-left corner in the atlas, x | y << 16
+    slot: array<vec4<u32>, 4>,
 }
 
 const TILES: f32 = 4.0;
@@ -41,12 +43,55 @@ fn tile_res(ip: IasmParams, t: u32) -> u32 {
     return ip.res[t / 4u][t % 4u];
 }
 
-// Equations 3.4, 3.5 (with the tile corner at p_t / n; see iasm.rs `texel_index`).
-fn buffer_index(ip: IasmParams, uv: vec2<f32>) -> u32 {
+// Texel p_b of uv inside its tile (equation 3.4, with the tile corner at p_t / n; see iasm.rs
+// `texel_index`).
+fn tile_texel(ip: IasmParams, uv: vec2<f32>) -> vec2<u32> {
     let t = tile_of(uv);
     let pt = clamp(floor(uv * TILES), vec2<f32>(0.0), vec2<f32>(TILES - 1.0));
-    let r = tile_res(ip, t);
-    let rf = f32(r);
-    let pb = clamp(floor((uv * TILES - pt) * rf), vec2<f32>(0.0), vec2<f32>(rf - 1.0));
-    return ip.off[t / 4u][t % 4u] + u32(pb.x) + u32(pb.y) * r;
+    let rf = f32(tile_res(ip, t));
+    return vec2<u32>(clamp(floor((uv * TILES - pt) * rf), vec2<f32>(0.0), vec2<f32>(rf - 1.0)));
+}
+
+// Equation 3.5: index in the linear buffer.
+fn buffer_index(ip: IasmParams, uv: vec2<f32>) -> u32 {
+    let t = tile_of(uv);
+    let pb = tile_texel(ip, uv);
+    return ip.off[t / 4u][t % 4u] + pb.x + pb.y * tile_res(ip, t);
+}
+
+// Where an evaluated sample looks its shadow up. `ok` false: outside the square or in an empty
+// tile (lit). Bias and normal offset are in texels of the tile the sample itself lies in.
+struct Lookup {
+    ok: bool,
+    // buffer coordinates of the offset sample, its tile, its depth in that tile's frustum
+    uv: vec2<f32>,
+    t: u32,
+    z: f32,
+    // buffer coordinates of the sample itself (sampling statistics)
+    uv0: vec2<f32>,
+}
+
+fn lookup(ip: IasmParams, p: vec3<f32>, n: vec3<f32>) -> Lookup {
+    var o: Lookup;
+    o.ok = false;
+    o.uv0 = buffer_uv(ip, p);
+    if !inside(o.uv0) {
+        return o;
+    }
+    let r0 = tile_res(ip, tile_of(o.uv0));
+    if r0 == 0u {
+        return o;
+    }
+    let texel = ip.dir.w / (TILES * f32(r0));
+    let q = p + n * (ip.imp.w * texel) - ip.dir.xyz * (ip.imp.z * texel);
+    o.uv = buffer_uv(ip, q);
+    o.t = tile_of(o.uv);
+    if !inside(o.uv) || tile_res(ip, o.t) == 0u {
+        return o;
+    }
+    let near = ip.near[o.t / 4u][o.t % 4u];
+    let far = ip.far[o.t / 4u][o.t % 4u];
+    o.z = (dot(q, ip.dir.xyz) - near) / max(far - near, 1e-6);
+    o.ok = true;
+    return o;
 }
