@@ -126,9 +126,7 @@ pub fn importance(w: f32, m: f32, k: f32) -> f32 {
 /// tile index ascending; then the empty tiles in index order. Deterministic for any input.
 pub fn rank(importance: &[f64; TILE_COUNT], empty: &[bool; TILE_COUNT]) -> [usize; TILE_COUNT] {
     let mut order: [usize; TILE_COUNT] = std::array::from_fn(|i| i);
-    order.sort_by(|&a, &b| {
-        empty[a].cmp(&empty[b]).then_with(|| importance[b].total_cmp(&importance[a])).then_with(|| a.cmp(&b))
-    });
+    order.sort_by(|&a, &b| empty[a].cmp(&empty[b]).then_with(|| importance[b].total_cmp(&importance[a])).then_with(|| a.cmp(&b)));
     order
 }
 
@@ -212,12 +210,7 @@ pub fn atlas_layout(set: &[u32; TILE_COUNT]) -> Option<(u32, u32, [[u32; 2]; TIL
 /// planes (thesis 3.5, near and far ignored).
 pub fn cull(p: &Placement, t: usize, boxes: &[(Vec3, Vec3)]) -> Vec<usize> {
     let (min, max) = p.tile_rect(t);
-    boxes
-        .iter()
-        .enumerate()
-        .filter(|(_, (a, b))| a.x <= max.x && b.x >= min.x && a.y <= max.y && b.y >= min.y)
-        .map(|(i, _)| i)
-        .collect()
+    boxes.iter().enumerate().filter(|(_, (a, b))| a.x <= max.x && b.x >= min.x && a.y <= max.y && b.y >= min.y).map(|(i, _)| i).collect()
 }
 
 /// Light-space AABB (x, y, depth) of a world AABB.

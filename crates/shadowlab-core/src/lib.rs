@@ -5,8 +5,8 @@
 pub mod builtin;
 pub mod bvh;
 pub mod camera;
-pub mod light;
 pub mod iasm;
+pub mod light;
 pub mod lightspace;
 pub mod loaders;
 pub mod metrics;

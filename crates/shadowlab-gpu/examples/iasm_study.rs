@@ -64,11 +64,8 @@ fn main() -> Res {
 fn path_study(lab: &Lab, scene: &Scene, cam: &Camera, size: u32, frames: usize, specs: &[String]) -> Res {
     let light = scene.lights[0];
     let cams = path_cameras(cam, &scene.camera_path, frames);
-    let views: Vec<View> = cams
-        .iter()
-        .enumerate()
-        .map(|(i, c)| lab.view(c, &cams[i.saturating_sub(1)], &light, size, size))
-        .collect::<Result<_, _>>()?;
+    let views: Vec<View> =
+        cams.iter().enumerate().map(|(i, c)| lab.view(c, &cams[i.saturating_sub(1)], &light, size, size)).collect::<Result<_, _>>()?;
     let rts: Vec<Vec<f32>> = views.iter().map(|v| lab.reference(v, 1).map(|r| r.visibility)).collect::<Result<_, _>>()?;
     println!("\n## path: {frames} frames along the scene's camera path");
     println!("| spec | wrong % (mean) | wrong % (max) | flicker % (mean) | flicker % (max) |");

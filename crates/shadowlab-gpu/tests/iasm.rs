@@ -5,8 +5,8 @@ use shadowlab_core::builtin::builtin;
 use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
-use shadowlab_gpu::techniques::iasm::Iasm;
 use shadowlab_gpu::techniques;
+use shadowlab_gpu::techniques::iasm::Iasm;
 
 mod common;
 use common::*;

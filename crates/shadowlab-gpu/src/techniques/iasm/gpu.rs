@@ -170,8 +170,7 @@ impl Iasm {
         let analysis_layout = view_layout(gpu, "iasm.analysis", &[binding::uniform(), binding::storage(false), binding::storage(false)]);
         let analysis = gpu.compute_pipeline("iasm.analysis", &analysis_src(), "main", &[&analysis_layout]);
         let copy_camera = gpu.compute_pipeline("iasm.camera", &analysis_src(), "copy_camera", &[&analysis_layout]);
-        let eval_layout =
-            view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false)]);
+        let eval_layout = view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false)]);
         let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
         let atlas = (p.get_u32("store") == 1).then(|| make_atlas(gpu, &[&render_layout, &scene.layout])).transpose()?;
@@ -340,7 +339,8 @@ impl Iasm {
             bytemuck::cast_slice(&data),
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         );
-        let layout = binding::layout(&gpu.device, "iasm.probe", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
+        let layout =
+            binding::layout(&gpu.device, "iasm.probe", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
         let group = binding::group(&gpu.device, "iasm.probe", &layout, &[ub.as_entire_binding(), probe.as_entire_binding()]);
         let pipeline = gpu.compute_pipeline("iasm.probe", &probe_src(), "probe_index", &[&layout]);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -360,11 +360,7 @@ impl Iasm {
             let extra = [self.params_buf.as_entire_binding(), wgpu::BindingResource::TextureView(&a.view), self.counts.as_entire_binding()];
             return f.view_group(gpu, "iasm.eval", &a.eval_layout, &extra);
         }
-        let extra = [
-            self.params_buf.as_entire_binding(),
-            self.shadow.as_entire_binding(),
-            self.counts.as_entire_binding(),
-        ];
+        let extra = [self.params_buf.as_entire_binding(), self.shadow.as_entire_binding(), self.counts.as_entire_binding()];
         f.view_group(gpu, "iasm.eval", &self.eval_layout, &extra)
     }
 }
@@ -475,7 +471,8 @@ impl Technique for Iasm {
 }
 
 fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Result<Atlas, GpuError> {
-    let (w, h, slots) = core::atlas_layout(&THESIS_RESOLUTIONS).ok_or_else(|| GpuError::Invalid("iasm: resolution set does not fit an atlas".into()))?;
+    let (w, h, slots) =
+        core::atlas_layout(&THESIS_RESOLUTIONS).ok_or_else(|| GpuError::Invalid("iasm: resolution set does not fit an atlas".into()))?;
     gpu.check_size(w, h, "iasm atlas")?;
     let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("iasm.atlas"),

@@ -180,7 +180,8 @@ pub const PARAMS: &[ParamDef] = &[
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "iasm",
-    summary: "Irregular Adaptive Shadow Maps: 4x4 tiles ahead of the camera, resolutions 1x1024..4x16 by importance rank, one linear buffer",
+    summary:
+        "Irregular Adaptive Shadow Maps: 4x4 tiles ahead of the camera, resolutions 1x1024..4x16 by importance rank, one linear buffer",
     cost: "importance pass + readback, up to 16 culled tile passes with atomic depth writes, 1 fetch per pixel",
     quality: "resolution follows the camera; tile seams where neighbours differ (four-tile corners, thesis Fig. 4.4)",
     source: "seed 001 (IASM thesis) chapter 3",
