@@ -9,12 +9,14 @@ use shadowlab_core::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, 
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 
-use super::{analysis_src, eval_atlas_src, eval_src, probe_src, IasmParams, TileParams, ATLAS_WGSL, BOUNDS_WGSL, RENDER_WGSL};
+use super::atlas::{make_atlas, Atlas};
+use super::chunks::chunk_bounds;
+use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, RENDER_WGSL};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, raster, Gpu, GpuError};
+use crate::{binding, Gpu, GpuError};
 
 const TILE_STRIDE: u64 = 256;
 const DUMMY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
@@ -28,7 +30,7 @@ pub struct TileStats {
     pub depth_max: [f32; TILE_COUNT],
 }
 
-fn unkey(k: u32) -> f32 {
+pub(super) fn unkey(k: u32) -> f32 {
     f32::from_bits(if k & 0x8000_0000 != 0 { k & 0x7fff_ffff } else { !k })
 }
 
@@ -60,17 +62,6 @@ pub struct Plan {
     pub draws: Vec<Vec<(u32, u32)>>,
 }
 
-/// The conventional alternative: the tiles in a depth atlas (store=atlas).
-pub struct Atlas {
-    pub texture: wgpu::Texture,
-    view: wgpu::TextureView,
-    /// Top-left corner per rank.
-    pub slots: [[u32; 2]; TILE_COUNT],
-    pipeline: wgpu::RenderPipeline,
-    eval_layout: wgpu::BindGroupLayout,
-    eval: wgpu::ComputePipeline,
-}
-
 pub struct Iasm {
     pub(super) m: f32,
     pub(super) k: f32,
@@ -96,7 +87,7 @@ pub struct Iasm {
     pub(super) shadow: wgpu::Buffer,
     pub(super) counts: wgpu::Buffer,
     tile_buf: wgpu::Buffer,
-    tile_groups: Vec<wgpu::BindGroup>,
+    pub(super) tile_groups: Vec<wgpu::BindGroup>,
     dummy: wgpu::TextureView,
     analysis_layout: wgpu::BindGroupLayout,
     analysis: wgpu::ComputePipeline,
@@ -365,42 +356,6 @@ impl Iasm {
     }
 }
 
-impl Iasm {
-    fn render_atlas(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer, a: &Atlas) {
-        timer.stage(gpu, "iasm.shadows.clear", |enc| {
-            drop(raster::begin_pass(enc, "iasm.shadows.clear", &[], &a.view));
-        });
-        for (rank, &t) in self.plan.order.iter().enumerate() {
-            if self.plan.empty[t] {
-                continue;
-            }
-            let (r, [x, y]) = (self.plan.res[t], a.slots[rank]);
-            timer.stage(gpu, &format!("iasm.shadows.t{t:02}"), |enc| {
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("iasm.shadows"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &a.view,
-                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&a.pipeline);
-                pass.set_bind_group(0, &self.tile_groups[t], &[]);
-                pass.set_bind_group(1, &f.scene.group, &[]);
-                pass.set_viewport(x as f32, y as f32, r as f32, r as f32, 0.0, 1.0);
-                pass.set_scissor_rect(x, y, r, r);
-                for &(a, b) in &self.plan.draws[t] {
-                    pass.draw(a..b, 0..1);
-                }
-            });
-        }
-    }
-}
-
 impl Technique for Iasm {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         self.place(gpu, f, timer);
@@ -470,27 +425,6 @@ impl Technique for Iasm {
     }
 }
 
-fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Result<Atlas, GpuError> {
-    let (w, h, slots) =
-        core::atlas_layout(&THESIS_RESOLUTIONS).ok_or_else(|| GpuError::Invalid("iasm: resolution set does not fit an atlas".into()))?;
-    gpu.check_size(w, h, "iasm atlas")?;
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("iasm.atlas"),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: raster::DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
-    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose(ATLAS_WGSL, true), layouts, &[]);
-    let eval_layout = view_layout(gpu, "iasm.eval_atlas", &[binding::uniform(), binding::texture_depth(), binding::storage(false)]);
-    let eval = gpu.compute_pipeline("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout]);
-    Ok(Atlas { texture, view, slots, pipeline, eval_layout, eval })
-}
-
 fn render_pipeline(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
     let module = gpu.shader("iasm.render", &compose(RENDER_WGSL, true));
     let layout = gpu.pipeline_layout("iasm.render", layouts);
@@ -510,40 +444,4 @@ fn render_pipeline(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::Rende
         multiview_mask: None,
         cache: None,
     })
-}
-
-/// World AABBs of chunks of `chunk` triangles in vertex order, computed once on the GPU (the
-/// lab keeps no CPU copy of the vertices). Returns the boxes.
-fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Vec<(Vec3, Vec3)>, GpuError> {
-    let n = scene.triangle_count.div_ceil(chunk).max(1) as usize;
-    let d = &gpu.device;
-    let init: Vec<u32> = (0..n).flat_map(|_| [u32::MAX, u32::MAX, u32::MAX, 0, 0, 0]).collect();
-    let boxes = gpu.buffer_init(
-        "iasm.chunks",
-        bytemuck::cast_slice(&init),
-        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-    );
-    let cp = gpu.uniform("iasm.chunk_params", &[chunk, scene.triangle_count, 0, 0]);
-    let layout = binding::layout(d, "iasm.bounds", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
-    let group = binding::group(d, "iasm.bounds", &layout, &[cp.as_entire_binding(), boxes.as_entire_binding()]);
-    let pipeline = gpu.compute_pipeline("iasm.bounds", &compose(BOUNDS_WGSL, true), "main", &[&layout, &scene.layout]);
-    let groups = scene.triangle_count.div_ceil(64).max(1);
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.set_bind_group(1, &scene.group, &[]);
-        pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
-    }
-    gpu.queue.submit([enc.finish()]);
-    gpu.take_error()?;
-    let w: Vec<u32> = gpu.read_buffer_as(&boxes, n * 6);
-    Ok(w.chunks_exact(6)
-        .map(|c| {
-            let lo = Vec3::new(unkey(c[0]), unkey(c[1]), unkey(c[2]));
-            let hi = Vec3::new(unkey(c[3]), unkey(c[4]), unkey(c[5]));
-            (lo, hi)
-        })
-        .collect())
 }

@@ -49,7 +49,7 @@ pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
 
 /// The atlas's tiles copied into the linear layout in the buffer's encoding (bits of 1 - z; 0 =
 /// nothing), for the same picture.
-fn atlas_as_buffer(t: &Iasm, a: &super::gpu::Atlas, gpu: &Gpu) -> Vec<u32> {
+fn atlas_as_buffer(t: &Iasm, a: &super::atlas::Atlas, gpu: &Gpu) -> Vec<u32> {
     let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&a.texture, 4));
     let w = a.texture.width();
     let plan = &t.plan;

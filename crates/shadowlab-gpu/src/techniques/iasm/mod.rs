@@ -9,6 +9,8 @@
 //! linear, 0 = at the tile's near plane (nearest the light); cleared texels read z = 1.
 //! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::iasm`.
 
+mod atlas;
+mod chunks;
 mod gpu;
 mod images;
 
