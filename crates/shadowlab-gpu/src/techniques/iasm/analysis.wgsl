@@ -1,8 +1,9 @@
 // Scene analysis (thesis 3.3 and the deferred near/far planes of 3.5): every evaluated view
 // sample adds its importance p = 1 + m clamp(1 - w/k, 0, 1) (equation 3.1, w = clip w = view
-// depth) to its tile in 1/64 fixed point, and the tile's min/max light depth is updated with
-// atomic min/max on order-preserving u32 keys. A workgroup first reduces into shared memory,
-// then one thread per tile adds to the global stats (64-bit sum: low word + carry).
+// depth) to its tile in 1/64 fixed point (64-bit sum: low word + carry), and updates the tile's
+// min/max light depth with atomic min/max on order-preserving u32 keys. Per-sample global
+// atomics as the thesis does (InterlockedAdd); a workgroup pre-reduction in shared memory was
+// 3x slower on lavapipe (barriers), 127 vs 41 ms at 1024x1024.
 // Stats per tile (8 u32): imp_lo, imp_hi, samples, depth_min key, depth_max key, 3 unused.
 
 @group(0) @binding(6) var<uniform> ip: IasmParams;
@@ -10,11 +11,6 @@
 @group(0) @binding(8) var<storage, read_write> camera: array<vec4<f32>, 5>;
 
 const FIXED: f32 = 64.0;
-
-var<workgroup> wg_imp: array<atomic<u32>, 16>;
-var<workgroup> wg_cnt: array<atomic<u32>, 16>;
-var<workgroup> wg_min: array<atomic<u32>, 16>;
-var<workgroup> wg_max: array<atomic<u32>, 16>;
 
 // Order-preserving key of a float (total order of finite values).
 fn key(f: f32) -> u32 {
@@ -26,46 +22,30 @@ fn key(f: f32) -> u32 {
 }
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    if li < 16u {
-        atomicStore(&wg_imp[li], 0u);
-        atomicStore(&wg_cnt[li], 0u);
-        atomicStore(&wg_min[li], 0xffffffffu);
-        atomicStore(&wg_max[li], 0u);
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= frame.size.x || id.y >= frame.size.y {
+        return;
     }
-    workgroupBarrier();
-    if id.x < frame.size.x && id.y < frame.size.y {
-        let i = id.y * frame.size.x + id.x;
-        if mask[i] != 0u {
-            let p = textureLoad(g_position, id.xy, 0).xyz;
-            let uv = buffer_uv(ip, p);
-            if inside(uv) {
-                let t = tile_of(uv);
-                let w = (frame.view_proj * vec4<f32>(p, 1.0)).w;
-                let imp = 1.0 + ip.imp.x * clamp(1.0 - w / ip.imp.y, 0.0, 1.0);
-                atomicAdd(&wg_imp[t], u32(round(imp * FIXED)));
-                atomicAdd(&wg_cnt[t], 1u);
-                let k = key(dot(p, ip.dir.xyz));
-                atomicMin(&wg_min[t], k);
-                atomicMax(&wg_max[t], k);
-            }
-        }
+    let i = id.y * frame.size.x + id.x;
+    if mask[i] == 0u {
+        return;
     }
-    workgroupBarrier();
-    if li < 16u {
-        let c = atomicLoad(&wg_cnt[li]);
-        if c > 0u {
-            let b = li * 8u;
-            let v = atomicLoad(&wg_imp[li]);
-            let old = atomicAdd(&stats[b], v);
-            if old + v < old {
-                atomicAdd(&stats[b + 1u], 1u);
-            }
-            atomicAdd(&stats[b + 2u], c);
-            atomicMin(&stats[b + 3u], atomicLoad(&wg_min[li]));
-            atomicMax(&stats[b + 4u], atomicLoad(&wg_max[li]));
-        }
+    let p = textureLoad(g_position, id.xy, 0).xyz;
+    let uv = buffer_uv(p);
+    if !inside(uv) {
+        return;
     }
+    let b = tile_of(uv) * 8u;
+    let w = (frame.view_proj * vec4<f32>(p, 1.0)).w;
+    let v = u32(round((1.0 + ip.imp.x * clamp(1.0 - w / ip.imp.y, 0.0, 1.0)) * FIXED));
+    let old = atomicAdd(&stats[b], v);
+    if old + v < old {
+        atomicAdd(&stats[b + 1u], 1u);
+    }
+    atomicAdd(&stats[b + 2u], 1u);
+    let k = key(dot(p, ip.dir.xyz));
+    atomicMin(&stats[b + 3u], k);
+    atomicMax(&stats[b + 4u], k);
 }
 
 // Copies the camera of this view (the lab hands techniques the frame uniform only): view_proj

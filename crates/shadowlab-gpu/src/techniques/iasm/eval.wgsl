@@ -13,14 +13,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    let l = lookup(ip, s.p, s.n);
+    let l = lookup(s.p, s.n);
     if !l.ok {
         visibility[s.i] = 1.0;
         return;
     }
-    if inside(l.uv0) && tile_res(ip, tile_of(l.uv0)) > 0u {
-        atomicAdd(&counts[buffer_index(ip, l.uv0)], 1u);
+    if inside(l.uv0) && tile_res(tile_of(l.uv0)) > 0u {
+        atomicAdd(&counts[buffer_index(l.uv0)], 1u);
     }
-    let stored = 1.0 - bitcast<f32>(shadow[buffer_index(ip, l.uv)]);
+    let stored = 1.0 - bitcast<f32>(shadow[buffer_index(l.uv)]);
     visibility[s.i] = select(0.0, 1.0, l.z <= stored);
 }

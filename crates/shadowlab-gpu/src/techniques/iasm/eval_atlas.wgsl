@@ -16,14 +16,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    let l = lookup(ip, s.p, s.n);
+    let l = lookup(s.p, s.n);
     if !l.ok {
         visibility[s.i] = 1.0;
         return;
     }
-    if inside(l.uv0) && tile_res(ip, tile_of(l.uv0)) > 0u {
-        atomicAdd(&counts[buffer_index(ip, l.uv0)], 1u);
+    if inside(l.uv0) && tile_res(tile_of(l.uv0)) > 0u {
+        atomicAdd(&counts[buffer_index(l.uv0)], 1u);
     }
-    let stored = textureLoad(atlas, slot_of(l.t) + tile_texel(ip, l.uv), 0);
+    let stored = textureLoad(atlas, slot_of(l.t) + tile_texel(l.uv), 0);
     visibility[s.i] = select(0.0, 1.0, l.z <= stored);
 }

@@ -9,6 +9,6 @@ fn probe_index(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let uv = probe[id.x].xy;
-    probe[id.x].z = bitcast<f32>(buffer_index(ip, uv));
+    probe[id.x].z = bitcast<f32>(buffer_index(uv));
     probe[id.x].w = bitcast<f32>(tile_of(uv));
 }
