@@ -12,13 +12,13 @@ mod common;
 use common::*;
 
 #[test]
-fn iasm_matches_rt_on_planebox_and_memory_is_exact() {
+fn iasm_buffer_matches_rt_on_planebox_and_memory_is_exact() {
     let Some(gpu) = gpu() else { return };
     let scene = builtin("planebox").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 256);
     let rt = lab.reference(&v, 1).unwrap();
-    let run = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
+    let run = lab.run(&v, &TechniqueSpec::parse("iasm:store=buffer").unwrap(), 1).unwrap();
     let a = agreement(&run.visibility, &rt.visibility, &v.mask);
     if a < 99.0 {
         panic!("iasm agrees with rt on {a:.3}%; {}", save_images("iasm-planebox", &v, &run, &rt));
@@ -48,7 +48,7 @@ fn gpu_texel_index_matches_cpu_equations() {
     let scene = builtin("planebox").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 64);
-    let values = techniques::resolve(&TechniqueSpec::parse("iasm").unwrap(), Some(&v.light)).unwrap().1;
+    let values = techniques::resolve(&TechniqueSpec::parse("iasm:store=buffer").unwrap(), Some(&v.light)).unwrap().1;
     let tech = Iasm::new(&gpu, &lab.gscene, &values, &v.light).unwrap();
     // a scrambled assignment
     let order = core::rank(&std::array::from_fn(|i| ((i * 11) % 16) as f64), &[false; 16]);
@@ -103,13 +103,14 @@ fn delayed_iasm_on_a_still_camera_equals_iasm_after_the_first_frame() {
 }
 
 #[test]
-fn atlas_store_matches_buffer_store() {
+fn atlas_store_matches_buffer_store_and_rt() {
     let Some(gpu) = gpu() else { return };
     let scene = builtin("courtyard").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 256);
-    let buf = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
-    let atl = lab.run(&v, &TechniqueSpec::parse("iasm:store=atlas").unwrap(), 1).unwrap();
+    let buf = lab.run(&v, &TechniqueSpec::parse("iasm:store=buffer").unwrap(), 1).unwrap();
+    let atl = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
+    assert_eq!(atl.params.get_u32("store"), 1, "atlas is the default store");
     // the same tiles, frusta and depths; only where the depth lives differs
     let a = agreement(&atl.visibility, &buf.visibility, &v.mask);
     assert!(a >= 99.9, "atlas and buffer agree on {a:.3}%");
@@ -120,4 +121,7 @@ fn atlas_store_matches_buffer_store() {
     // 2048 x 1024 depth texels (buddy-packed thesis set) against the buffer's exact set
     assert_eq!(atl.report.shadow_data_bytes, 2048 * 1024 * 4);
     assert_eq!(buf.report.shadow_data_bytes, 6_860_800);
+    let rt = lab.reference(&v, 1).unwrap();
+    let a = agreement(&atl.visibility, &rt.visibility, &v.mask);
+    assert!(a >= 99.0, "atlas iasm agrees with rt on {a:.3}% of courtyard");
 }

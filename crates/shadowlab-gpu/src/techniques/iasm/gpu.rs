@@ -368,9 +368,9 @@ impl Technique for Iasm {
         Ok(())
     }
 
-    fn render(&mut self, gpu: &Gpu, _f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         if let Some(a) = &self.atlas {
-            self.render_atlas(gpu, _f, timer, a);
+            self.render_atlas(gpu, f, timer, a);
             return Ok(());
         }
         timer.stage(gpu, "iasm.shadows.clear", |enc| enc.clear_buffer(&self.shadow, 0, None));
@@ -395,7 +395,7 @@ impl Technique for Iasm {
                 });
                 pass.set_pipeline(&self.render);
                 pass.set_bind_group(0, &self.tile_groups[t], &[]);
-                pass.set_bind_group(1, &_f.scene.group, &[]);
+                pass.set_bind_group(1, &f.scene.group, &[]);
                 pass.set_viewport(0.0, 0.0, r as f32, r as f32, 0.0, 1.0);
                 for &(a, b) in &self.plan.draws[t] {
                     pass.draw(a..b, 0..1);
