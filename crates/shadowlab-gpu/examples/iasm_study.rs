@@ -6,7 +6,8 @@
 //!
 //!     cargo run -p shadowlab-gpu --example iasm_study -- <builtin scene | setup.toml> <size> <frames> <spec>...
 //!
-//! `frames` 0 skips the path study; the corner study runs the first two `iasm...` specs given.
+//! `frames` 0 skips the path study; the corner study runs the first two `iasm...` specs given
+//! (IASM_NO_CORNERS=1 skips it).
 
 use glam::{Vec2, Vec3};
 use shadowlab_core::builtin::builtin;
@@ -55,7 +56,7 @@ fn main() -> Res {
         path_study(&lab, &scene, &cam, size, frames, specs)?;
     }
     let iasm: Vec<&String> = specs.iter().filter(|s| s.starts_with("iasm")).take(2).collect();
-    if !iasm.is_empty() {
+    if !iasm.is_empty() && std::env::var_os("IASM_NO_CORNERS").is_none() {
         corner_study(&lab, &cam, &light, size, &iasm)?;
     }
     Ok(())

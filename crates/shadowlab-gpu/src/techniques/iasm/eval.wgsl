@@ -22,5 +22,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         atomicAdd(&counts[buffer_index(l.uv0)], 1u);
     }
     let stored = 1.0 - bitcast<f32>(shadow[buffer_index(l.uv)]);
-    visibility[s.i] = select(0.0, 1.0, l.z <= stored);
+    // a cleared texel (1: nothing between the tile's planes) is lit even for a receiver beyond
+    // the far plane (delayed planes of a moving camera)
+    visibility[s.i] = select(0.0, 1.0, l.z <= stored || stored >= 1.0);
 }
