@@ -104,7 +104,7 @@ impl Iasm {
         };
         let d = &gpu.device;
         let texels = core::texels(&THESIS_RESOLUTIONS);
-        if texels * 4 > gpu.limits.max_storage_buffer_binding_size as u64 {
+        if texels * 4 > gpu.limits.max_storage_buffer_binding_size {
             return Err(GpuError::Invalid("iasm shadow buffer exceeds this device's storage binding limit".into()));
         }
         let chunk = p.get_u32("chunk").max(1);
@@ -270,26 +270,24 @@ impl Iasm {
         let p = self.placement;
         let mut plan = Plan { stats, ..Default::default() };
         let mut empty: [bool; TILE_COUNT] = std::array::from_fn(|t| stats.samples[t] == 0);
-        for t in 0..TILE_COUNT {
-            let (mut near, far) = (stats.depth_min[t], stats.depth_max[t]);
-            let mut draws = Vec::new();
-            if !empty[t] {
-                // chunks over the tile that can cast onto its receivers (not wholly beyond them)
-                let culled: Vec<usize> = core::cull(&p, t, &self.boxes).into_iter().filter(|&c| self.boxes[c].0.z <= far).collect();
-                for &c in &culled {
-                    near = near.min(self.boxes[c].0.z);
-                }
-                let tris = self.triangles;
-                draws = core::runs(&culled)
-                    .into_iter()
-                    .map(|(a, b)| (a as u32 * self.chunk * 3, (b as u32 * self.chunk).min(tris) * 3))
-                    .collect();
-                empty[t] = culled.is_empty();
+        for (t, e) in empty.iter_mut().enumerate() {
+            if *e {
+                plan.draws.push(Vec::new());
+                continue;
             }
+            let (mut near, far) = (stats.depth_min[t], stats.depth_max[t]);
+            // chunks over the tile that can cast onto its receivers (not wholly beyond them)
+            let culled: Vec<usize> = core::cull(&p, t, &self.boxes).into_iter().filter(|&c| self.boxes[c].0.z <= far).collect();
+            for &c in &culled {
+                near = near.min(self.boxes[c].0.z);
+            }
+            let tris = self.triangles;
+            let draws = core::runs(&culled).into_iter().map(|(a, b)| (a as u32 * self.chunk * 3, (b as u32 * self.chunk).min(tris) * 3));
+            *e = culled.is_empty();
             let margin = 1e-3 * (far - near).abs().max(1e-3 * p.size);
             plan.near[t] = near - margin;
             plan.far[t] = far + margin;
-            plan.draws.push(if empty[t] { Vec::new() } else { draws });
+            plan.draws.push(if *e { Vec::new() } else { draws.collect() });
         }
         let imp: [f64; TILE_COUNT] = std::array::from_fn(|t| if empty[t] { 0.0 } else { stats.importance[t] });
         plan.order = core::rank(&imp, &empty);
