@@ -79,8 +79,11 @@ pub struct Iasm {
     pub placement: Placement,
     pub plan: Plan,
     pub atlas: Option<Atlas>,
-    /// Delayed: the analysis of the previous frame is in `stats_buf`.
+    /// Delayed: the analysis of the previous frame is in `stats_buf`, made over `analysed`.
     pending: bool,
+    analysed: Placement,
+    /// Delayed: this frame's own placement, analysed after the shadows for the next frame.
+    current: Placement,
     pub(super) params_buf: wgpu::Buffer,
     stats_buf: wgpu::Buffer,
     camera_buf: wgpu::Buffer,
@@ -182,6 +185,8 @@ impl Iasm {
             plan: Plan::default(),
             atlas,
             pending: false,
+            analysed: basis,
+            current: basis,
             params_buf,
             stats_buf,
             camera_buf,
@@ -357,7 +362,12 @@ impl Iasm {
 impl Technique for Iasm {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         self.place(gpu, f, timer);
-        if !(self.delayed && self.pending) {
+        self.current = self.placement;
+        if self.delayed && self.pending {
+            // the previous frame's analysis belongs to the previous frame's square: keep both
+            // together, so every tile's planes and resolution describe that tile's region
+            self.placement = self.analysed;
+        } else {
             self.analyse(gpu, f, timer);
         }
         let stats = self.read_stats(gpu, timer);
@@ -411,8 +421,11 @@ impl Technique for Iasm {
             gpu.dispatch_2d(enc, "iasm.evaluate", pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
         });
         if self.delayed {
-            // this frame's analysis feeds the next frame (thesis 4.3: copied after the shadows)
+            // this frame's analysis, over this frame's square, feeds the next frame (thesis 4.3:
+            // copied after the shadows)
+            self.placement = self.current;
             self.analyse(gpu, f, timer);
+            self.analysed = self.current;
             self.pending = true;
         }
         Ok(())
