@@ -4,9 +4,11 @@
 //! (equation 3.1) and light-depth range; the CPU ranks the tiles and hands out a fixed set of 16
 //! resolutions by rank; every non-empty tile is rasterized with its own frustum (culled chunks
 //! of the scene) into one linear storage buffer by atomic max on the inverted depth
-//! (Listing 3.1); the evaluation finds tile and texel by equations 3.2-3.5.
-//! Stored depth: 32-bit float 1 - z per texel, z = (light depth - near_t) / (far_t - near_t),
-//! linear, 0 = at the tile's near plane (nearest the light); cleared texels read z = 1.
+//! (Listing 3.1, `store=buffer`) or into its square of a depth atlas (`store=atlas`, the
+//! default: faster here, see DEFAULT_STORE); the evaluation finds tile and texel by equations
+//! 3.2-3.5. Depth z = (light depth - near_t) / (far_t - near_t), linear, 0 = the tile's near
+//! plane (nearest the light); the buffer stores the bits of 1 - z (cleared 0 reads z = 1), the
+//! atlas stores z (cleared to 1). A cleared texel is lit.
 //! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::iasm`.
 
 mod atlas;
@@ -190,7 +192,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "iasm",
     summary:
         "Irregular Adaptive Shadow Maps: 4x4 tiles ahead of the camera, resolutions 1x1024..4x16 by importance rank, one linear buffer",
-    cost: "importance pass + readback, up to 16 culled tile passes with atomic depth writes, 1 fetch per pixel",
+    cost: "importance pass + 512-byte readback, up to 16 culled tile passes (atlas: depth test; buffer: atomic max), 1 fetch per pixel",
     quality: "resolution follows the camera; tile seams where neighbours differ (four-tile corners, thesis Fig. 4.4)",
     source: "seed 001 (IASM thesis) chapter 3",
     lights: &["directional"],
