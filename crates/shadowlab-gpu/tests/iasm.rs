@@ -125,3 +125,31 @@ fn atlas_store_matches_buffer_store_and_rt() {
     let a = agreement(&atl.visibility, &rt.visibility, &v.mask);
     assert!(a >= 99.0, "atlas iasm agrees with rt on {a:.3}% of courtyard");
 }
+
+#[test]
+fn samples_outside_the_square_are_counted_and_lit() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 128);
+    // a 2 m square ahead of the camera cannot hold the whole 10 m plane in view
+    let run = lab.run(&v, &TechniqueSpec::parse("iasm:size=2").unwrap(), 1).unwrap();
+    let c = &run.report.counters;
+    let inside: f64 = (0..16).map(|t| c[&format!("tile{t:02}.samples")]).sum();
+    let evaluated = v.mask.iter().filter(|m| **m != 0).count() as f64;
+    assert!(c["outside_samples"] > 0.0);
+    assert_eq!(inside + c["outside_samples"], evaluated);
+    // the same placement on the CPU: every sample clearly outside it is lit
+    let shadowlab_core::light::Light::Directional { direction } = v.light else { panic!() };
+    let cam = scene.camera;
+    let p = core::place(direction, cam.position, (cam.target - cam.position).normalize(), 2.0, Some(2.0 / 64.0), core::Anchor::Circle);
+    let mut outside = 0;
+    for (i, pos) in v.position.iter().enumerate() {
+        let uv = p.uv(glam::Vec3::from_slice(&pos[..3]));
+        if v.mask[i] != 0 && (uv.min_element() < -1e-3 || uv.max_element() > 1.0 + 1e-3) {
+            outside += 1;
+            assert_eq!(run.visibility[i], 1.0, "pixel {i} outside the square is not lit");
+        }
+    }
+    assert!(outside as f64 <= c["outside_samples"] && outside as f64 > 0.9 * c["outside_samples"]);
+}

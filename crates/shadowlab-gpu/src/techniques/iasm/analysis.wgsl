@@ -4,7 +4,8 @@
 // min/max light depth with atomic min/max on order-preserving u32 keys. Per-sample global
 // atomics as the thesis does (InterlockedAdd); a workgroup pre-reduction in shared memory was
 // 3x slower on lavapipe (barriers), 127 vs 41 ms at 1024x1024.
-// Stats per tile (8 u32): imp_lo, imp_hi, samples, depth_min key, depth_max key, 3 unused.
+// Stats per tile (8 u32): imp_lo, imp_hi, samples, depth_min key, depth_max key, 3 unused;
+// then word 128: samples outside the square.
 
 @group(0) @binding(6) var<uniform> ip: IasmParams;
 @group(0) @binding(7) var<storage, read_write> stats: array<atomic<u32>>;
@@ -33,6 +34,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = textureLoad(g_position, id.xy, 0).xyz;
     let uv = buffer_uv(p);
     if !inside(uv) {
+        // samples outside the square (lit by the evaluation): counted after the 16 tiles
+        atomicAdd(&stats[128u], 1u);
         return;
     }
     let b = tile_of(uv) * 8u;

@@ -28,6 +28,8 @@ pub struct TileStats {
     pub samples: [u32; TILE_COUNT],
     pub depth_min: [f32; TILE_COUNT],
     pub depth_max: [f32; TILE_COUNT],
+    /// Evaluated samples outside the square (lit: no shadow data there).
+    pub outside: u32,
 }
 
 pub(super) fn unkey(k: u32) -> f32 {
@@ -44,6 +46,7 @@ impl TileStats {
             s.depth_min[t] = unkey(b[3]);
             s.depth_max[t] = unkey(b[4]);
         }
+        s.outside = w[TILE_COUNT * 8];
         s
     }
 }
@@ -122,7 +125,7 @@ impl Iasm {
         };
 
         let params_buf = gpu.uniform("iasm.params", &<IasmParams as bytemuck::Zeroable>::zeroed());
-        let stats_buf = gpu.storage("iasm.stats", TILE_COUNT as u64 * 32);
+        let stats_buf = gpu.storage("iasm.stats", TILE_COUNT as u64 * 32 + 4);
         let camera_buf = gpu.storage("iasm.camera", 80);
         let shadow = gpu.storage("iasm.shadow", texels * core::TEXEL_BYTES);
         let counts = gpu.storage("iasm.counts", texels * 4);
@@ -262,7 +265,8 @@ impl Iasm {
     /// Dispatches the analysis of `f` with the current placement into `stats_buf`.
     fn analyse(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
         gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params()));
-        let init: Vec<u32> = (0..TILE_COUNT).flat_map(|_| [0, 0, 0, u32::MAX, 0, 0, 0, 0]).collect();
+        let mut init: Vec<u32> = (0..TILE_COUNT).flat_map(|_| [0, 0, 0, u32::MAX, 0, 0, 0, 0]).collect();
+        init.push(0);
         gpu.queue.write_buffer(&self.stats_buf, 0, bytemuck::cast_slice(&init));
         let group = f.view_group(gpu, "iasm.analysis", &self.analysis_layout, &self.analysis_extra());
         timer.stage(gpu, "iasm.importance", |enc| {
@@ -304,7 +308,7 @@ impl Iasm {
 
     fn read_stats(&self, gpu: &Gpu, timer: &mut StageTimer) -> TileStats {
         let t0 = std::time::Instant::now();
-        let words: Vec<u32> = gpu.read_buffer_as(&self.stats_buf, TILE_COUNT * 8);
+        let words: Vec<u32> = gpu.read_buffer_as(&self.stats_buf, TILE_COUNT * 8 + 1);
         timer.add("iasm.readback", t0.elapsed().as_secs_f64() * 1e3);
         TileStats::parse(&words)
     }

@@ -41,6 +41,12 @@ pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
         c.insert(format!("tile{i:02}.samples"), plan.stats.samples[i] as f64);
     }
     c.insert("draws_total".into(), draws as f64);
+    // evaluated samples outside the square: lit for want of shadow data (the camera on the
+    // square's edge with the thesis placement sees ground beyond it)
+    let inside: f64 = plan.stats.samples.iter().map(|&n| n as f64).sum();
+    let outside = plan.stats.outside as f64;
+    c.insert("outside_samples".into(), outside);
+    c.insert("outside_pct".into(), if inside + outside > 0.0 { 100.0 * outside / (inside + outside) } else { 0.0 });
     c.insert("triangles_drawn".into(), tris as f64);
     r.images.push(mosaic(t, &shadow));
     r.images.push(resolution_picture(t));
