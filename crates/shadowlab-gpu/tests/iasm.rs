@@ -153,3 +153,38 @@ fn samples_outside_the_square_are_counted_and_lit() {
     }
     assert!(outside as f64 <= c["outside_samples"] && outside as f64 > 0.9 * c["outside_samples"]);
 }
+
+#[test]
+fn analysis_matches_a_cpu_recount_of_samples_and_importance() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let run = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
+    let c = &run.report.counters;
+    let shadowlab_core::light::Light::Directional { direction } = v.light else { panic!() };
+    let cam = scene.camera;
+    let fwd = (cam.target - cam.position).normalize();
+    let side = c["square_side"] as f32;
+    let p = core::place(direction, cam.position, fwd, side, Some(side / 64.0), core::Anchor::Circle);
+    let (mut n, mut imp) = ([0u64; 16], [0f64; 16]);
+    for (i, pos) in v.position.iter().enumerate() {
+        let q = glam::Vec3::from_slice(&pos[..3]);
+        let uv = p.uv(q);
+        if v.mask[i] == 0 || uv.min_element() < 0.0 || uv.max_element() >= 1.0 {
+            continue;
+        }
+        let t = core::tile_of(uv).0;
+        n[t] += 1;
+        // equation 3.1 with m = 4, k = half the side (the defaults), in the GPU's 1/64 steps
+        imp[t] += (core::importance((q - cam.position).dot(fwd), 4.0, 0.5 * side) as f64 * 64.0).round() / 64.0;
+    }
+    assert!(n.iter().sum::<u64>() > 10_000);
+    for t in 0..16 {
+        let (gn, gi) = (c[&format!("tile{t:02}.samples")], c[&format!("tile{t:02}.importance")]);
+        // f32 differences may move a sample lying on a tile border: allow 0.5 % of the tile
+        let tol = 1.0 + 0.005 * n[t] as f64;
+        assert!((gn - n[t] as f64).abs() <= tol, "tile {t}: GPU {gn} samples, CPU {}", n[t]);
+        assert!((gi - imp[t]).abs() <= 5.0 * tol, "tile {t}: GPU importance {gi}, CPU {}", imp[t]);
+    }
+}

@@ -39,6 +39,7 @@ pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
         c.insert(format!("tile{i:02}.draws"), d.len() as f64);
         c.insert(format!("tile{i:02}.triangles"), tt as f64);
         c.insert(format!("tile{i:02}.samples"), plan.stats.samples[i] as f64);
+        c.insert(format!("tile{i:02}.importance"), plan.stats.importance[i]);
     }
     c.insert("draws_total".into(), draws as f64);
     // evaluated samples outside the square: lit for want of shadow data (the camera on the
