@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::gpu::unkey;
+use super::plan::unkey;
 use super::BOUNDS_WGSL;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;

@@ -15,6 +15,7 @@ mod atlas;
 mod chunks;
 mod gpu;
 mod images;
+mod plan;
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::params::{ParamDef, BOOL};
