@@ -7,6 +7,7 @@ pub mod bvh;
 pub mod camera;
 pub mod cascades;
 pub mod edges;
+pub mod iasm;
 pub mod light;
 pub mod lightspace;
 pub mod loaders;

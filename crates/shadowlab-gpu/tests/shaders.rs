@@ -180,3 +180,30 @@ fn csm_and_reduce_layouts_match_rust() {
     check(&get("csm/depth.wgsl"), "CsmDepth", size_of::<[[f32; 4]; 4]>(), &[("view_proj", 0)]);
     check(&get("reduce/reduce.wgsl"), "ReduceParams", size_of::<ReduceParams>(), &[("channel", 0)]);
 }
+
+#[test]
+fn iasm_layouts_match_wgsl() {
+    use shadowlab_gpu::techniques::iasm::{IasmParams, TileParams};
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    for n in ["iasm/analysis.wgsl", "iasm/eval.wgsl", "iasm/eval_atlas.wgsl", "iasm/probe.wgsl"] {
+        check(
+            &get(n),
+            "IasmParams",
+            size_of::<IasmParams>(),
+            &[
+                ("up", offset_of!(IasmParams, up)),
+                ("dir", offset_of!(IasmParams, dir)),
+                ("imp", offset_of!(IasmParams, imp)),
+                ("res", offset_of!(IasmParams, res)),
+                ("off", offset_of!(IasmParams, off)),
+                ("near", offset_of!(IasmParams, near)),
+                ("far", offset_of!(IasmParams, far)),
+                ("slot", offset_of!(IasmParams, slot)),
+            ],
+        );
+    }
+    for n in ["iasm/render.wgsl", "iasm/atlas.wgsl"] {
+        check(&get(n), "TileParams", size_of::<TileParams>(), &[("tile", offset_of!(TileParams, tile))]);
+    }
+}

@@ -1,6 +1,7 @@
 //! Built-in procedural scenes: deterministic, no files needed. Each has a default camera,
 //! light(s) and a short camera path.
 
+mod city;
 mod courtyard;
 mod foliage;
 mod planebox;
@@ -39,6 +40,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         name: "planebox",
         summary: "a 10 m plane and a 1 m box under a directional light: the exact-shadow test case",
         build: planebox::build,
+    },
+    BuiltinScene {
+        name: "city",
+        summary: "9 x 9 blocks of towers, 450 m across, street lamps, street-level camera, sun 25 degrees high (IASM/CSM wide area)",
+        build: city::build,
     },
 ];
 

@@ -2,6 +2,7 @@
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
 pub mod csm;
+pub mod iasm;
 pub mod mdsm;
 pub mod sm;
 pub mod sv;
@@ -133,7 +134,7 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &mdsm::INFO, &sv::INFO, &csm::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &mdsm::INFO, &sv::INFO, &csm::INFO, &iasm::INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
@@ -142,6 +143,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(mdsm::shaders());
     v.extend(sv::shaders());
     v.extend(csm::shaders());
+    v.extend(iasm::shaders());
     v
 }
 

@@ -1,0 +1,81 @@
+//! `store=atlas`, the conventional alternative to the linear buffer (issue 6): the same tiles,
+//! frusta and depths as squares of one Depth32Float atlas (buddy-packed by rank, see
+//! `shadowlab_core::iasm::atlas_layout`), rendered with the hardware depth test and read with
+//! `textureLoad` in eval_atlas.wgsl.
+
+use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
+
+use super::gpu::Iasm;
+use super::{eval_atlas_src, ATLAS_WGSL};
+use crate::shaders::compose;
+use crate::techniques::{view_layout, FrameInputs};
+use crate::timing::StageTimer;
+use crate::{binding, raster, Gpu, GpuError};
+
+/// The conventional alternative: the tiles in a depth atlas (store=atlas).
+pub struct Atlas {
+    pub texture: wgpu::Texture,
+    pub(super) view: wgpu::TextureView,
+    /// Top-left corner per rank.
+    pub slots: [[u32; 2]; TILE_COUNT],
+    pipeline: wgpu::RenderPipeline,
+    pub(super) eval_layout: wgpu::BindGroupLayout,
+    pub(super) eval: wgpu::ComputePipeline,
+}
+
+pub(super) fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Result<Atlas, GpuError> {
+    let (w, h, slots) =
+        core::atlas_layout(&THESIS_RESOLUTIONS).ok_or_else(|| GpuError::Invalid("iasm: resolution set does not fit an atlas".into()))?;
+    gpu.check_size(w, h, "iasm atlas")?;
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("iasm.atlas"),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: raster::DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose(ATLAS_WGSL, true), layouts, &[]);
+    let eval_layout = view_layout(gpu, "iasm.eval_atlas", &[binding::uniform(), binding::texture_depth(), binding::storage(false)]);
+    let eval = gpu.compute_pipeline("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout]);
+    Ok(Atlas { texture, view, slots, pipeline, eval_layout, eval })
+}
+
+impl Iasm {
+    pub(super) fn render_atlas(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer, a: &Atlas) {
+        timer.stage(gpu, "iasm.shadows.clear", |enc| {
+            drop(raster::begin_pass(enc, "iasm.shadows.clear", &[], &a.view));
+        });
+        for (rank, &t) in self.plan.order.iter().enumerate() {
+            if self.plan.empty[t] {
+                continue;
+            }
+            let (r, [x, y]) = (self.plan.res[t], a.slots[rank]);
+            timer.stage(gpu, &format!("iasm.shadows.t{t:02}"), |enc| {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("iasm.shadows"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &a.view,
+                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&a.pipeline);
+                pass.set_bind_group(0, &self.tile_groups[t], &[]);
+                pass.set_bind_group(1, &f.scene.group, &[]);
+                pass.set_viewport(x as f32, y as f32, r as f32, r as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, r, r);
+                for &(a, b) in &self.plan.draws[t] {
+                    pass.draw(a..b, 0..1);
+                }
+            });
+        }
+    }
+}

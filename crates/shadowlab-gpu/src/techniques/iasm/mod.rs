@@ -1,0 +1,226 @@
+//! `iasm`: Irregular Adaptive Shadow Maps (seed 001, chapter 3) for directional lights. One
+//! orthographic light square ahead of the camera (the camera on its inscribed circle), split
+//! into 4x4 tiles of equal area; a compute pass sums each tile's view-sample importance
+//! (equation 3.1) and light-depth range; the CPU ranks the tiles and hands out a fixed set of 16
+//! resolutions by rank; every non-empty tile is rasterized with its own frustum (culled chunks
+//! of the scene) into one linear storage buffer by atomic max on the inverted depth
+//! (Listing 3.1, `store=buffer`) or into its square of a depth atlas (`store=atlas`, the
+//! default: faster here, see DEFAULT_STORE); the evaluation finds tile and texel by equations
+//! 3.2-3.5. Depth z = (light depth - near_t) / (far_t - near_t), linear, 0 = the tile's near
+//! plane (nearest the light); the buffer stores the bits of 1 - z (cleared 0 reads z = 1), the
+//! atlas stores z (cleared to 1). A cleared texel is lit.
+//! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::iasm`.
+
+mod atlas;
+mod chunks;
+mod gpu;
+mod images;
+mod plan;
+
+use bytemuck::{Pod, Zeroable};
+use shadowlab_core::params::{ParamDef, BOOL};
+
+use crate::shaders::compose;
+use crate::techniques::{compose_view, TechniqueInfo};
+
+pub use gpu::Iasm;
+
+const PARAMS_WGSL: &str = include_str!("params.wgsl");
+const ANALYSIS_WGSL: &str = include_str!("analysis.wgsl");
+const RENDER_WGSL: &str = include_str!("render.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
+const PROBE_WGSL: &str = include_str!("probe.wgsl");
+const ATLAS_WGSL: &str = include_str!("atlas.wgsl");
+const EVAL_ATLAS_WGSL: &str = include_str!("eval_atlas.wgsl");
+
+fn analysis_src() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{ANALYSIS_WGSL}"), false)
+}
+fn eval_src() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{EVAL_WGSL}"), false)
+}
+fn eval_atlas_src() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{EVAL_ATLAS_WGSL}"), false)
+}
+fn probe_src() -> String {
+    compose(&format!("{PARAMS_WGSL}{PROBE_WGSL}"), false)
+}
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![
+        ("iasm/analysis.wgsl", analysis_src()),
+        ("iasm/render.wgsl", compose(RENDER_WGSL, true)),
+        ("iasm/eval.wgsl", eval_src()),
+        ("iasm/bounds.wgsl", compose(BOUNDS_WGSL, true)),
+        ("iasm/probe.wgsl", probe_src()),
+        ("iasm/atlas.wgsl", compose(ATLAS_WGSL, true)),
+        ("iasm/eval_atlas.wgsl", eval_atlas_src()),
+    ]
+}
+
+/// m of equation 3.1: a sample at the camera weighs 1 + m, one at w >= k weighs 1. The thesis
+/// gives no value. Too low: the ranking follows sample counts (wide far tiles win); too high:
+/// a few near pixels outrank a whole tile of mid-distance ground.
+pub const DEFAULT_M: f64 = 4.0;
+/// k of equation 3.1 in world units; 0 = half the light square's side (the distance from the
+/// camera to the square's centre). The thesis gives no value. Too low: every sample beyond k
+/// weighs the same; too high: distance hardly matters.
+pub const DEFAULT_K: f64 = 0.0;
+/// Square side in world units; 0 = the scene bounds' extent across the light (thesis 5: "the
+/// frustum sides have been empirically chosen to encompass all geometry in the scene").
+/// Too small: geometry ahead falls outside (lit); too large: coarse tiles.
+pub const DEFAULT_SIZE: f64 = 0.0;
+/// Constant bias in texels of the tile (as `sm`); 0.5 from `sm`'s sweep.
+pub const DEFAULT_BIAS: f64 = 0.5;
+/// Normal offset in texels of the tile (as `sm`); 0.5 from `sm`'s sweep; low: acne at grazing
+/// light, high: shifted shadows.
+pub const DEFAULT_NORMAL_OFFSET: f64 = 0.5;
+/// Where the tiles' depth lives: 0 = buffer (the thesis's linear storage buffer, exactly the
+/// set's 6,860,800 bytes, fragments write by atomic max: no early depth test), 1 = atlas (the
+/// same tiles in a 2048 x 1024 Depth32Float atlas, 8,388,608 bytes, hardware depth test). The
+/// atlas rendered the tiles 1.4-3x faster on every measured setup (lavapipe, 2026-11-22,
+/// docs/bench/iasm.md), so it is the default, as issue 6 asks; results are the same.
+pub const DEFAULT_STORE: f64 = 1.0;
+/// Triangles per culling chunk (vertex order). Small: many draw calls and CPU culling work;
+/// large: loose bounds that pass every tile (the thesis's village worst case).
+pub const DEFAULT_CHUNK: f64 = 256.0;
+
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef {
+        key: "m",
+        default: DEFAULT_M,
+        min: 0.0,
+        max: 1000.0,
+        integer: false,
+        doc: "importance weight of near samples, p = 1 + m clamp(1 - w/k, 0, 1)",
+        source: "seed 001 eq. 3.1 (no value given; shadowlab choice)",
+        choices: &[],
+    },
+    ParamDef {
+        key: "k",
+        default: DEFAULT_K,
+        min: 0.0,
+        max: 1e6,
+        integer: false,
+        doc: "importance range (world units); 0 = half the light square's side",
+        source: "seed 001 eq. 3.1 (no value given; shadowlab choice)",
+        choices: &[],
+    },
+    ParamDef {
+        key: "size",
+        default: DEFAULT_SIZE,
+        min: 0.0,
+        max: 1e6,
+        integer: false,
+        doc: "side of the light square (world units); 0 = scene extent across the light",
+        source: "seed 001 ch. 5: sides chosen to encompass all geometry",
+        choices: &[],
+    },
+    ParamDef {
+        key: "bias",
+        default: DEFAULT_BIAS,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "constant depth bias, texels of the sample's tile; low: acne, high: peter-panning",
+        source: "sm's sweep 2026-11-22",
+        choices: &[],
+    },
+    ParamDef {
+        key: "normal_offset",
+        default: DEFAULT_NORMAL_OFFSET,
+        min: 0.0,
+        max: 100.0,
+        integer: false,
+        doc: "offset along the normal, texels of the sample's tile",
+        source: "Holbert 2011; sm's sweep 2026-11-22",
+        choices: &[],
+    },
+    ParamDef {
+        key: "delayed",
+        default: 0.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "use the previous frame's importance and near/far planes (no readback stall)",
+        source: "seed 001 4.3, deferred delayed IASM",
+        choices: BOOL,
+    },
+    ParamDef {
+        key: "snap",
+        default: 1.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "move the square in steps of the coarsest texel (tile/16) so texel grids do not shimmer",
+        source: "shadowlab addition (not in seed 001)",
+        choices: BOOL,
+    },
+    ParamDef {
+        key: "anchor",
+        default: 0.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "circle: camera on the inscribed circle (Fig. 3.1); tile: then shifted so the camera sits at a tile centre (no four-tile corner at the camera)",
+        source: "seed 001 3.2 / ch. 5 suggested fix",
+        choices: &["circle", "tile"],
+    },
+    ParamDef {
+        key: "store",
+        default: DEFAULT_STORE,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)",
+        source: "seed 001 3.2/3.5; default = the faster on lavapipe (docs/bench/iasm.md)",
+        choices: &["buffer", "atlas"],
+    },
+    ParamDef {
+        key: "chunk",
+        default: DEFAULT_CHUNK,
+        min: 1.0,
+        max: 1e7,
+        integer: true,
+        doc: "triangles per culling chunk (vertex order)",
+        source: "shadowlab choice; seed 001 4.3: culling decides the cost",
+        choices: &[],
+    },
+];
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "iasm",
+    summary:
+        "Irregular Adaptive Shadow Maps: 4x4 tiles ahead of the camera, resolutions 1x1024..4x16 by importance rank, one linear buffer",
+    cost: "importance pass + 512-byte readback, up to 16 culled tile passes (atlas: depth test; buffer: atomic max), 1 fetch per pixel",
+    quality: "resolution follows the camera; tile seams where neighbours differ (four-tile corners, thesis Fig. 4.4)",
+    source: "seed 001 (IASM thesis) chapter 3",
+    lights: &["directional"],
+    params: PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, p, light)?)),
+};
+
+/// WGSL `IasmParams` (params.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct IasmParams {
+    pub right: [f32; 4],
+    pub up: [f32; 4],
+    pub dir: [f32; 4],
+    pub imp: [f32; 4],
+    pub res: [u32; 16],
+    pub off: [u32; 16],
+    pub near: [f32; 16],
+    pub far: [f32; 16],
+    /// store=atlas: top-left corner of each tile's square, x | y << 16.
+    pub slot: [u32; 16],
+}
+
+/// WGSL `TileParams` (render.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TileParams {
+    pub view_proj: [[f32; 4]; 4],
+    pub tile: [u32; 4],
+}
