@@ -9,6 +9,7 @@ pub mod light;
 pub mod lightspace;
 pub mod loaders;
 pub mod metrics;
+pub mod moments;
 pub mod params;
 pub mod scene;
 pub mod setup;
