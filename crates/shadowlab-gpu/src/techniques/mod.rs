@@ -1,6 +1,7 @@
 //! The technique trait and the one registry. A technique is a folder with its `mod.rs` and
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
+pub mod filtered;
 pub mod sm;
 
 use std::collections::BTreeMap;
@@ -124,12 +125,13 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &filtered::VSM_INFO, &filtered::ESM_INFO, &filtered::EVSM_INFO, &filtered::MSM_INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
     let mut v = Vec::new();
     v.extend(sm::shaders());
+    v.extend(filtered::shaders());
     v
 }
 

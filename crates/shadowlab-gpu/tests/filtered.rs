@@ -1,0 +1,122 @@
+//! GPU tests of the filterable shadow maps (`vsm`, `esm`, `evsm`, `msm`, with and without
+//! `sd`) against the `rt` reference.
+
+use shadowlab_core::builtin::builtin;
+use shadowlab_core::metrics::compare;
+use shadowlab_core::params::TechniqueSpec;
+use shadowlab_gpu::lab::{Lab, Run};
+
+mod common;
+use common::*;
+
+fn run(lab: &Lab, v: &shadowlab_gpu::lab::View, spec: &str) -> Run {
+    lab.run(v, &TechniqueSpec::parse(spec).unwrap(), 1).unwrap_or_else(|e| panic!("{spec}: {e}"))
+}
+
+fn fractional(r: &Run, mask: &[u32]) -> usize {
+    r.visibility.iter().zip(mask).filter(|(x, m)| **m != 0 && **x > 0.01 && **x < 0.99).count()
+}
+
+/// A box on a plane has an exact shadow. At 2048^2 the 2x2 filter region is a few millimetres,
+/// so every representation must agree with `rt` except within a texel or two of the edge.
+#[test]
+fn filtered_maps_at_high_resolution_match_rt_on_planebox() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    for (name, bytes_per_texel) in [("vsm", 8), ("esm", 4), ("evsm", 16), ("msm", 16)] {
+        let r = run(&lab, &v, &format!("{name}:res=2048"));
+        let a = agreement(&r.visibility, &rt.visibility, &v.mask);
+        if a < THRESHOLD_PLANEBOX {
+            panic!("{name} 2048 agrees with rt on {a:.3}%; {}", save_images(&format!("{name}-planebox"), &v, &r, &rt));
+        }
+        assert_eq!(r.report.shadow_data_bytes, 2048 * 2048 * bytes_per_texel, "{name}");
+        assert_eq!(r.report.counters["fetches_per_pixel"], 4.0);
+        let s = r.report.sampling.as_ref().unwrap();
+        assert!(s.used_texel_fraction > 0.0 && s.samples_per_used_texel_mean >= 1.0);
+        assert_eq!(r.report.images.len(), 2);
+    }
+}
+const THRESHOLD_PLANEBOX: f64 = 99.0;
+
+/// Seed 004 figure 2: on `foliage` the lamp's cables in front of the lamp (one occluder in
+/// front of another) make VSM leak light into the shadow; plain shadow mapping at the same
+/// resolution does not leak there, and at high resolution (near) never.
+#[test]
+fn vsm_leaks_on_foliage_where_sm_does_not() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("foliage").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let m = |r: &Run| compare(&r.visibility, &rt.visibility, &v.mask);
+    let vsm = m(&run(&lab, &v, "vsm"));
+    let sm = m(&run(&lab, &v, "sm"));
+    let sm_hi = m(&run(&lab, &v, "sm:res=4096"));
+    eprintln!("false-lit %: vsm {:.3}, sm {:.3}, sm 4096 {:.3}", vsm.false_lit_pct, sm.false_lit_pct, sm_hi.false_lit_pct);
+    assert!(vsm.false_lit_pct > 2.0 * sm.false_lit_pct && vsm.false_lit_pct > 0.1, "vsm {vsm:?} sm {sm:?}");
+    assert!(sm_hi.false_lit_pct < 0.1, "sm 4096 leaks: {sm_hi:?}");
+}
+
+/// The single-depth variants (gather 2x2, convert, interpolate) compute the same bilinear
+/// moments as the full maps without blur; only the f32 rounding of the stored moments differs.
+#[test]
+fn single_depth_variants_agree_with_full_maps() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    for name in ["vsm", "esm", "evsm", "msm"] {
+        let full = run(&lab, &v, &format!("{name}:blur=1"));
+        let sd = run(&lab, &v, &format!("{name}:sd=true"));
+        let m = compare(&sd.visibility, &full.visibility, &v.mask);
+        assert!(100.0 - m.wrong_pct >= 99.9 && m.mae < 2e-3, "{name}: sd vs full {m:?}");
+        assert_eq!(sd.report.shadow_data_bytes, 512 * 512 * 4);
+        assert_eq!(sd.report.counters["texture_instructions_per_pixel"], 1.0);
+        assert_eq!(sd.report.counters["bytes_read_per_pixel"], 16.0);
+    }
+}
+
+/// Pre-filtering keeps the shadow right but softens its edge: blur=5 agrees with `rt` as well
+/// as blur=1 (within a point), and has more fractional pixels.
+#[test]
+fn blur_softens_edges_and_keeps_the_shadow() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    for name in ["vsm", "evsm"] {
+        let b1 = run(&lab, &v, &format!("{name}:res=1024,blur=1"));
+        let b5 = run(&lab, &v, &format!("{name}:res=1024,blur=5"));
+        let (a1, a5) = (agreement(&b1.visibility, &rt.visibility, &v.mask), agreement(&b5.visibility, &rt.visibility, &v.mask));
+        assert!(a1 >= 98.0 && a5 >= 98.0, "{name}: blur 1 {a1:.3}%, blur 5 {a5:.3}%");
+        let (f1, f5) = (fractional(&b1, &v.mask), fractional(&b5, &v.mask));
+        assert!(f5 > f1 && f1 > 0, "{name}: fractional pixels blur 1 {f1}, blur 5 {f5}");
+        assert_eq!(b5.report.counters["blur_width"], 5.0);
+        assert!(b5.report.counters["blur_scratch_bytes"] > 0.0);
+    }
+}
+
+#[test]
+fn bad_filtered_requests_are_errors() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 32);
+    let e = lab.run(&v, &TechniqueSpec::parse("vsm:blur=4").unwrap(), 1).err().expect("even blur must fail");
+    assert!(e.to_string().contains("odd"), "{e}");
+    assert!(lab.run(&v, &TechniqueSpec::parse("esm:c_pos=3").unwrap(), 1).is_err());
+    assert!(lab.run(&v, &TechniqueSpec::parse("esm:c=100").unwrap(), 1).is_err());
+    let v = view(&lab, &scene, 1, 32); // point light
+    let e = lab.run(&v, &TechniqueSpec::parse("msm").unwrap(), 1).err().expect("point light must fail");
+    assert!(e.to_string().contains("point"), "{e}");
+    // spot light works
+    let v = view(&lab, &scene, 0, 64);
+    let rt = lab.reference(&v, 1).unwrap();
+    let r = run(&lab, &v, "evsm:res=2048");
+    let a = agreement(&r.visibility, &rt.visibility, &v.mask);
+    assert!(a >= 97.0, "spot evsm agrees on {a:.3}%");
+}
