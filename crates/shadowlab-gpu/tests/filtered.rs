@@ -41,6 +41,8 @@ fn filtered_maps_at_high_resolution_match_rt_on_planebox() {
 }
 const THRESHOLD_PLANEBOX: f64 = 99.0;
 
+const LEAK_MIN_PCT: f64 = 0.3;
+
 /// Seed 004 figure 2: on `foliage` the lamp's cables in front of the lamp (one occluder in
 /// front of another) make VSM leak light into the shadow; plain shadow mapping at the same
 /// resolution does not leak there, and at high resolution (near) never.
@@ -52,12 +54,24 @@ fn vsm_leaks_on_foliage_where_sm_does_not() {
     let v = view(&lab, &scene, 0, 256);
     let rt = lab.reference(&v, 1).unwrap();
     let m = |r: &Run| compare(&r.visibility, &rt.visibility, &v.mask);
-    let vsm = m(&run(&lab, &v, "vsm"));
-    let sm = m(&run(&lab, &v, "sm"));
-    let sm_hi = m(&run(&lab, &v, "sm:res=4096"));
-    eprintln!("false-lit %: vsm {:.3}, sm {:.3}, sm 4096 {:.3}", vsm.false_lit_pct, sm.false_lit_pct, sm_hi.false_lit_pct);
-    assert!(vsm.false_lit_pct > 2.0 * sm.false_lit_pct && vsm.false_lit_pct > 0.1, "vsm {vsm:?} sm {sm:?}");
-    assert!(sm_hi.false_lit_pct < 0.1, "sm 4096 leaks: {sm_hi:?}");
+    let (vsm_run, sm_run) = (run(&lab, &v, "vsm"), run(&lab, &v, "sm"));
+    let (vsm, sm, sm_hi) = (m(&vsm_run), m(&sm_run), m(&run(&lab, &v, "sm:res=4096")));
+    // leaks of the upper bound itself: lit for one, shadowed for rt and for the other on the
+    // same 512^2 view of the scene (thin cables and fence wires that both miss cancel out)
+    let only = |a: &Run, b: &Run| {
+        let n = (0..v.mask.len())
+            .filter(|&i| v.mask[i] != 0 && rt.visibility[i] < 0.5 && a.visibility[i] >= 0.5 && b.visibility[i] < 0.5)
+            .count();
+        100.0 * n as f64 / vsm.evaluated_pixels as f64
+    };
+    let (vsm_leaks, sm_leaks) = (only(&vsm_run, &sm_run), only(&sm_run, &vsm_run));
+    eprintln!(
+        "false-lit %: vsm {:.3}, sm {:.3}, sm 4096 {:.3}; vsm-only leaks {vsm_leaks:.3} %, sm-only {sm_leaks:.3} %",
+        vsm.false_lit_pct, sm.false_lit_pct, sm_hi.false_lit_pct
+    );
+    assert!(vsm_leaks > LEAK_MIN_PCT && vsm_leaks > 3.0 * sm_leaks, "vsm {vsm:?} sm {sm:?}");
+    assert!(vsm.false_lit_pct > sm.false_lit_pct, "vsm {vsm:?} sm {sm:?}");
+    assert!(sm_hi.false_lit_pct < 0.25 * vsm.false_lit_pct, "sm 4096 {sm_hi:?}");
 }
 
 /// The single-depth variants (gather 2x2, convert, interpolate) compute the same bilinear
