@@ -125,7 +125,8 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &filtered::VSM_INFO, &filtered::ESM_INFO, &filtered::EVSM_INFO, &filtered::MSM_INFO];
+pub static REGISTRY: &[&TechniqueInfo] =
+    &[&crate::reference::INFO, &sm::INFO, &filtered::VSM_INFO, &filtered::ESM_INFO, &filtered::EVSM_INFO, &filtered::MSM_INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {

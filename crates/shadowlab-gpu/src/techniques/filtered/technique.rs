@@ -57,7 +57,8 @@ impl Filtered {
             }
             _ => 0.0,
         };
-        let (c, c_pos, c_neg) = (get(p, "c", cpu::DEFAULT_ESM_C), get(p, "c_pos", cpu::DEFAULT_EVSM_C_POS), get(p, "c_neg", cpu::DEFAULT_EVSM_C_NEG));
+        let (c, c_pos, c_neg) =
+            (get(p, "c", cpu::DEFAULT_ESM_C), get(p, "c_pos", cpu::DEFAULT_EVSM_C_POS), get(p, "c_neg", cpu::DEFAULT_EVSM_C_NEG));
         let params = FilteredParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
             texel: [lp.texel, lp.perspective as u32 as f32, res as f32, inv_far],
@@ -103,8 +104,11 @@ impl Filtered {
         let render_pipeline =
             raster::scene_pipeline(gpu, &format!("{name}.render"), &render_source(), &[&render_layout, &scene.layout], &[Some(target)]);
         let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering);
-        let eval_layout =
-            view_layout(gpu, &format!("{name}.eval"), &[binding::uniform(), binding::texture_float(), sampler_type, binding::storage(false)]);
+        let eval_layout = view_layout(
+            gpu,
+            &format!("{name}.eval"),
+            &[binding::uniform(), binding::texture_float(), sampler_type, binding::storage(false)],
+        );
         let eval_pipeline = gpu.compute_pipeline(&format!("{name}.evaluate"), &eval_source(), "main", &[&eval_layout]);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("filtered.gather"),
@@ -233,4 +237,3 @@ impl Technique for Filtered {
         r
     }
 }
-
