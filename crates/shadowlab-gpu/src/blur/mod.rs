@@ -43,7 +43,7 @@ pub struct Blur {
 }
 
 impl Blur {
-    /// Blur of `tex` (which needs TEXTURE_BINDING | STORAGE_BINDING) with kernel width `k`
+    /// Blur of mip 0 of `tex` (which needs TEXTURE_BINDING | STORAGE_BINDING) with kernel width `k`
     /// (odd, >= 3; 1 needs no blur). The scratch texture is allocated here.
     pub fn new(gpu: &Gpu, label: &str, tex: &wgpu::Texture, k: u32) -> Result<Blur, GpuError> {
         if k < 3 || k % 2 == 0 {
@@ -58,7 +58,7 @@ impl Blur {
         let d = &gpu.device;
         let scratch = d.create_texture(&wgpu::TextureDescriptor {
             label: Some(&format!("{label}.scratch")),
-            size: tex.size(),
+            size: wgpu::Extent3d { width: tex.width(), height: tex.height(), depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -75,7 +75,7 @@ impl Blur {
         let pipeline = gpu.compute_pipeline(label, &source(wgsl_format), "main", &[&layout]);
         let half = (k / 2) as i32;
         let sigma = (k as f32 - 1.0) / 4.0;
-        let (tv, sv) = (tex.create_view(&Default::default()), scratch.create_view(&Default::default()));
+        let (tv, sv) = (mip0(tex), scratch.create_view(&Default::default()));
         let group = |dir: [i32; 2], src: &wgpu::TextureView, dst: &wgpu::TextureView| {
             let u = gpu.uniform(label, &BlurParams { dir, half, sigma });
             binding::group(
@@ -101,4 +101,9 @@ impl Blur {
         let bpp = self.scratch.format().block_copy_size(None).unwrap_or(16) as u64;
         self.width as u64 * self.height as u64 * bpp
     }
+}
+
+/// A view of mip level 0 only (storage and render-target bindings take one level).
+pub fn mip0(tex: &wgpu::Texture) -> wgpu::TextureView {
+    tex.create_view(&wgpu::TextureViewDescriptor { mip_level_count: Some(1), ..Default::default() })
 }

@@ -4,7 +4,8 @@
 // the sample are loaded and their (pre-blurred) moments interpolated bilinearly (RGBA32Float
 // is not filterable in core WebGPU, so the bilinear filter is done here). Single-depth
 // variants: one textureGather of 4 depths, converted and interpolated in moments.wgsl.
-// Also counts the view samples per texel (sampling statistics).
+// With mips (mode.z = levels > 1) the moments are read trilinearly at the level matching the
+// pixel's footprint. Also counts the view samples per texel (sampling statistics).
 
 struct FilteredParams {
     light_view_proj: mat4x4<f32>,
@@ -60,6 +61,42 @@ fn visibility_gather(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
     }
 }
 
+// The 2x2 texels around uv on mip `level`, interpolated bilinearly (same texels and weights
+// as the single-depth gather on level 0).
+fn bilinear_moments(uv: vec2<f32>, level: i32) -> vec4<f32> {
+    let r = max(i32(fp.texel.z) >> u32(level), 1);
+    let w = gather_weights(uv, f32(r));
+    let t0 = vec2<i32>(floor(uv * f32(r) - 0.5));
+    let lo = vec2<i32>(0);
+    let hi = vec2<i32>(r - 1);
+    return w.x * textureLoad(shadow_map, clamp(t0 + vec2<i32>(0, 1), lo, hi), level)
+        + w.y * textureLoad(shadow_map, clamp(t0 + vec2<i32>(1, 1), lo, hi), level)
+        + w.z * textureLoad(shadow_map, clamp(t0 + vec2<i32>(1, 0), lo, hi), level)
+        + w.w * textureLoad(shadow_map, clamp(t0, lo, hi), level);
+}
+
+// Map distance (texels of level 0) from m0 to the sample of view pixel j; 1e9 if none.
+fn neighbour_distance(j: vec2<i32>, m0: vec2<f32>) -> f32 {
+    if any(j < vec2<i32>(0)) || any(j >= vec2<i32>(frame.size)) {
+        return 1e9;
+    }
+    let pn = textureLoad(g_position, j, 0);
+    if pn.w <= 0.0 {
+        return 1e9;
+    }
+    return length((to_map(pn.xyz).xy - m0) * fp.texel.z);
+}
+
+// Texels of the map covered by one view pixel (no derivatives in compute): per axis the nearer
+// of the two neighbours (one-sided at silhouettes), then the larger axis.
+fn footprint(id: vec2<i32>, m0: vec2<f32>) -> f32 {
+    var fx = min(neighbour_distance(id + vec2<i32>(1, 0), m0), neighbour_distance(id - vec2<i32>(1, 0), m0));
+    var fy = min(neighbour_distance(id + vec2<i32>(0, 1), m0), neighbour_distance(id - vec2<i32>(0, 1), m0));
+    fx = select(fx, 1.0, fx > 1e8);
+    fy = select(fy, 1.0, fy > 1e8);
+    return max(fx, fy);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var s: Sample;
@@ -90,12 +127,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         visibility[s.i] = visibility_gather(z, w, d);
         return;
     }
-    // the same 2x2 texels and order as the gather
-    let t0 = vec2<i32>(floor(m.xy * res - 0.5));
-    let hi = vec2<i32>(i32(res) - 1);
-    let m4 = w.x * textureLoad(shadow_map, clamp(t0 + vec2<i32>(0, 1), vec2<i32>(0), hi), 0)
-        + w.y * textureLoad(shadow_map, clamp(t0 + vec2<i32>(1, 1), vec2<i32>(0), hi), 0)
-        + w.z * textureLoad(shadow_map, clamp(t0 + vec2<i32>(1, 0), vec2<i32>(0), hi), 0)
-        + w.w * textureLoad(shadow_map, clamp(t0, vec2<i32>(0), hi), 0);
-    visibility[s.i] = visibility_of(m4, d);
+    if fp.mode.z > 1u {
+        // trilinear: the level whose texels match the pixel's footprint in the map
+        let top = f32(fp.mode.z - 1u);
+        let lod = clamp(log2(max(footprint(vec2<i32>(id.xy), m0.xy), 1.0)), 0.0, top);
+        let l0 = floor(lod);
+        let mt = mix(bilinear_moments(m.xy, i32(l0)), bilinear_moments(m.xy, i32(min(l0 + 1.0, top))), lod - l0);
+        visibility[s.i] = visibility_of(mt, d);
+        return;
+    }
+    visibility[s.i] = visibility_of(bilinear_moments(m.xy, 0), d);
 }

@@ -8,13 +8,16 @@
 //! `<name>.evaluate` interpolates the 2x2 texels around each sample bilinearly and takes the
 //! representation's upper bound on the lit fraction. With `sd=true` (seed 004 section 3.2) only
 //! the depth is stored (R32Float, never blurred) and the evaluation gathers 2x2 depths, converts
-//! each and interpolates (`*_visibility_gather` in `moments.wgsl`, for leak tracing).
+//! each and interpolates (`*_visibility_gather` in `moments.wgsl`, for leak tracing). With
+//! `mips=true` a box-filtered mip chain is built (`<name>.mips`) and read trilinearly at the
+//! level matching the pixel's footprint in the map (from the neighbouring view samples).
 //!
 //! Stored depth: linear light-space depth in [0, 1], 0 = near the light (orthographic: the
 //! post-projective depth; spot: view depth / far, far = the farthest scene-bounds corner).
 //! Map formats: VSM RG32Float (8 B/texel), ESM R32Float (4), EVSM and MSM RGBA32Float (16),
 //! sd R32Float (4). The CPU math is `shadowlab_core::moments`.
 
+mod mips;
 mod technique;
 
 use bytemuck::{Pod, Zeroable};
@@ -30,7 +33,11 @@ const RENDER_WGSL: &str = include_str!("render.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("filtered/render.wgsl", render_source()), ("filtered/eval.wgsl", eval_source())]
+    vec![
+        ("filtered/render.wgsl", render_source()),
+        ("filtered/eval.wgsl", eval_source()),
+        ("filtered/mips.wgsl (rgba32float)", mips::source("rgba32float")),
+    ]
 }
 fn render_source() -> String {
     compose(&format!("{MOMENTS_WGSL}{RENDER_WGSL}"), true)
@@ -94,6 +101,16 @@ const SD: ParamDef = ParamDef {
     source: "seed 004 section 3.2",
     choices: BOOL,
 };
+const MIPS: ParamDef = ParamDef {
+    key: "mips",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "box-filtered mip chain (+1/3 memory) read trilinearly at the pixel's footprint; ignored with sd=true; softer, wider leaks where texels are small on screen",
+    source: "Donnelly and Lauritzen 2006 (filtering with mipmaps); issue 5",
+    choices: BOOL,
+};
 const BIAS: ParamDef = p(
     "bias",
     DEFAULT_BIAS,
@@ -144,10 +161,10 @@ const MOMENT_BIAS: ParamDef = p(
     "seed 004 section 4 (3e-6 with 32-bit floats)",
 );
 
-pub const VSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, BIAS, NORMAL_OFFSET, MIN_VARIANCE];
-pub const ESM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, BIAS, NORMAL_OFFSET, ESM_C];
-pub const EVSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, BIAS, NORMAL_OFFSET, MIN_VARIANCE, C_POS, C_NEG];
-pub const MSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, BIAS, NORMAL_OFFSET, MOMENT_BIAS];
+pub const VSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MIN_VARIANCE];
+pub const ESM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, ESM_C];
+pub const EVSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MIN_VARIANCE, C_POS, C_NEG];
+pub const MSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MOMENT_BIAS];
 
 const LIGHTS: &[&str] = &["directional", "spot"];
 const COST: &str = "one pass over the scene into a float map + optional separable blur (2 x width taps per texel) + one 2x2 read per pixel";

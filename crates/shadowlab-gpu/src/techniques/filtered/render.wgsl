@@ -8,7 +8,8 @@ struct FilteredParams {
     // x: world size of one texel (orthographic) or per unit of light-view depth (perspective)
     // y: 1 if perspective; z: resolution; w: 1 / far (perspective linear depth)
     texel: vec4<f32>,
-    // x: kind (0 vsm, 1 esm, 2 evsm, 3 msm); y: 1 = single depth (store z only)
+    // x: kind (0 vsm, 1 esm, 2 evsm, 3 msm); y: 1 = single depth (store z only);
+    // z: mip levels (0 or 1 = no mips)
     mode: vec4<u32>,
     // x: minimum variance, y: ESM c, z: EVSM c+, w: EVSM c-
     shape: vec4<f32>,

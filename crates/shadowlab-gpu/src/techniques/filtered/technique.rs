@@ -6,8 +6,9 @@ use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::moments as cpu;
 use shadowlab_core::params::ParamValues;
 
+use super::mips::{self, MipChain};
 use super::{eval_source, render_source, FilteredParams, Kind};
-use crate::blur::Blur;
+use crate::blur::{mip0, Blur};
 use crate::scene_gpu::GpuScene;
 use crate::techniques::sm::{count_image, depth_image};
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
@@ -25,6 +26,7 @@ pub struct Filtered {
     blur: Option<Blur>,
     /// Effective kernel width (1 with sd).
     blur_width: u32,
+    mips: Option<MipChain>,
     counts: wgpu::Buffer,
     uniform: wgpu::Buffer,
     render_pipeline: wgpu::RenderPipeline,
@@ -44,6 +46,7 @@ impl Filtered {
         let res = p.get_u32("res");
         gpu.check_size(res, res, "shadow map")?;
         let sd = p.get_bool("sd");
+        let levels = if p.get_bool("mips") && !sd { mips::levels(res) } else { 1 };
         let blur_width = p.get_u32("blur");
         if blur_width % 2 == 0 {
             return Err(GpuError::Invalid(format!("{name}: blur={blur_width} must be odd (1 = no blur)")));
@@ -62,7 +65,7 @@ impl Filtered {
         let params = FilteredParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
             texel: [lp.texel, lp.perspective as u32 as f32, res as f32, inv_far],
-            mode: [kind as u32, sd as u32, 0, 0],
+            mode: [kind as u32, sd as u32, levels, 0],
             shape: [get(p, "min_variance", cpu::DEFAULT_MIN_VARIANCE) as f32, c as f32, c_pos as f32, c_neg as f32],
             bias: [get(p, "moment_bias", cpu::DEFAULT_MOMENT_BIAS) as f32, p.get("bias") as f32, p.get("normal_offset") as f32, 0.0],
         };
@@ -81,11 +84,11 @@ impl Filtered {
             _ => wgpu::TextureFormat::Rgba32Float,
         };
         let d = &gpu.device;
-        let texture = |label: &str, format, usage| {
+        let texture = |label: &str, format, usage, mip_level_count| {
             d.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-                mip_level_count: 1,
+                mip_level_count,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
                 format,
@@ -94,9 +97,11 @@ impl Filtered {
             })
         };
         use wgpu::TextureUsages as U;
-        let map = texture(&format!("{name}.map"), format, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING | U::COPY_SRC);
-        let depth = texture(&format!("{name}.depth"), raster::DEPTH_FORMAT, U::RENDER_ATTACHMENT);
+        let map =
+            texture(&format!("{name}.map"), format, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING | U::COPY_SRC, levels);
+        let depth = texture(&format!("{name}.depth"), raster::DEPTH_FORMAT, U::RENDER_ATTACHMENT, 1);
         let blur = if blur_width > 1 && !sd { Some(Blur::new(gpu, &format!("{name}.blur"), &map, blur_width)?) } else { None };
+        let mips = if levels > 1 { Some(MipChain::new(gpu, &format!("{name}.mips"), &map)?) } else { None };
         let uniform = gpu.uniform(&format!("{name}.params"), &params);
         let render_layout = binding::layout(d, name, wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
         let render_group = binding::group(d, name, &render_layout, &[uniform.as_entire_binding()]);
@@ -127,6 +132,7 @@ impl Filtered {
             clear,
             blur_width: if blur.is_some() { blur_width } else { 1 },
             blur,
+            mips,
             counts,
             uniform,
             render_pipeline,
@@ -159,7 +165,7 @@ impl Filtered {
 impl Technique for Filtered {
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         let name = self.kind.name();
-        let map_view = self.map.create_view(&Default::default());
+        let map_view = mip0(&self.map);
         let depth_view = self.depth.create_view(&Default::default());
         timer.stage(gpu, &format!("{name}.render"), |enc| {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -187,6 +193,10 @@ impl Technique for Filtered {
         if let Some(blur) = &self.blur {
             let label = format!("{name}.blur");
             timer.stage(gpu, &label, |enc| blur.record(gpu, enc, &label));
+        }
+        if let Some(m) = &self.mips {
+            let label = format!("{name}.mips");
+            timer.stage(gpu, &label, |enc| m.record(gpu, enc, &label));
         }
         Ok(())
     }
@@ -219,12 +229,17 @@ impl Technique for Filtered {
         let counts: Vec<u32> = gpu.read_buffer_as(&self.counts, n);
         let texels: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, bpt as u32));
         let depth = self.first_moment_as_depth(&texels);
-        let mut r = TechniqueReport { shadow_data_bytes: n as u64 * bpt, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+        let levels = self.map.mip_level_count();
+        let bytes = if levels > 1 { mips::chain_bytes(self.res, bpt) } else { n as u64 * bpt };
+        let mut r = TechniqueReport { shadow_data_bytes: bytes, sampling: Some(sampling_stats(&counts)), ..Default::default() };
         let c = &mut r.counters;
-        // texels read per evaluated pixel: 2x2 either way (4 loads, or one gather of 4 depths)
-        c.insert("fetches_per_pixel".into(), 4.0);
-        c.insert("texture_instructions_per_pixel".into(), if self.sd { 1.0 } else { 4.0 });
-        c.insert("bytes_read_per_pixel".into(), 4.0 * bpt as f64);
+        // texels read per evaluated pixel: 2x2 (4 loads, or one gather of 4 depths); trilinear:
+        // 2x2 on two levels (plus 4 G-buffer positions of the neighbours for the footprint)
+        let texels = if levels > 1 { 8.0 } else { 4.0 };
+        c.insert("fetches_per_pixel".into(), texels);
+        c.insert("texture_instructions_per_pixel".into(), if self.sd { 1.0 } else { texels });
+        c.insert("bytes_read_per_pixel".into(), texels * bpt as f64);
+        c.insert("mip_levels".into(), levels as f64);
         c.insert("bytes_per_texel".into(), bpt as f64);
         c.insert("shadow_map_texels".into(), n as f64);
         c.insert("blur_width".into(), self.blur_width as f64);
