@@ -46,7 +46,7 @@ impl Blur {
     /// Blur of mip 0 of `tex` (which needs TEXTURE_BINDING | STORAGE_BINDING) with kernel width `k`
     /// (odd, >= 3; 1 needs no blur). The scratch texture is allocated here.
     pub fn new(gpu: &Gpu, label: &str, tex: &wgpu::Texture, k: u32) -> Result<Blur, GpuError> {
-        if k < 3 || k % 2 == 0 {
+        if k < 3 || k.is_multiple_of(2) {
             return Err(GpuError::Invalid(format!("{label}: blur kernel width {k} must be odd and at least 3")));
         }
         let format = tex.format();

@@ -48,7 +48,7 @@ impl Filtered {
         let sd = p.get_bool("sd");
         let levels = if p.get_bool("mips") && !sd { mips::levels(res) } else { 1 };
         let blur_width = p.get_u32("blur");
-        if blur_width % 2 == 0 {
+        if blur_width.is_multiple_of(2) {
             return Err(GpuError::Invalid(format!("{name}: blur={blur_width} must be odd (1 = no blur)")));
         }
         let lp = lightspace::fit(light, &scene.bounds, res)
