@@ -117,7 +117,8 @@ pub fn msm_shadow_intensity(b: [f64; 4], d: f64, bias: f64) -> f64 {
     if g.is_finite() {
         g.clamp(0.0, 1.0)
     } else {
-        0.0
+        // numerically singular (f32 on the GPU): the two-moment (Chebyshev) bound
+        1.0 - chebyshev(b[0], b[1], d, 0.0)
     }
 }
 

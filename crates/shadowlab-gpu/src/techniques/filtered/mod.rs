@@ -28,7 +28,9 @@ use crate::shaders::compose;
 use crate::techniques::{compose_view, TechniqueInfo};
 pub use technique::Filtered;
 
-const MOMENTS_WGSL: &str = include_str!("moments.wgsl");
+/// The representation library (encoders, bounds, `*_visibility_gather`): self-contained WGSL
+/// with no bindings, for other passes (leak tracing) to prepend.
+pub const MOMENTS_WGSL: &str = include_str!("moments.wgsl");
 const RENDER_WGSL: &str = include_str!("render.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 

@@ -87,9 +87,9 @@ fn msm_visibility(moments: vec4<f32>, d: f32, bias: f32) -> f32 {
     } else {
         g = 1.0 - (z2 * z3 - b.x * (z2 + z3) + b.y) / ((d - z2) * (d - z3));
     }
-    // NaN/inf (degenerate moments) counts as lit, like the CPU version
+    // NaN/inf (degenerate moments): the Chebyshev bound, like the CPU version
     if !(abs(g) <= 1e30) {
-        g = 0.0;
+        return chebyshev_bound(b.x, b.y, d, 0.0);
     }
     return 1.0 - clamp(g, 0.0, 1.0);
 }
