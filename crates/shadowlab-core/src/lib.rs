@@ -13,6 +13,7 @@ pub mod lightspace;
 pub mod loaders;
 pub mod mdsm;
 pub mod metrics;
+pub mod moments;
 pub mod params;
 pub mod scene;
 pub mod setup;

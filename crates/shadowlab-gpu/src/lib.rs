@@ -6,6 +6,7 @@
 //! [`lab::Lab`] runs that flow for one view and hands back what metrics and reports need.
 
 pub mod binding;
+pub mod blur;
 pub mod context;
 pub mod frame;
 pub mod gbuffer;

@@ -21,6 +21,7 @@ pub fn all() -> Vec<(&'static str, String)> {
     v.extend(crate::reference::shaders());
     v.extend(crate::shade::shaders());
     v.extend(crate::reduce::shaders());
+    v.extend(crate::blur::shaders());
     v.extend(crate::techniques::shaders());
     v
 }

@@ -207,3 +207,32 @@ fn iasm_layouts_match_wgsl() {
         check(&get(n), "TileParams", size_of::<TileParams>(), &[("tile", offset_of!(TileParams, tile))]);
     }
 }
+
+#[test]
+fn filtered_and_blur_layouts_match_rust() {
+    use shadowlab_gpu::blur::BlurParams;
+    use shadowlab_gpu::techniques::filtered::FilteredParams;
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    for f in ["filtered/render.wgsl", "filtered/eval.wgsl"] {
+        check(
+            &get(f),
+            "FilteredParams",
+            size_of::<FilteredParams>(),
+            &[
+                ("texel", offset_of!(FilteredParams, texel)),
+                ("mode", offset_of!(FilteredParams, mode)),
+                ("shape", offset_of!(FilteredParams, shape)),
+                ("bias", offset_of!(FilteredParams, bias)),
+            ],
+        );
+    }
+    for b in ["blur/blur.wgsl (r32float)", "blur/blur.wgsl (rgba32float)"] {
+        check(
+            &get(b),
+            "BlurParams",
+            size_of::<BlurParams>(),
+            &[("dir", offset_of!(BlurParams, dir)), ("half", offset_of!(BlurParams, half)), ("sigma", offset_of!(BlurParams, sigma))],
+        );
+    }
+}

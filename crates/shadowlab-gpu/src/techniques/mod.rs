@@ -2,6 +2,7 @@
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
 pub mod csm;
+pub mod filtered;
 pub mod iasm;
 pub mod mdsm;
 pub mod sm;
@@ -134,7 +135,18 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &mdsm::INFO, &sv::INFO, &csm::INFO, &iasm::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[
+    &crate::reference::INFO,
+    &sm::INFO,
+    &sv::INFO,
+    &mdsm::INFO,
+    &filtered::VSM_INFO,
+    &filtered::ESM_INFO,
+    &filtered::EVSM_INFO,
+    &filtered::MSM_INFO,
+    &csm::INFO,
+    &iasm::INFO,
+];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
@@ -144,6 +156,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(sv::shaders());
     v.extend(csm::shaders());
     v.extend(iasm::shaders());
+    v.extend(filtered::shaders());
     v
 }
 

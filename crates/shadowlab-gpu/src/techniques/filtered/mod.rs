@@ -1,0 +1,224 @@
+//! Filterable shadow maps (seed 004 section 2.1): `vsm` (z, z^2; Chebyshev), `esm` (e^{cz};
+//! Markov), `evsm` (positive and negative exponential warps, two Chebyshev bounds, the minimum),
+//! `msm` (four moments, Hamburger 4-moment bound). Four registry entries, one implementation.
+//!
+//! Passes: `<name>.render` rasterises the scene from the light (directional: orthographic,
+//! spot: perspective, via `lightspace::fit`) writing b(z) per texel; `<name>.blur` pre-filters it
+//! with the separable Gaussian of [`crate::blur`] (`blur` = kernel width, 1 = none);
+//! `<name>.evaluate` interpolates the 2x2 texels around each sample bilinearly and takes the
+//! representation's upper bound on the lit fraction. With `sd=true` (seed 004 section 3.2) only
+//! the depth is stored (R32Float, never blurred) and the evaluation gathers 2x2 depths, converts
+//! each and interpolates (`*_visibility_gather` in `moments.wgsl`, for leak tracing). With
+//! `mips=true` a box-filtered mip chain is built (`<name>.mips`) and read trilinearly at the
+//! level matching the pixel's footprint in the map (from the neighbouring view samples).
+//!
+//! Stored depth: linear light-space depth in [0, 1], 0 = near the light (orthographic: the
+//! post-projective depth; spot: view depth / far, far = the farthest scene-bounds corner).
+//! Map formats: VSM RG32Float (8 B/texel), ESM R32Float (4), EVSM and MSM RGBA32Float (16),
+//! sd R32Float (4). The CPU math is `shadowlab_core::moments`.
+
+mod mips;
+mod technique;
+
+use bytemuck::{Pod, Zeroable};
+use shadowlab_core::moments as cpu;
+use shadowlab_core::params::{ParamDef, BOOL};
+
+use crate::shaders::compose;
+use crate::techniques::{compose_view, TechniqueInfo};
+pub use technique::Filtered;
+
+/// The representation library (encoders, bounds, `*_visibility_gather`): self-contained WGSL
+/// with no bindings, for other passes (leak tracing) to prepend.
+pub const MOMENTS_WGSL: &str = include_str!("moments.wgsl");
+const RENDER_WGSL: &str = include_str!("render.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![
+        ("filtered/render.wgsl", render_source()),
+        ("filtered/eval.wgsl", eval_source()),
+        ("filtered/mips.wgsl (rgba32float)", mips::source("rgba32float")),
+    ]
+}
+fn render_source() -> String {
+    compose(&format!("{MOMENTS_WGSL}{RENDER_WGSL}"), true)
+}
+fn eval_source() -> String {
+    compose_view(&format!("{MOMENTS_WGSL}{EVAL_WGSL}"), false)
+}
+
+/// The four representations; the index is `mode.x` in the WGSL.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Vsm = 0,
+    Esm = 1,
+    Evsm = 2,
+    Msm = 3,
+}
+
+impl Kind {
+    pub fn name(self) -> &'static str {
+        ["vsm", "esm", "evsm", "msm"][self as usize]
+    }
+    /// Channels of the (non-sd) map.
+    pub fn channels(self) -> u32 {
+        [2, 1, 4, 4][self as usize]
+    }
+}
+
+/// Blur kernel width default. Measured (docs/bench/filtered.md): 1 gives the fewest wrong
+/// pixels against `rt` on foliage, courtyard and sponza (any blur widens every leak and every
+/// edge); larger widths soften the edges (the point of pre-filtering) at that cost.
+pub const DEFAULT_BLUR: f64 = 1.0;
+/// Constant bias (texels along the light) and normal offset (texels along the normal). The upper
+/// bounds need no bias (seed 004 section 2.1): a sweep (normal offset 0/0.5/1 x bias 0/0.5,
+/// 512x512 output, foliage and courtyard, 2026-11-22, docs/bench/filtered.md) found 0/0 best or
+/// within 0.1 point of best for all four; every normal offset widens the leaks (courtyard VSM
+/// 1.19 % wrong at 0, 1.56 % at 0.5, 1.99 % at 1). Kept as parameters for curved receivers.
+pub const DEFAULT_BIAS: f64 = 0.0;
+pub const DEFAULT_NORMAL_OFFSET: f64 = 0.0;
+
+const fn p(key: &'static str, default: f64, min: f64, max: f64, integer: bool, doc: &'static str, source: &'static str) -> ParamDef {
+    ParamDef { key, default, min, max, integer, doc, source, choices: &[] }
+}
+
+const RES: ParamDef = p("res", 512.0, 16.0, 16384.0, true, "shadow map side (texels)", "seeds' evaluation: 512 with 1024x1024 output");
+const BLUR: ParamDef = p(
+    "blur",
+    DEFAULT_BLUR,
+    1.0,
+    15.0,
+    true,
+    "Gaussian pre-filter kernel width (odd; 1 = none; sigma = (width-1)/4); ignored with sd=true; high: wider leaks and softer edges",
+    "seed 004 section 2.1 eq. 2; default: shadowlab measurement (docs/bench/filtered.md)",
+);
+const SD: ParamDef = ParamDef {
+    key: "sd",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "single depth: store linear depth only (R32Float), gather 2x2 and convert in the shader",
+    source: "seed 004 section 3.2",
+    choices: BOOL,
+};
+const MIPS: ParamDef = ParamDef {
+    key: "mips",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "box-filtered mip chain (+1/3 memory) read trilinearly at the pixel's footprint; ignored with sd=true; softer, wider leaks where texels are small on screen",
+    source: "Donnelly and Lauritzen 2006 (filtering with mipmaps); issue 5",
+    choices: BOOL,
+};
+const BIAS: ParamDef = p(
+    "bias",
+    DEFAULT_BIAS,
+    0.0,
+    100.0,
+    false,
+    "constant depth bias, texels; high: peter-panning",
+    "shadowlab measurement (docs/bench/filtered.md)",
+);
+const NORMAL_OFFSET: ParamDef = p(
+    "normal_offset",
+    DEFAULT_NORMAL_OFFSET,
+    0.0,
+    100.0,
+    false,
+    "offset along the normal, texels; low: self-shadowing on curved/grazing receivers, high: shifted shadows",
+    "Holbert 2011; value: shadowlab measurement (docs/bench/filtered.md)",
+);
+const MIN_VARIANCE: ParamDef = p(
+    "min_variance",
+    cpu::DEFAULT_MIN_VARIANCE,
+    0.0,
+    1.0,
+    false,
+    "minimum variance (depth units^2; EVSM: scaled by each warp's slope); low: acne, high: leaks",
+    "seed 004 section 4 (1e-10)",
+);
+const ESM_C: ParamDef =
+    p("c", cpu::DEFAULT_ESM_C, 0.0, 88.0, false, "ESM exponent; low: leaks near contact, > 88: f32 overflow", "seed 004 section 4 (80)");
+const C_POS: ParamDef = p(
+    "c_pos",
+    cpu::DEFAULT_EVSM_C_POS,
+    0.0,
+    42.0,
+    false,
+    "EVSM positive exponent (depth in [-1,1]); high: f32 overflow of e^{2c}",
+    "seed 004 section 4 (20)",
+);
+const C_NEG: ParamDef =
+    p("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, false, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
+const MOMENT_BIAS: ParamDef = p(
+    "moment_bias",
+    cpu::DEFAULT_MOMENT_BIAS,
+    0.0,
+    1.0,
+    false,
+    "MSM blend of the moments towards 0.5; low: unstable (singular Hankel matrix), high: leaks",
+    "seed 004 section 4 (3e-6 with 32-bit floats)",
+);
+
+pub const VSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MIN_VARIANCE];
+pub const ESM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, ESM_C];
+pub const EVSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MIN_VARIANCE, C_POS, C_NEG];
+pub const MSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MOMENT_BIAS];
+
+const LIGHTS: &[&str] = &["directional", "spot"];
+const COST: &str = "one pass over the scene into a float map + optional separable blur (2 x width taps per texel) + one 2x2 read per pixel";
+
+pub const VSM_INFO: TechniqueInfo = TechniqueInfo {
+    name: "vsm",
+    summary: "variance shadow map: (z, z^2), pre-filterable, Chebyshev upper bound",
+    cost: COST,
+    quality: "soft, bias-free edges; light leaks where an occluder lies in front of another (high variance)",
+    source: "Donnelly and Lauritzen 2006; seed 004 section 2.1",
+    lights: LIGHTS,
+    params: VSM_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Vsm)?)),
+};
+pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
+    name: "esm",
+    summary: "exponential shadow map: e^{cz}, pre-filterable, Markov upper bound",
+    cost: COST,
+    quality: "leaks wherever receiver and occluder are close in depth (contact), worse for large depth ranges",
+    source: "Annen et al. 2008, Salvi 2008; seed 004 section 2.1",
+    lights: LIGHTS,
+    params: ESM_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Esm)?)),
+};
+pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
+    name: "evsm",
+    summary: "exponential variance shadow map: moments of e^{c+ z} and -e^{-c- z}, min of two Chebyshev bounds",
+    cost: COST,
+    quality: "fewer leaks than VSM and ESM; 16 bytes per texel",
+    source: "Lauritzen and McCool 2008; seed 004 section 2.1 (leak tracing's default)",
+    lights: LIGHTS,
+    params: EVSM_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Evsm)?)),
+};
+pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
+    name: "msm",
+    summary: "moment shadow map: (z, z^2, z^3, z^4), Hamburger 4-moment bound with moment bias",
+    cost: COST,
+    quality: "sharper bound than VSM for two occluder layers; leaks near steep edges with values near 1",
+    source: "Peters and Klein 2015 (algorithm 2); seed 004 section 2.1",
+    lights: LIGHTS,
+    params: MSM_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Msm)?)),
+};
+
+/// WGSL `FilteredParams` (render.wgsl and eval.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FilteredParams {
+    pub light_view_proj: [[f32; 4]; 4],
+    pub texel: [f32; 4],
+    pub mode: [u32; 4],
+    pub shape: [f32; 4],
+    pub bias: [f32; 4],
+}
