@@ -132,3 +132,11 @@ fn shared_struct_layouts_match_rust() {
         check(&get(sm), "SmParams", size_of::<SmParams>(), &[("texel", offset_of!(SmParams, texel)), ("bias", offset_of!(SmParams, bias))]);
     }
 }
+
+#[test]
+fn min_sm_reduce_layout_matches_rust() {
+    use shadowlab_gpu::techniques::min_sm::MsfReduce;
+    let all = shadowlab_gpu::shaders::all();
+    let src = &all.iter().find(|(n, _)| *n == "min_sm/reduce.wgsl").expect("min_sm/reduce.wgsl listed").1;
+    check(&parse("min_sm/reduce.wgsl", src), "MsfReduce", size_of::<MsfReduce>(), &[("mode", offset_of!(MsfReduce, mode))]);
+}

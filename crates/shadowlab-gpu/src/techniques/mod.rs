@@ -1,6 +1,7 @@
 //! The technique trait and the one registry. A technique is a folder with its `mod.rs` and
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
+pub mod min_sm;
 pub mod sm;
 
 use std::collections::BTreeMap;
@@ -124,12 +125,13 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &min_sm::INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
     let mut v = Vec::new();
     v.extend(sm::shaders());
+    v.extend(min_sm::shaders());
     v
 }
 

@@ -1,0 +1,92 @@
+// min-sm reduction of the view samples projected into the light's fixed frame (directional:
+// orthographic plane x, y; spot: image plane x/d, y/d), d = depth along the light.
+// `bounds`: bounding box of the plane coordinates, greatest depth and sample count
+// (workgroup-reduced, then one global atomic per word). `rows`: per band of `grid` rows of that
+// box, the least and greatest x. Values are order-preserving u32 codes (calipers/frustum.rs
+// encode_max / encode_min), all combined with atomicMax over a buffer cleared to 0 (= empty).
+
+struct MsfReduce {
+    // world -> light view (right-handed, looking along -z)
+    frame_view: mat4x4<f32>,
+    // x: 1 if perspective, y: grid (bands), z, w: unused
+    mode: vec4<u32>,
+}
+
+@group(0) @binding(6) var<uniform> msf: MsfReduce;
+// [0] min x, [1] max x, [2] min y, [3] max y, [4] max depth, [5] count, [6..8) unused,
+// then (min x, max x) per band
+@group(0) @binding(7) var<storage, read_write> red: array<atomic<u32>>;
+
+const HEADER: u32 = 8u;
+
+var<workgroup> wg: array<atomic<u32>, 6>;
+
+fn code_max(x: f32) -> u32 {
+    let b = bitcast<u32>(x);
+    if (b & 0x80000000u) != 0u {
+        return ~b;
+    }
+    return b | 0x80000000u;
+}
+
+fn code_min(x: f32) -> u32 {
+    return ~code_max(x);
+}
+
+fn decode_max(u: u32) -> f32 {
+    if (u & 0x80000000u) != 0u {
+        return bitcast<f32>(u & 0x7fffffffu);
+    }
+    return bitcast<f32>(~u);
+}
+
+// (plane x, plane y, depth)
+fn project(p: vec3<f32>) -> vec3<f32> {
+    let q = (msf.frame_view * vec4<f32>(p, 1.0)).xyz;
+    let d = -q.z;
+    if msf.mode.x == 1u {
+        return vec3<f32>(q.xy / d, d);
+    }
+    return vec3<f32>(q.xy, d);
+}
+
+@compute @workgroup_size(8, 8)
+fn bounds(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    var s: Sample;
+    if load_sample(id, &s) {
+        let q = project(s.p);
+        atomicMax(&wg[0], code_min(q.x));
+        atomicMax(&wg[1], code_max(q.x));
+        atomicMax(&wg[2], code_min(q.y));
+        atomicMax(&wg[3], code_max(q.y));
+        atomicMax(&wg[4], code_max(q.z));
+        atomicAdd(&wg[5], 1u);
+    }
+    workgroupBarrier();
+    if li == 0u {
+        let n = atomicLoad(&wg[5]);
+        if n > 0u {
+            for (var k = 0u; k < 5u; k++) {
+                atomicMax(&red[k], atomicLoad(&wg[k]));
+            }
+            atomicAdd(&red[5], n);
+        }
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let q = project(s.p);
+    let lo = decode_max(~atomicLoad(&red[2]));
+    let hi = decode_max(atomicLoad(&red[3]));
+    let grid = msf.mode.y;
+    // band_of in calipers/frustum.rs
+    let t = (q.y - lo) / max(hi - lo, 1e-30);
+    let band = min(u32(max(t, 0.0) * f32(grid)), grid - 1u);
+    atomicMax(&red[HEADER + 2u * band], code_min(q.x));
+    atomicMax(&red[HEADER + 2u * band + 1u], code_max(q.x));
+}
