@@ -150,7 +150,7 @@ fn degenerate_sample_sets_give_valid_maps() {
     let [q, _] = ndc(&m, one[0]);
     assert!(q.x.abs() < 1e-4 && q.y.abs() < 1e-4, "{q}"); // f32 plane coordinates of the reduction
     assert_eq!(m.hull_points, 1); // one band, its x range and y range both a point
-    // samples on a line in the light plane (a vertical edge seen along the light)
+                                  // samples on a line in the light plane (a vertical edge seen along the light)
     let line: Vec<DVec3> = (0..50).map(|i| DVec3::new(-2.0, 0.0, -1.0) + DVec3::new(0.3, 0.0, 0.2) * (i as f64 * 0.1)).collect();
     check_fit(&light, &line, 512, 1.0);
     let spot = Light::Spot { position: Vec3::new(0.0, 2.9, 0.0), direction: -Vec3::Y, cone_deg: 40.0 };
