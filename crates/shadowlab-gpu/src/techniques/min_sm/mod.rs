@@ -37,6 +37,9 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 /// up to 6 % per side); too high: more atomics targets and a longer read-back (8 bytes per band).
 /// 1024 keeps the overshoot at a quarter texel of a 512 map on the box's y side.
 pub const DEFAULT_GRID: f64 = 1024.0;
+/// Pixels of a screen row one reduction thread walks, keeping its extremes in registers:
+/// neighbouring pixels mostly fall in the same band, so atomics drop by about this factor.
+pub const RUN: u32 = 16;
 /// Texels of padding beyond the bias reach (normal offset + PCF half width): f32 rounding of the
 /// projected samples and of the band bounds. Too low: samples at the rim read outside the map
 /// (lit); too high: wasted texels.
@@ -164,7 +167,7 @@ impl MinShadowMap {
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             ..Default::default()
         });
-        let reduce = MsfReduce { frame_view: frame.view.as_mat4().to_cols_array_2d(), mode: [frame.perspective as u32, grid, 0, 0] };
+        let reduce = MsfReduce { frame_view: frame.view.as_mat4().to_cols_array_2d(), mode: [frame.perspective as u32, grid, RUN, 0] };
         let reduce_uniform = gpu.uniform("min-sm.reduce", &reduce);
         let reduce_layout = view_layout(gpu, "min-sm.reduce", &[binding::uniform(), binding::storage(false)]);
         let src = compose_view(REDUCE_WGSL, false);
@@ -230,8 +233,8 @@ impl Technique for MinShadowMap {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         timer.stage(gpu, "min-sm.reduce", |enc| {
             enc.clear_buffer(&self.red, 0, None);
-            gpu.dispatch_2d(enc, "min-sm.reduce.bounds", &self.bounds_pipeline, &[&group], w, h);
-            gpu.dispatch_2d(enc, "min-sm.reduce.rows", &self.rows_pipeline, &[&group], w, h);
+            gpu.dispatch_2d(enc, "min-sm.reduce.bounds", &self.bounds_pipeline, &[&group], w.div_ceil(RUN), h);
+            gpu.dispatch_2d(enc, "min-sm.reduce.rows", &self.rows_pipeline, &[&group], w.div_ceil(RUN), h);
             enc.copy_buffer_to_buffer(&self.red, 0, &self.staging, 0, self.red.size());
         });
         let t0 = std::time::Instant::now();

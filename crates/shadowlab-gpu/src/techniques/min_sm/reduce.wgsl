@@ -8,7 +8,7 @@
 struct MsfReduce {
     // world -> light view (right-handed, looking along -z)
     frame_view: mat4x4<f32>,
-    // x: 1 if perspective, y: grid (bands), z, w: unused
+    // x: 1 if perspective, y: grid (bands), z: pixels per thread along a screen row, w: unused
     mode: vec4<u32>,
 }
 
@@ -50,43 +50,80 @@ fn project(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(q.xy, d);
 }
 
+// Each thread walks `run` pixels of one screen row (thread x covers x = id.x * run ..), keeping
+// its extremes in registers: neighbouring pixels mostly share a band, so few atomics are issued.
+fn pixel(id: vec3<u32>, k: u32) -> vec3<u32> {
+    return vec3<u32>(id.x * msf.mode.z + k, id.y, 0u);
+}
+
 @compute @workgroup_size(8, 8)
 fn bounds(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    var s: Sample;
-    if load_sample(id, &s) {
-        let q = project(s.p);
-        atomicMax(&wg[0], code_min(q.x));
-        atomicMax(&wg[1], code_max(q.x));
-        atomicMax(&wg[2], code_min(q.y));
-        atomicMax(&wg[3], code_max(q.y));
-        atomicMax(&wg[4], code_max(q.z));
-        atomicAdd(&wg[5], 1u);
+    var lo = vec3<f32>(3.4e38);
+    var hi = vec3<f32>(-3.4e38);
+    var n = 0u;
+    for (var k = 0u; k < msf.mode.z; k++) {
+        var s: Sample;
+        if load_sample(pixel(id, k), &s) {
+            let q = project(s.p);
+            lo = min(lo, q);
+            hi = max(hi, q);
+            n += 1u;
+        }
+    }
+    if n > 0u {
+        atomicMax(&wg[0], code_min(lo.x));
+        atomicMax(&wg[1], code_max(hi.x));
+        atomicMax(&wg[2], code_min(lo.y));
+        atomicMax(&wg[3], code_max(hi.y));
+        atomicMax(&wg[4], code_max(hi.z));
+        atomicAdd(&wg[5], n);
     }
     workgroupBarrier();
     if li == 0u {
-        let n = atomicLoad(&wg[5]);
-        if n > 0u {
+        let total = atomicLoad(&wg[5]);
+        if total > 0u {
             for (var k = 0u; k < 5u; k++) {
                 atomicMax(&red[k], atomicLoad(&wg[k]));
             }
-            atomicAdd(&red[5], n);
+            atomicAdd(&red[5], total);
         }
     }
 }
 
+fn flush(band: u32, lo: f32, hi: f32) {
+    atomicMax(&red[HEADER + 2u * band], code_min(lo));
+    atomicMax(&red[HEADER + 2u * band + 1u], code_max(hi));
+}
+
 @compute @workgroup_size(8, 8)
 fn rows(@builtin(global_invocation_id) id: vec3<u32>) {
-    var s: Sample;
-    if !load_sample(id, &s) {
-        return;
-    }
-    let q = project(s.p);
-    let lo = decode_max(~atomicLoad(&red[2]));
-    let hi = decode_max(atomicLoad(&red[3]));
+    let lo_y = decode_max(~atomicLoad(&red[2]));
+    let hi_y = decode_max(atomicLoad(&red[3]));
     let grid = msf.mode.y;
-    // band_of in calipers/frustum.rs
-    let t = (q.y - lo) / max(hi - lo, 1e-30);
-    let band = min(u32(max(t, 0.0) * f32(grid)), grid - 1u);
-    atomicMax(&red[HEADER + 2u * band], code_min(q.x));
-    atomicMax(&red[HEADER + 2u * band + 1u], code_max(q.x));
+    var cur = 0xffffffffu;
+    var lo = 0.0;
+    var hi = 0.0;
+    for (var k = 0u; k < msf.mode.z; k++) {
+        var s: Sample;
+        if load_sample(pixel(id, k), &s) {
+            let q = project(s.p);
+            // band_of in calipers/frustum.rs
+            let t = (q.y - lo_y) / max(hi_y - lo_y, 1e-30);
+            let band = min(u32(max(t, 0.0) * f32(grid)), grid - 1u);
+            if band != cur {
+                if cur != 0xffffffffu {
+                    flush(cur, lo, hi);
+                }
+                cur = band;
+                lo = q.x;
+                hi = q.x;
+            } else {
+                lo = min(lo, q.x);
+                hi = max(hi, q.x);
+            }
+        }
+    }
+    if cur != 0xffffffffu {
+        flush(cur, lo, hi);
+    }
 }
