@@ -85,15 +85,6 @@ pub struct MsfReduce {
     pub mode: [u32; 4],
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn shares_sm_parameters_by_key() {
-        let keys: Vec<_> = super::PARAMS.iter().map(|p| p.key).collect();
-        assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid"]);
-    }
-}
-
 pub struct MinShadowMap {
     res: u32,
     pcf: u32,
@@ -316,5 +307,14 @@ impl Technique for MinShadowMap {
         r.images.push(depth_image("shadow map (depth)", self.res, &depth));
         r.images.push(count_image("view samples per texel", self.res, &counts));
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shares_sm_parameters_by_key() {
+        let keys: Vec<_> = super::PARAMS.iter().map(|p| p.key).collect();
+        assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid"]);
     }
 }
