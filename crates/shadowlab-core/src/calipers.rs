@@ -149,6 +149,50 @@ pub fn min_area_rect(hull: &[DVec2]) -> Option<Rect> {
     best.map(|(_, r)| r)
 }
 
+/// The enclosing rectangle whose longer side is shortest: for a square map it gives the smallest
+/// (square) texel, where [`min_area_rect`] gives the most texels per area but may stretch them.
+/// max(w, h) over the orientation is piecewise sinusoidal: w and h alone are concave between
+/// the hull-edge orientations (their breakpoints), so the minimum is at a breakpoint or where
+/// w = h inside an interval. All are tried; O(n^2) for n hull vertices (n is small here).
+pub fn min_side_rect(hull: &[DVec2]) -> Option<Rect> {
+    if hull.len() < 3 {
+        return min_area_rect(hull);
+    }
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let n = hull.len();
+    let mut cuts: Vec<f64> =
+        (0..n).filter_map(|i| (hull[(i + 1) % n] - hull[i]).try_normalize()).map(|e| e.y.atan2(e.x).rem_euclid(quarter)).collect();
+    cuts.sort_by(f64::total_cmp);
+    let mut candidates = cuts.clone();
+    for (i, &a) in cuts.iter().enumerate() {
+        let b = if i + 1 < cuts.len() { cuts[i + 1] } else { cuts[0] + quarter };
+        if b - a < 1e-15 {
+            continue;
+        }
+        // extreme vertices are fixed inside (a, b): w = d1 . u, h = d2 . u.perp()
+        let mid = DVec2::from_angle(0.5 * (a + b));
+        let span = |dir: DVec2| {
+            let (lo, hi) = hull.iter().fold((hull[0], hull[0]), |(lo, hi), p| {
+                (if p.dot(dir) < lo.dot(dir) { *p } else { lo }, if p.dot(dir) > hi.dot(dir) { *p } else { hi })
+            });
+            hi - lo
+        };
+        let (d1, d2) = (span(mid), span(mid.perp()));
+        // d1.x c + d1.y s = d2.y c - d2.x s
+        let t = (d2.y - d1.x).atan2(d1.y + d2.x);
+        for k in -2..=2 {
+            let th = t + k as f64 * std::f64::consts::PI;
+            if th > a && th < b {
+                candidates.push(th);
+            }
+        }
+    }
+    candidates
+        .iter()
+        .filter_map(|&th| bounding_rect(hull, DVec2::from_angle(th)))
+        .min_by(|r, s| r.half.max_element().total_cmp(&s.half.max_element()).then(r.area().total_cmp(&s.area())))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -225,6 +269,31 @@ mod tests {
                 assert!(a >= r.area() * (1.0 - 1e-9), "trial {trial}: angle {s} gives {a} < {}", r.area());
             }
         }
+    }
+
+    #[test]
+    fn min_side_rect_beats_every_sampled_orientation() {
+        let mut rng = Rng(21);
+        for trial in 0..200 {
+            let n = 3 + (rng.next() * 60.0) as usize;
+            let pts = random_set(&mut rng, n, trial % 3);
+            let hull = convex_hull(&pts);
+            let r = min_side_rect(&hull).unwrap();
+            let side = r.half.max_element();
+            let tol = 1e-9 * (1.0 + r.center.length() + side);
+            assert!(pts.iter().all(|p| r.contains(*p, tol)), "trial {trial}");
+            for s in 0..2000 {
+                let q = bounding_rect(&pts, DVec2::from_angle(s as f64 * std::f64::consts::FRAC_PI_2 / 2000.0)).unwrap();
+                assert!(q.half.max_element() >= side - tol, "trial {trial}: angle {s} gives {} < {side}", q.half.max_element());
+            }
+            // never smaller in area than the minimum-area rectangle
+            assert!(r.area() >= min_area_rect(&hull).unwrap().area() * (1.0 - 1e-9));
+        }
+        // a 4 x 1 rectangle: min area keeps it (4 x 1), min side turns it to 45 degrees (5/sqrt 2 square)
+        let h = convex_hull(&[DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(4.0, 1.0), DVec2::new(0.0, 1.0)]);
+        let r = min_side_rect(&h).unwrap();
+        assert!((r.half.max_element() * 2.0 - 5.0 / 2f64.sqrt()).abs() < 1e-9, "{r:?}");
+        assert!((min_area_rect(&h).unwrap().area() - 4.0).abs() < 1e-12);
     }
 
     #[test]

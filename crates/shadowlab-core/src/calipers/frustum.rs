@@ -12,7 +12,7 @@
 
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 
-use super::{convex_hull, min_area_rect, Rect};
+use super::{convex_hull, min_area_rect, min_side_rect, Rect};
 use crate::light::Light;
 use crate::scene::Bounds;
 
@@ -183,6 +183,15 @@ impl Reduction {
     }
 }
 
+/// Which rectangle around the hull the map covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RectFit {
+    /// Minimum area (the seeds' MSF): most texels on the samples, texels may be stretched.
+    Area,
+    /// Shortest longer side: the smallest texel side (square texels in a square map).
+    Side,
+}
+
 /// A fitted minimal shadow frustum.
 #[derive(Clone, Debug)]
 pub struct MinFrustum {
@@ -211,13 +220,24 @@ impl MinFrustum {
 
 /// Fits the MSF of `red` for a `res`-texel map, padding the rectangle by `pad_texels` texels on
 /// every side (normal offset and PCF kernel reach beyond a sample). `None` for point lights.
-pub fn fit(light: &Light, bounds: &Bounds, frame: &LightFrame, red: &Reduction, res: u32, pad_texels: f64) -> Option<MinFrustum> {
+pub fn fit(
+    light: &Light,
+    bounds: &Bounds,
+    frame: &LightFrame,
+    red: &Reduction,
+    res: u32,
+    pad_texels: f64,
+    shape: RectFit,
+) -> Option<MinFrustum> {
     if matches!(light, Light::Point { .. }) {
         return None;
     }
     let input = red.points();
     let hull = convex_hull(&input);
-    let rect = min_area_rect(&hull)?;
+    let rect = match shape {
+        RectFit::Area => min_area_rect(&hull)?,
+        RectFit::Side => min_side_rect(&hull)?,
+    };
     let floor = frame.scene_half * MIN_EXTENT_FRACTION;
     let half = rect.half.max(DVec2::splat(floor));
     // square map, side of the larger texel: M' = M + 2 pad M' / res

@@ -31,12 +31,19 @@ fn samples_in(rng: &mut Rng, n: usize, lo: DVec3, hi: DVec3) -> Vec<DVec3> {
 /// plane, and every point between it and the light (inside the scene bounds, beyond the near plane
 /// of a spot) lands on the same texel, nearer.
 fn check_fit(light: &Light, pts: &[DVec3], res: u32, pad: f64) -> MinFrustum {
+    let side = check_fit_shape(light, pts, res, pad, RectFit::Side);
+    let area = check_fit_shape(light, pts, res, pad, RectFit::Area);
+    assert!(side.texel <= area.texel * (1.0 + 1e-9) && side.rect.area() >= area.rect.area() * (1.0 - 1e-9));
+    area
+}
+
+fn check_fit_shape(light: &Light, pts: &[DVec3], res: u32, pad: f64, shape: RectFit) -> MinFrustum {
     let b = bounds();
     let frame = light_frame(light, &b).unwrap();
     let proj: Vec<(DVec2, f64)> = pts.iter().map(|p| frame.project(*p)).collect();
     let red = Reduction::from_samples(&proj, 1024).unwrap();
     assert_eq!(red.count, pts.len() as u64);
-    let m = fit(light, &b, &frame, &red, res, pad).unwrap();
+    let m = fit(light, &b, &frame, &red, res, pad, shape).unwrap();
     assert!(m.view_proj.is_finite() && m.texel > 0.0 && m.near < m.far);
     let inset = 1.0 - 2.0 * (pad - 0.5).max(0.0) / res as f64;
     for p in pts {

@@ -9,7 +9,7 @@
 //! Stored depth: post-projective, 0 = near the light (orthographic: linear).
 
 use bytemuck::Zeroable;
-use shadowlab_core::calipers::frustum::{self, LightFrame, MinFrustum, Reduction, HEADER_WORDS};
+use shadowlab_core::calipers::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction, HEADER_WORDS};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace::{self, LightProjection};
 use shadowlab_core::metrics::sampling_stats;
@@ -64,6 +64,16 @@ pub const PARAMS: &[ParamDef] = &[
         source: "shadowlab: exact hull up to one band; 1024 = 8 KB read back",
         choices: &[],
     },
+    ParamDef {
+        key: "fit",
+        default: 0.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "rectangle around the hull: area = minimum area (the seeds' MSF; texels may be stretched up to the rectangle's aspect), side = shortest longer side (smallest square texel)",
+        source: "seed 000 section 3.2 (area); side: shadowlab, see docs/bench/min_sm.md",
+        choices: &["area", "side"],
+    },
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -89,6 +99,7 @@ pub struct MinShadowMap {
     res: u32,
     pcf: u32,
     grid: u32,
+    shape: RectFit,
     light: Light,
     bounds: Bounds,
     frame: LightFrame,
@@ -177,6 +188,7 @@ impl MinShadowMap {
             res,
             pcf,
             grid,
+            shape: if p.get_u32("fit") == 1 { RectFit::Side } else { RectFit::Area },
             light: *light,
             bounds: scene.bounds,
             frame,
@@ -236,7 +248,7 @@ impl Technique for MinShadowMap {
         let t1 = std::time::Instant::now();
         let red = Reduction::from_words(&words, self.grid as usize);
         self.last_count = red.as_ref().map_or(0, |r| r.count);
-        self.last = red.and_then(|r| frustum::fit(&self.light, &self.bounds, &self.frame, &r, self.res, self.pad_texels));
+        self.last = red.and_then(|r| frustum::fit(&self.light, &self.bounds, &self.frame, &r, self.res, self.pad_texels, self.shape));
         let (vp, texel, persp) = match &self.last {
             Some(m) => (m.view_proj_f32(), m.texel as f32, m.perspective),
             None => (self.scene_fit.view_proj, self.scene_fit.texel, self.scene_fit.perspective),
@@ -315,6 +327,6 @@ mod tests {
     #[test]
     fn shares_sm_parameters_by_key() {
         let keys: Vec<_> = super::PARAMS.iter().map(|p| p.key).collect();
-        assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid"]);
+        assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid", "fit"]);
     }
 }
