@@ -52,8 +52,15 @@ fn project(p: vec3<f32>) -> vec3<f32> {
 
 // Each thread walks `run` pixels of one screen row (thread x covers x = id.x * run ..), keeping
 // its extremes in registers: neighbouring pixels mostly share a band, so few atomics are issued.
-fn pixel(id: vec3<u32>, k: u32) -> vec3<u32> {
-    return vec3<u32>(id.x * msf.mode.z + k, id.y, 0u);
+// Only the mask and the position are read (not view.wgsl's load_sample, which also loads the
+// normal and writes the visibility of skipped pixels): half the G-buffer traffic.
+fn load_position(id: vec3<u32>, k: u32, p: ptr<function, vec3<f32>>) -> bool {
+    let x = id.x * msf.mode.z + k;
+    if x >= frame.size.x || id.y >= frame.size.y || mask[id.y * frame.size.x + x] == 0u {
+        return false;
+    }
+    *p = textureLoad(g_position, vec2<u32>(x, id.y), 0).xyz;
+    return true;
 }
 
 @compute @workgroup_size(8, 8)
@@ -62,9 +69,9 @@ fn bounds(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocatio
     var hi = vec3<f32>(-3.4e38);
     var n = 0u;
     for (var k = 0u; k < msf.mode.z; k++) {
-        var s: Sample;
-        if load_sample(pixel(id, k), &s) {
-            let q = project(s.p);
+        var p: vec3<f32>;
+        if load_position(id, k, &p) {
+            let q = project(p);
             lo = min(lo, q);
             hi = max(hi, q);
             n += 1u;
@@ -104,9 +111,9 @@ fn rows(@builtin(global_invocation_id) id: vec3<u32>) {
     var lo = 0.0;
     var hi = 0.0;
     for (var k = 0u; k < msf.mode.z; k++) {
-        var s: Sample;
-        if load_sample(pixel(id, k), &s) {
-            let q = project(s.p);
+        var p: vec3<f32>;
+        if load_position(id, k, &p) {
+            let q = project(p);
             // band_of in calipers/frustum.rs
             let t = (q.y - lo_y) / max(hi_y - lo_y, 1e-30);
             let band = min(u32(max(t, 0.0) * f32(grid)), grid - 1u);
