@@ -79,9 +79,9 @@ pub const PARAMS: &[ParamDef] = &[
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "min-sm",
     summary: "shadow map over the minimal shadow frustum: min-area rectangle (rotating calipers) around the view samples in light space",
-    cost: "two reduction passes over the view samples + an 8 KB read-back and a CPU hull/calipers fit (~0.1 ms) + one depth pass",
+    cost: "two reduction passes over the view samples + an 8 KB read-back and a CPU hull/calipers fit (~0.25 ms) + one depth pass",
     quality: "sm with the map focused on what the view sees: wins on close-ups, near sm on full-scene views; perspective aliasing remains",
-    source: "seed 000 section 3.2 and seed 002 section 4.1.5 (MSF, Stamminger & Drettakis 2002); calipers: Toussaint 1983",
+    source: "seed 000 section 3.2 and seed 002 section 4.1.5 (MSF after Stamminger & Drettakis 2002, Perspective Shadow Maps); calipers: Toussaint 1983",
     lights: &["directional", "spot"],
     params: PARAMS,
     create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, p, light)?)),
