@@ -130,3 +130,33 @@ fn bad_requests_are_errors() {
     assert!(lab.run(&v, &spec("min-sm:res=8"), 1).is_err());
     assert!(lab.run(&v, &spec("min-sm:gird=8"), 1).is_err());
 }
+
+/// One-pass mode: on the same view again it reproduces the two-pass result exactly; along the
+/// courtyard's camera path (the band range of the previous view is wrong for the next) every
+/// sample still lands inside the map.
+#[test]
+fn one_pass_reduction_is_exact_on_a_repeat_and_conservative_along_a_path() {
+    use shadowlab_core::camera::path_cameras;
+    use shadowlab_gpu::techniques::resolve;
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let light = scene.lights[0];
+    let v = view(&lab, &scene, 0, 128);
+    let one = lab.run(&v, &spec("min-sm"), 1).unwrap(); // warm-up: two passes, then one
+    let two = lab.run(&v, &spec("min-sm:one_pass=false"), 1).unwrap();
+    assert_eq!(one.report.counters["reduce_passes"], 1.0);
+    assert_eq!(two.report.counters["reduce_passes"], 2.0);
+    assert_eq!(one.visibility, two.visibility);
+    assert_eq!(one.report.counters["hull_points"], two.report.counters["hull_points"]);
+
+    let (info, params) = resolve(&spec("min-sm"), Some(&light)).unwrap();
+    let mut inst = lab.instantiate(info, params, "min-sm".into(), &light).unwrap();
+    let cams = path_cameras(&scene.camera, &scene.camera_path, 5);
+    for (i, cam) in cams.iter().enumerate() {
+        let v = lab.view(cam, cam, &light, 128, 128).unwrap();
+        let run = lab.step(&v, &mut inst, false, 1).unwrap();
+        assert_eq!(run.report.counters["reduce_passes"], if i == 0 { 2.0 } else { 1.0 });
+        assert_all_samples_inside(&format!("path view {i}"), &v, &run);
+    }
+}

@@ -7,7 +7,9 @@
 //! The GPU reduces the view samples first (`min-sm`'s reduce.wgsl): their bounding box in the
 //! fixed [`LightFrame`], then per band of `grid` rows of that box the least and greatest x. The
 //! four corners of each band's x range are a superset whose hull contains every sample and
-//! exceeds the exact hull by at most one band height ([`Reduction::points`]).
+//! exceeds the exact hull by at most one band height ([`Reduction::points`]). In one-pass mode
+//! the bands divide a prior y range (the previous frame's) and samples outside it go to two
+//! overflow slots: still a superset, tight again when the range holds.
 //! Depth of the map is post-projective, 0 = near (orthographic: linear).
 
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
@@ -104,6 +106,12 @@ pub fn decode_min(u: u32) -> f32 {
 /// sample count, 2 unused.
 pub const HEADER_WORDS: usize = 8;
 
+/// Words of the reduction buffer for `grid` bands: the header, (min x, max x) per band, then two
+/// overflow slots for samples below and above the band range (one-pass mode).
+pub fn buffer_words(grid: usize) -> usize {
+    HEADER_WORDS + 2 * (grid + 2)
+}
+
 /// The reduced view samples.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reduction {
@@ -112,40 +120,61 @@ pub struct Reduction {
     pub hi: DVec2,
     pub max_depth: f64,
     pub count: u64,
-    /// Per band of rows over [lo.y, hi.y]: least and greatest x, `None` if empty.
+    /// The y range the bands divide: the samples' own (two passes) or a prior range, the
+    /// previous frame's (one pass).
+    pub band_lo: f64,
+    pub band_hi: f64,
+    /// Per band of rows over [band_lo, band_hi]: least and greatest x, `None` if empty.
     pub bands: Vec<Option<(f64, f64)>>,
+    /// x ranges of the samples below `band_lo` and above `band_hi` (only with a prior range).
+    pub under: Option<(f64, f64)>,
+    pub over: Option<(f64, f64)>,
 }
 
-/// The band of plane coordinate `y` among `grid` bands over [lo, hi] (as the GPU computes it).
-pub fn band_of(y: f32, lo: f32, hi: f32, grid: u32) -> u32 {
+/// The slot of plane coordinate `y` among `grid` bands over [lo, hi], as the GPU computes it.
+/// With `overflow`, y below lo goes to slot `grid` and above hi to `grid + 1`; else clamped.
+pub fn band_of(y: f32, lo: f32, hi: f32, grid: u32, overflow: bool) -> u32 {
+    if overflow && y < lo {
+        return grid;
+    }
+    if overflow && y > hi {
+        return grid + 1;
+    }
     let t = (y - lo) / (hi - lo).max(1e-30);
     ((t.max(0.0) * grid as f32) as u32).min(grid - 1)
 }
 
+fn slot(w: &[u32], i: usize) -> Option<(f64, f64)> {
+    let (a, c) = (w[HEADER_WORDS + 2 * i], w[HEADER_WORDS + 2 * i + 1]);
+    (a != 0 && c != 0).then(|| (decode_min(a) as f64, decode_max(c) as f64))
+}
+
 impl Reduction {
-    /// Decodes the GPU buffer: [`HEADER_WORDS`], then (min x, max x) codes per band.
-    pub fn from_words(w: &[u32], grid: usize) -> Option<Reduction> {
-        if w.len() < HEADER_WORDS + 2 * grid || w[5] == 0 {
+    /// Decodes the GPU buffer ([`buffer_words`]); `prior` is the band range the pass used, if
+    /// not the samples' own.
+    pub fn from_words(w: &[u32], grid: usize, prior: Option<(f32, f32)>) -> Option<Reduction> {
+        if w.len() < buffer_words(grid) || w[5] == 0 {
             return None;
         }
-        let bands = (0..grid)
-            .map(|b| {
-                let (a, c) = (w[HEADER_WORDS + 2 * b], w[HEADER_WORDS + 2 * b + 1]);
-                (a != 0 && c != 0).then(|| (decode_min(a) as f64, decode_max(c) as f64))
-            })
-            .collect();
+        let (lo, hi) =
+            (DVec2::new(decode_min(w[0]) as f64, decode_min(w[2]) as f64), DVec2::new(decode_max(w[1]) as f64, decode_max(w[3]) as f64));
+        let (band_lo, band_hi) = prior.map_or((lo.y, hi.y), |(a, b)| (a as f64, b as f64));
         Some(Reduction {
-            lo: DVec2::new(decode_min(w[0]) as f64, decode_min(w[2]) as f64),
-            hi: DVec2::new(decode_max(w[1]) as f64, decode_max(w[3]) as f64),
+            lo,
+            hi,
             max_depth: decode_max(w[4]) as f64,
             count: w[5] as u64,
-            bands,
+            band_lo,
+            band_hi,
+            bands: (0..grid).map(|b| slot(w, b)).collect(),
+            under: slot(w, grid),
+            over: slot(w, grid + 1),
         })
     }
 
     /// What the GPU computes, on the CPU (tests): samples as (plane coordinates, depth).
-    pub fn from_samples(samples: &[(DVec2, f64)], grid: usize) -> Option<Reduction> {
-        let mut w = vec![0u32; HEADER_WORDS + 2 * grid];
+    pub fn from_samples(samples: &[(DVec2, f64)], grid: usize, prior: Option<(f32, f32)>) -> Option<Reduction> {
+        let mut w = vec![0u32; buffer_words(grid)];
         let f = |x: f64| x as f32;
         for (p, d) in samples {
             w[0] = w[0].max(encode_min(f(p.x)));
@@ -158,26 +187,35 @@ impl Reduction {
         if w[5] == 0 {
             return None;
         }
-        let (lo, hi) = (decode_min(w[2]), decode_max(w[3]));
+        let (lo, hi) = prior.unwrap_or((decode_min(w[2]), decode_max(w[3])));
         for (p, _) in samples {
-            let b = HEADER_WORDS + 2 * band_of(f(p.y), lo, hi, grid as u32) as usize;
+            let b = HEADER_WORDS + 2 * band_of(f(p.y), lo, hi, grid as u32, prior.is_some()) as usize;
             w[b] = w[b].max(encode_min(f(p.x)));
             w[b + 1] = w[b + 1].max(encode_max(f(p.x)));
         }
-        Reduction::from_words(&w, grid)
+        Reduction::from_words(&w, grid, prior)
     }
 
-    /// The corners of every non-empty band's x range: their hull contains every sample.
+    /// The corners of every non-empty band's x range (and of the overflow slots, spanning from
+    /// the band range to the samples' extreme y): their hull contains every sample.
     pub fn points(&self) -> Vec<DVec2> {
-        let g = self.bands.len() as f64;
-        let h = self.hi.y - self.lo.y;
-        let mut v = Vec::with_capacity(4 * self.bands.len());
+        let n = self.bands.len();
+        let h = self.band_hi - self.band_lo;
+        let corners =
+            |(x0, x1): (f64, f64), y0: f64, y1: f64| [DVec2::new(x0, y0), DVec2::new(x1, y0), DVec2::new(x0, y1), DVec2::new(x1, y1)];
+        let mut v = Vec::with_capacity(4 * n + 8);
         for (i, b) in self.bands.iter().enumerate() {
-            if let Some((x0, x1)) = *b {
-                let y0 = self.lo.y + h * i as f64 / g;
-                let y1 = if i + 1 == self.bands.len() { self.hi.y } else { self.lo.y + h * (i + 1) as f64 / g };
-                v.extend([DVec2::new(x0, y0), DVec2::new(x1, y0), DVec2::new(x0, y1), DVec2::new(x1, y1)]);
+            if let Some(x) = *b {
+                let y0 = self.band_lo + h * i as f64 / n as f64;
+                let y1 = if i + 1 == n { self.band_hi } else { self.band_lo + h * (i + 1) as f64 / n as f64 };
+                v.extend(corners(x, y0, y1));
             }
+        }
+        if let Some(x) = self.under {
+            v.extend(corners(x, self.lo.y, self.band_lo));
+        }
+        if let Some(x) = self.over {
+            v.extend(corners(x, self.band_hi, self.hi.y));
         }
         v
     }

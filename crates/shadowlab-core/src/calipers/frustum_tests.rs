@@ -41,7 +41,7 @@ fn check_fit_shape(light: &Light, pts: &[DVec3], res: u32, pad: f64, shape: Rect
     let b = bounds();
     let frame = light_frame(light, &b).unwrap();
     let proj: Vec<(DVec2, f64)> = pts.iter().map(|p| frame.project(*p)).collect();
-    let red = Reduction::from_samples(&proj, 1024).unwrap();
+    let red = Reduction::from_samples(&proj, 1024, None).unwrap();
     assert_eq!(red.count, pts.len() as u64);
     let m = fit(light, &b, &frame, &red, res, pad, shape).unwrap();
     assert!(m.view_proj.is_finite() && m.texel > 0.0 && m.near < m.far);
@@ -83,9 +83,13 @@ fn codes_keep_float_order() {
         assert_ne!(encode_max(x), 0);
         assert_ne!(encode_min(x), 0);
     }
-    assert_eq!(band_of(0.0, 0.0, 1.0, 4), 0);
-    assert_eq!(band_of(1.0, 0.0, 1.0, 4), 3);
-    assert_eq!(band_of(0.5, 0.0, 1.0, 4), 2);
+    assert_eq!(band_of(0.0, 0.0, 1.0, 4, false), 0);
+    assert_eq!(band_of(1.0, 0.0, 1.0, 4, false), 3);
+    assert_eq!(band_of(0.5, 0.0, 1.0, 4, false), 2);
+    assert_eq!(band_of(-0.5, 0.0, 1.0, 4, false), 0);
+    assert_eq!(band_of(-0.5, 0.0, 1.0, 4, true), 4);
+    assert_eq!(band_of(1.5, 0.0, 1.0, 4, true), 5);
+    assert_eq!(band_of(1.0, 0.0, 1.0, 4, true), 3);
 }
 
 #[test]
@@ -135,7 +139,7 @@ fn reduced_hull_is_a_tight_superset_of_the_exact_one() {
     let proj: Vec<(DVec2, f64)> = pts.iter().map(|p| frame.project(*p)).collect();
     let exact = min_area_rect(&convex_hull(&proj.iter().map(|p| p.0).collect::<Vec<_>>())).unwrap();
     for grid in [16usize, 256, 1024] {
-        let red = Reduction::from_samples(&proj, grid).unwrap();
+        let red = Reduction::from_samples(&proj, grid, None).unwrap();
         let reduced = min_area_rect(&convex_hull(&red.points())).unwrap();
         let band = (red.hi.y - red.lo.y) / grid as f64;
         assert!(reduced.area() >= exact.area() * (1.0 - 1e-6), "grid {grid}");
@@ -163,6 +167,35 @@ fn degenerate_sample_sets_give_valid_maps() {
     let spot = Light::Spot { position: Vec3::new(0.0, 2.9, 0.0), direction: -Vec3::Y, cone_deg: 40.0 };
     check_fit(&spot, &[DVec3::new(0.3, 0.0, 0.2)], 256, 1.0);
     // no samples: nothing to fit
-    assert!(Reduction::from_samples(&[], 64).is_none());
+    assert!(Reduction::from_samples(&[], 64, None).is_none());
     assert!(light_frame(&Light::Point { position: Vec3::ZERO }, &bounds()).is_none());
+}
+
+/// One-pass mode: bands over a prior range (the previous frame's). With the exact range it is
+/// the two-pass reduction; with a wrong one every sample is still inside the hull.
+#[test]
+fn prior_band_range_keeps_every_sample_inside() {
+    let mut rng = Rng(17);
+    let light = Light::Directional { direction: Vec3::new(0.3, -1.0, 0.2) };
+    let b = bounds();
+    let frame = light_frame(&light, &b).unwrap();
+    let pts = samples_in(&mut rng, 4000, DVec3::new(-1.0, 0.0, -1.0), DVec3::new(2.0, 1.0, 1.0));
+    let proj: Vec<(DVec2, f64)> = pts.iter().map(|p| frame.project(*p)).collect();
+    let two = Reduction::from_samples(&proj, 256, None).unwrap();
+    let exact = Some((two.lo.y as f32, two.hi.y as f32));
+    let one = Reduction::from_samples(&proj, 256, exact).unwrap();
+    assert_eq!(one.points(), two.points());
+    assert!(one.under.is_none() && one.over.is_none());
+    let area = |r: &Reduction| min_area_rect(&convex_hull(&r.points())).unwrap().area();
+    let (ylo, yhi) = (two.lo.y as f32, two.hi.y as f32);
+    let h = yhi - ylo;
+    for prior in [(ylo + 0.3 * h, yhi - 0.2 * h), (ylo - h, ylo - 0.5 * h), (yhi + 1.0, yhi + 2.0), (ylo + 0.5 * h, ylo + 0.5 * h)] {
+        let red = Reduction::from_samples(&proj, 256, Some(prior)).unwrap();
+        let hull = convex_hull(&red.points());
+        let r = min_area_rect(&hull).unwrap();
+        for p in &proj {
+            assert!(r.contains(p.0, 1e-5), "prior {prior:?}: {} outside", p.0);
+        }
+        assert!(area(&red) >= area(&two) * (1.0 - 1e-9), "prior {prior:?}");
+    }
 }

@@ -9,7 +9,7 @@
 //! Stored depth: post-projective, 0 = near the light (orthographic: linear).
 
 use bytemuck::Zeroable;
-use shadowlab_core::calipers::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction, HEADER_WORDS};
+use shadowlab_core::calipers::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace::{self, LightProjection};
 use shadowlab_core::metrics::sampling_stats;
@@ -74,6 +74,16 @@ pub const PARAMS: &[ParamDef] = &[
         source: "seed 000 section 3.2 (area); side: shadowlab, see docs/bench/min_sm.md",
         choices: &["area", "side"],
     },
+    ParamDef {
+        key: "one_pass",
+        default: 1.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "true: one pass over the G-buffer, bands over the previous frame's y range (samples outside it go to two overflow slots: always conservative, tight again next frame); false or first frame: two passes (bounds, then bands)",
+        source: "shadowlab: halves the G-buffer reads in steady state (docs/bench/min_sm.md)",
+        choices: shadowlab_core::params::BOOL,
+    },
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -93,6 +103,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 pub struct MsfReduce {
     pub frame_view: [[f32; 4]; 4],
     pub mode: [u32; 4],
+    pub prev: [f32; 4],
 }
 
 pub struct MinShadowMap {
@@ -100,6 +111,10 @@ pub struct MinShadowMap {
     pcf: u32,
     grid: u32,
     shape: RectFit,
+    one_pass: bool,
+    /// y range of the last frame's samples in the light frame (the next one-pass band range).
+    prior: Option<(f32, f32)>,
+    last_passes: u32,
     light: Light,
     bounds: Bounds,
     frame: LightFrame,
@@ -169,13 +184,17 @@ impl MinShadowMap {
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             ..Default::default()
         });
-        let reduce = MsfReduce { frame_view: frame.view.as_mat4().to_cols_array_2d(), mode: [frame.perspective as u32, grid, RUN, 0] };
+        let reduce = MsfReduce {
+            frame_view: frame.view.as_mat4().to_cols_array_2d(),
+            mode: [frame.perspective as u32, grid, RUN, 0],
+            prev: [0.0; 4],
+        };
         let reduce_uniform = gpu.uniform("min-sm.reduce", &reduce);
         let reduce_layout = view_layout(gpu, "min-sm.reduce", &[binding::uniform(), binding::storage(false)]);
         let src = compose_view(REDUCE_WGSL, false);
         let bounds_pipeline = gpu.compute_pipeline("min-sm.reduce.bounds", &src, "bounds", &[&reduce_layout]);
         let rows_pipeline = gpu.compute_pipeline("min-sm.reduce.rows", &src, "rows", &[&reduce_layout]);
-        let words = (HEADER_WORDS + 2 * grid as usize) as u64 * 4;
+        let words = frustum::buffer_words(grid as usize) as u64 * 4;
         let red = gpu.storage("min-sm.reduction", words);
         let staging = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("min-sm.reduction.readback"),
@@ -189,6 +208,9 @@ impl MinShadowMap {
             pcf,
             grid,
             shape: if p.get_u32("fit") == 1 { RectFit::Side } else { RectFit::Area },
+            one_pass: p.get_bool("one_pass"),
+            prior: None,
+            last_passes: 0,
             light: *light,
             bounds: scene.bounds,
             frame,
@@ -234,10 +256,19 @@ impl Technique for MinShadowMap {
             &[self.reduce_uniform.as_entire_binding(), self.red.as_entire_binding()],
         );
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
+        let prior = if self.one_pass { self.prior } else { None };
+        let (lo, hi) = prior.unwrap_or((0.0, 0.0));
+        // mode.w and prev of MsfReduce
+        let w_at = std::mem::offset_of!(MsfReduce, mode) as u64 + 12;
+        gpu.queue.write_buffer(&self.reduce_uniform, w_at, bytemuck::bytes_of(&(prior.is_some() as u32)));
+        gpu.queue.write_buffer(&self.reduce_uniform, std::mem::offset_of!(MsfReduce, prev) as u64, bytemuck::bytes_of(&[lo, hi, 0.0, 0.0]));
+        self.last_passes = if prior.is_some() { 1 } else { 2 };
         timer.stage(gpu, "min-sm.reduce", |enc| {
             enc.clear_buffer(&self.red, 0, None);
             gpu.dispatch_2d(enc, "min-sm.reduce.bounds", &self.bounds_pipeline, &[&group], w.div_ceil(RUN), h);
-            gpu.dispatch_2d(enc, "min-sm.reduce.rows", &self.rows_pipeline, &[&group], w.div_ceil(RUN), h);
+            if prior.is_none() {
+                gpu.dispatch_2d(enc, "min-sm.reduce.rows", &self.rows_pipeline, &[&group], w.div_ceil(RUN), h);
+            }
             enc.copy_buffer_to_buffer(&self.red, 0, &self.staging, 0, self.red.size());
         });
         let t0 = std::time::Instant::now();
@@ -246,8 +277,9 @@ impl Technique for MinShadowMap {
 
         // CPU: hull, calipers, projection
         let t1 = std::time::Instant::now();
-        let red = Reduction::from_words(&words, self.grid as usize);
+        let red = Reduction::from_words(&words, self.grid as usize, prior);
         self.last_count = red.as_ref().map_or(0, |r| r.count);
+        self.prior = red.as_ref().map(|r| (r.lo.y as f32, r.hi.y as f32));
         self.last = red.and_then(|r| frustum::fit(&self.light, &self.bounds, &self.frame, &r, self.res, self.pad_texels, self.shape));
         let (vp, texel, persp) = match &self.last {
             Some(m) => (m.view_proj_f32(), m.texel as f32, m.perspective),
@@ -309,6 +341,7 @@ impl Technique for MinShadowMap {
         c.insert("cpu_fit_ms".into(), self.last_fit_ms);
         c.insert("readback_bytes".into(), self.red.size() as f64);
         c.insert("fallback_scene_fit".into(), self.last.is_none() as u32 as f64);
+        c.insert("reduce_passes".into(), self.last_passes as f64);
         if let Some(m) = &self.last {
             c.insert("reduced_points".into(), m.input_points as f64);
             c.insert("hull_points".into(), m.hull_points as f64);
@@ -327,6 +360,6 @@ mod tests {
     #[test]
     fn shares_sm_parameters_by_key() {
         let keys: Vec<_> = super::PARAMS.iter().map(|p| p.key).collect();
-        assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid", "fit"]);
+        assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid", "fit", "one_pass"]);
     }
 }
