@@ -54,7 +54,7 @@ fn main() {
     let mut reduced_area = 0.0;
     let cpu_bands = best(&mut || {
         let t = Instant::now();
-        let red = Reduction::from_samples(&samples, 1024).unwrap();
+        let red = Reduction::from_samples(&samples, 1024, None).unwrap();
         reduced_area = min_area_rect(&convex_hull(&red.points())).unwrap().area();
         ms(t)
     });
