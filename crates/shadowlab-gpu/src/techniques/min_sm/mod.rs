@@ -237,13 +237,18 @@ impl MinShadowMap {
         })
     }
 
-    fn read_reduction(&self, gpu: &Gpu) -> Vec<u32> {
+    fn read_reduction(&self, gpu: &Gpu) -> Result<Vec<u32>, GpuError> {
         let slice = self.staging.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
         gpu.wait();
-        let words = bytemuck::pod_collect_to_vec(&slice.get_mapped_range().expect("mapped reduction"));
+        let failed = |e: String| GpuError::Validation(format!("min-sm: reading back the reduction: {e}"));
+        rx.recv().map_err(|e| failed(e.to_string()))?.map_err(|e| failed(e.to_string()))?;
+        let words = bytemuck::pod_collect_to_vec(&slice.get_mapped_range().map_err(|e| failed(e.to_string()))?);
         self.staging.unmap();
-        words
+        Ok(words)
     }
 }
 
@@ -272,7 +277,7 @@ impl Technique for MinShadowMap {
             enc.copy_buffer_to_buffer(&self.red, 0, &self.staging, 0, self.red.size());
         });
         let t0 = std::time::Instant::now();
-        let words = self.read_reduction(gpu);
+        let words = self.read_reduction(gpu)?;
         timer.add("min-sm.readback", t0.elapsed().as_secs_f64() * 1e3);
 
         // CPU: hull, calipers, projection
