@@ -123,7 +123,8 @@ pub struct MinShadowMap {
     pad_texels: f64,
     params: SmParams,
     last: Option<MinFrustum>,
-    last_fit_ms: f64,
+    /// CPU fit time of every frame so far (ms).
+    fit_ms: Vec<f64>,
     last_count: u64,
     map: wgpu::Texture,
     counts: wgpu::Buffer,
@@ -218,7 +219,7 @@ impl MinShadowMap {
             pad_texels,
             params,
             last: None,
-            last_fit_ms: 0.0,
+            fit_ms: Vec::new(),
             last_count: 0,
             map,
             counts: gpu.storage("min-sm.counts", res as u64 * res as u64 * 4),
@@ -293,8 +294,9 @@ impl Technique for MinShadowMap {
         self.params.light_view_proj = vp.to_cols_array_2d();
         self.params.texel[0] = texel;
         self.params.texel[1] = persp as u32 as f32;
-        self.last_fit_ms = t1.elapsed().as_secs_f64() * 1e3;
-        timer.add("min-sm.fit", self.last_fit_ms);
+        let fit_ms = t1.elapsed().as_secs_f64() * 1e3;
+        self.fit_ms.push(fit_ms);
+        timer.add("min-sm.fit", fit_ms);
         gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         Ok(())
     }
@@ -343,7 +345,9 @@ impl Technique for MinShadowMap {
         c.insert("view_samples".into(), self.last_count as f64);
         c.insert("samples_in_map".into(), in_map as f64);
         c.insert("samples_outside_map".into(), self.last_count.saturating_sub(in_map) as f64);
-        c.insert("cpu_fit_ms".into(), self.last_fit_ms);
+        // median and max over the frames run so far (a single frame can be preempted)
+        c.insert("cpu_fit_ms".into(), crate::timing::median(&self.fit_ms));
+        c.insert("cpu_fit_ms_max".into(), self.fit_ms.iter().copied().fold(0.0, f64::max));
         c.insert("readback_bytes".into(), self.red.size() as f64);
         c.insert("fallback_scene_fit".into(), self.last.is_none() as u32 as f64);
         c.insert("reduce_passes".into(), self.last_passes as f64);
