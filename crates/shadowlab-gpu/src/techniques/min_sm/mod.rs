@@ -1,7 +1,8 @@
 //! `min-sm`: shadow mapping with the minimal shadow frustum (MSF; seed 000 section 3.2, seed 002
 //! section 4.1.5). Per frame: the view samples are projected into the light's fixed frame and
 //! reduced on the GPU (bounding box, then per band of `grid` rows the least and greatest x;
-//! reduce.wgsl), the few band corners are read back, the CPU takes their convex hull and the
+//! reduce.wgsl; in steady state one pass, banding over the previous frame's range with overflow
+//! slots), the few band corners are read back, the CPU takes their convex hull and the
 //! minimum-area rectangle by rotating calipers (`shadowlab_core::calipers`), and the map is
 //! rendered over that rectangle (rotated, padded by the bias reach) with near/far fitted to the
 //! scene towards the light and the farthest sample. Depth map and evaluation are `sm`'s shaders
@@ -89,7 +90,7 @@ pub const PARAMS: &[ParamDef] = &[
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "min-sm",
     summary: "shadow map over the minimal shadow frustum: min-area rectangle (rotating calipers) around the view samples in light space",
-    cost: "two reduction passes over the view samples + an 8 KB read-back and a CPU hull/calipers fit (~0.25 ms) + one depth pass",
+    cost: "one reduction pass over the view samples (two on the first frame) + an 8 KB read-back and a CPU hull/calipers fit (~0.25 ms) + one depth pass",
     quality: "sm with the map focused on what the view sees: wins on close-ups, near sm on full-scene views; perspective aliasing remains",
     source: "seed 000 section 3.2 and seed 002 section 4.1.5 (MSF after Stamminger & Drettakis 2002, Perspective Shadow Maps); calipers: Toussaint 1983",
     lights: &["directional", "spot"],
