@@ -4,6 +4,7 @@
 
 pub mod builtin;
 pub mod bvh;
+pub mod calipers;
 pub mod camera;
 pub mod cascades;
 pub mod edges;

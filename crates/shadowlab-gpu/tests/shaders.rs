@@ -236,3 +236,16 @@ fn filtered_and_blur_layouts_match_rust() {
         );
     }
 }
+
+#[test]
+fn min_sm_reduce_layout_matches_rust() {
+    use shadowlab_gpu::techniques::min_sm::MsfReduce;
+    let all = shadowlab_gpu::shaders::all();
+    let src = &all.iter().find(|(n, _)| *n == "min_sm/reduce.wgsl").expect("min_sm/reduce.wgsl listed").1;
+    check(
+        &parse("min_sm/reduce.wgsl", src),
+        "MsfReduce",
+        size_of::<MsfReduce>(),
+        &[("mode", offset_of!(MsfReduce, mode)), ("prev", offset_of!(MsfReduce, prev))],
+    );
+}

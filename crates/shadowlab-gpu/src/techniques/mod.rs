@@ -5,6 +5,7 @@ pub mod csm;
 pub mod filtered;
 pub mod iasm;
 pub mod mdsm;
+pub mod min_sm;
 pub mod sm;
 pub mod sv;
 
@@ -139,6 +140,7 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &crate::reference::INFO,
     &sm::INFO,
     &sv::INFO,
+    &min_sm::INFO,
     &mdsm::INFO,
     &filtered::VSM_INFO,
     &filtered::ESM_INFO,
@@ -157,6 +159,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(csm::shaders());
     v.extend(iasm::shaders());
     v.extend(filtered::shaders());
+    v.extend(min_sm::shaders());
     v
 }
 

@@ -1,0 +1,375 @@
+//! `min-sm`: shadow mapping with the minimal shadow frustum (MSF; seed 000 section 3.2, seed 002
+//! section 4.1.5). Per frame: the view samples are projected into the light's fixed frame and
+//! reduced on the GPU (bounding box, then per band of `grid` rows the least and greatest x;
+//! reduce.wgsl; in steady state one pass, banding over the previous frame's range with overflow
+//! slots), the few band corners are read back, the CPU takes their convex hull and the
+//! minimum-area rectangle by rotating calipers (`shadowlab_core::calipers`), and the map is
+//! rendered over that rectangle (rotated, padded by the bias reach) with near/far fitted to the
+//! scene towards the light and the farthest sample. Depth map and evaluation are `sm`'s shaders
+//! and bias model; the texel is the rectangle's larger texel side.
+//! Stored depth: post-projective, 0 = near the light (orthographic: linear).
+
+use bytemuck::Zeroable;
+use shadowlab_core::calipers::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction};
+use shadowlab_core::light::Light;
+use shadowlab_core::lightspace::{self, LightProjection};
+use shadowlab_core::metrics::sampling_stats;
+use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::scene::Bounds;
+
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose;
+use crate::techniques::sm::{self, count_image, depth_image, SmParams};
+use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{binding, raster, Gpu, GpuError};
+
+const DEPTH_WGSL: &str = include_str!("../sm/depth.wgsl");
+const EVAL_WGSL: &str = include_str!("../sm/eval.wgsl");
+const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
+
+/// min-sm's own shader (the depth and evaluation shaders are `sm`'s files, validated there).
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("min_sm/reduce.wgsl", compose_view(REDUCE_WGSL, false))]
+}
+
+/// Bands of the light-space reduction. The hull of the band corners exceeds the exact hull by at
+/// most one band height (1/grid of the samples' extent). Too low: a looser rectangle (16 bands:
+/// up to 6 % per side); too high: more atomics targets and a longer read-back (8 bytes per band).
+/// 1024 keeps the overshoot at a quarter texel of a 512 map on the box's y side.
+pub const DEFAULT_GRID: f64 = 1024.0;
+/// Pixels of a screen row one reduction thread walks, keeping its extremes in registers:
+/// neighbouring pixels mostly fall in the same band, so atomics drop by about this factor.
+pub const RUN: u32 = 16;
+/// Texels of padding beyond the bias reach (normal offset + PCF half width): f32 rounding of the
+/// projected samples and of the band bounds. Too low: samples at the rim read outside the map
+/// (lit); too high: wasted texels.
+pub const PAD_MARGIN_TEXELS: f64 = 1.0;
+
+/// `sm`'s parameters (same keys, defaults, docs and sources; the order is checked by a test),
+/// then the reduction grid.
+pub const PARAMS: &[ParamDef] = &[
+    sm::PARAMS[0], // res
+    sm::PARAMS[1], // pcf
+    sm::PARAMS[2], // bias
+    sm::PARAMS[3], // slope_bias
+    sm::PARAMS[4], // max_slope
+    sm::PARAMS[5], // normal_offset
+    ParamDef {
+        key: "grid",
+        default: DEFAULT_GRID,
+        min: 1.0,
+        max: 16384.0,
+        integer: true,
+        doc: "bands of the GPU reduction before the hull (hull overshoot <= 1/grid of the samples' extent)",
+        source: "shadowlab: exact hull up to one band; 1024 = 8 KB read back",
+        choices: &[],
+    },
+    ParamDef {
+        key: "fit",
+        default: 0.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "rectangle around the hull: area = minimum area (the seeds' MSF; texels may be stretched up to the rectangle's aspect), side = shortest longer side (smallest square texel)",
+        source: "seed 000 section 3.2 (area); side: shadowlab, see docs/bench/min_sm.md",
+        choices: &["area", "side"],
+    },
+    ParamDef {
+        key: "one_pass",
+        default: 1.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "true: one pass over the G-buffer, bands over the previous frame's y range (samples outside it go to two overflow slots: always conservative, tight again next frame); false or first frame: two passes (bounds, then bands)",
+        source: "shadowlab: halves the G-buffer reads in steady state (docs/bench/min_sm.md)",
+        choices: shadowlab_core::params::BOOL,
+    },
+];
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "min-sm",
+    summary: "shadow map over the minimal shadow frustum: min-area rectangle (rotating calipers) around the view samples in light space",
+    cost: "one reduction pass over the view samples (two on the first frame) + an 8 KB read-back and a CPU hull/calipers fit (~0.25 ms) + one depth pass",
+    quality: "sm with the map focused on what the view sees: wins on close-ups, near sm on full-scene views; perspective aliasing remains",
+    source: "seed 000 section 3.2 and seed 002 section 4.1.5 (MSF after Stamminger & Drettakis 2002, Perspective Shadow Maps); calipers: Toussaint 1983",
+    lights: &["directional", "spot"],
+    params: PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, p, light)?)),
+};
+
+/// WGSL `MsfReduce` (reduce.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, Zeroable)]
+pub struct MsfReduce {
+    pub frame_view: [[f32; 4]; 4],
+    pub mode: [u32; 4],
+    pub prev: [f32; 4],
+}
+
+pub struct MinShadowMap {
+    res: u32,
+    pcf: u32,
+    grid: u32,
+    shape: RectFit,
+    one_pass: bool,
+    /// y range of the last frame's samples in the light frame (the next one-pass band range).
+    prior: Option<(f32, f32)>,
+    last_passes: u32,
+    light: Light,
+    bounds: Bounds,
+    frame: LightFrame,
+    /// `sm`'s scene-fitted projection: used when no sample is evaluated, and for comparisons.
+    scene_fit: LightProjection,
+    pad_texels: f64,
+    params: SmParams,
+    last: Option<MinFrustum>,
+    /// CPU fit time of every frame so far (ms).
+    fit_ms: Vec<f64>,
+    last_count: u64,
+    map: wgpu::Texture,
+    counts: wgpu::Buffer,
+    uniform: wgpu::Buffer,
+    depth_pipeline: wgpu::RenderPipeline,
+    depth_group: wgpu::BindGroup,
+    eval_pipeline: wgpu::ComputePipeline,
+    eval_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    reduce_uniform: wgpu::Buffer,
+    reduce_layout: wgpu::BindGroupLayout,
+    bounds_pipeline: wgpu::ComputePipeline,
+    rows_pipeline: wgpu::ComputePipeline,
+    red: wgpu::Buffer,
+    staging: wgpu::Buffer,
+}
+
+impl MinShadowMap {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<MinShadowMap, GpuError> {
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "shadow map")?;
+        let no_point = || GpuError::Invalid("min-sm does not support point lights".into());
+        let scene_fit = lightspace::fit(light, &scene.bounds, res).ok_or_else(no_point)?;
+        let frame = frustum::light_frame(light, &scene.bounds).ok_or_else(no_point)?;
+        let (pcf, grid) = (p.get_u32("pcf"), p.get_u32("grid"));
+        let params = SmParams {
+            light_view_proj: scene_fit.view_proj.to_cols_array_2d(),
+            texel: [scene_fit.texel, scene_fit.perspective as u32 as f32, res as f32, pcf as f32],
+            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
+        };
+        let d = &gpu.device;
+        let map = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("min-sm.map"),
+            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: raster::DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let uniform = gpu.uniform("min-sm.params", &params);
+        let depth_layout = binding::layout(d, "min-sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
+        let depth_group = binding::group(d, "min-sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
+        let depth_pipeline = raster::scene_pipeline(gpu, "min-sm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
+        let eval_layout = view_layout(
+            gpu,
+            "min-sm.eval",
+            &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
+        );
+        let eval_pipeline = gpu.compute_pipeline("min-sm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("min-sm.cmp"),
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            mag_filter: wgpu::FilterMode::Nearest,
+            min_filter: wgpu::FilterMode::Nearest,
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            ..Default::default()
+        });
+        let reduce = MsfReduce {
+            frame_view: frame.view.as_mat4().to_cols_array_2d(),
+            mode: [frame.perspective as u32, grid, RUN, 0],
+            prev: [0.0; 4],
+        };
+        let reduce_uniform = gpu.uniform("min-sm.reduce", &reduce);
+        let reduce_layout = view_layout(gpu, "min-sm.reduce", &[binding::uniform(), binding::storage(false)]);
+        let src = compose_view(REDUCE_WGSL, false);
+        let bounds_pipeline = gpu.compute_pipeline("min-sm.reduce.bounds", &src, "bounds", &[&reduce_layout]);
+        let rows_pipeline = gpu.compute_pipeline("min-sm.reduce.rows", &src, "rows", &[&reduce_layout]);
+        let words = frustum::buffer_words(grid as usize) as u64 * 4;
+        let red = gpu.storage("min-sm.reduction", words);
+        let staging = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("min-sm.reduction.readback"),
+            size: words,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let pad_texels = p.get("normal_offset") + (pcf as f64 - 1.0) * 0.5 + PAD_MARGIN_TEXELS;
+        Ok(MinShadowMap {
+            res,
+            pcf,
+            grid,
+            shape: if p.get_u32("fit") == 1 { RectFit::Side } else { RectFit::Area },
+            one_pass: p.get_bool("one_pass"),
+            prior: None,
+            last_passes: 0,
+            light: *light,
+            bounds: scene.bounds,
+            frame,
+            scene_fit,
+            pad_texels,
+            params,
+            last: None,
+            fit_ms: Vec::new(),
+            last_count: 0,
+            map,
+            counts: gpu.storage("min-sm.counts", res as u64 * res as u64 * 4),
+            uniform,
+            depth_pipeline,
+            depth_group,
+            eval_pipeline,
+            eval_layout,
+            sampler,
+            reduce_uniform,
+            reduce_layout,
+            bounds_pipeline,
+            rows_pipeline,
+            red,
+            staging,
+        })
+    }
+
+    fn read_reduction(&self, gpu: &Gpu) -> Result<Vec<u32>, GpuError> {
+        let slice = self.staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        gpu.wait();
+        let failed = |e: String| GpuError::Validation(format!("min-sm: reading back the reduction: {e}"));
+        rx.recv().map_err(|e| failed(e.to_string()))?.map_err(|e| failed(e.to_string()))?;
+        let words = bytemuck::pod_collect_to_vec(&slice.get_mapped_range().map_err(|e| failed(e.to_string()))?);
+        self.staging.unmap();
+        Ok(words)
+    }
+}
+
+impl Technique for MinShadowMap {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let group = f.view_group(
+            gpu,
+            "min-sm.reduce",
+            &self.reduce_layout,
+            &[self.reduce_uniform.as_entire_binding(), self.red.as_entire_binding()],
+        );
+        let (w, h) = (f.gbuffer.width, f.gbuffer.height);
+        let prior = if self.one_pass { self.prior } else { None };
+        let (lo, hi) = prior.unwrap_or((0.0, 0.0));
+        // mode.w and prev of MsfReduce
+        let w_at = std::mem::offset_of!(MsfReduce, mode) as u64 + 12;
+        gpu.queue.write_buffer(&self.reduce_uniform, w_at, bytemuck::bytes_of(&(prior.is_some() as u32)));
+        gpu.queue.write_buffer(&self.reduce_uniform, std::mem::offset_of!(MsfReduce, prev) as u64, bytemuck::bytes_of(&[lo, hi, 0.0, 0.0]));
+        self.last_passes = if prior.is_some() { 1 } else { 2 };
+        timer.stage(gpu, "min-sm.reduce", |enc| {
+            enc.clear_buffer(&self.red, 0, None);
+            gpu.dispatch_2d(enc, "min-sm.reduce.bounds", &self.bounds_pipeline, &[&group], w.div_ceil(RUN), h);
+            if prior.is_none() {
+                gpu.dispatch_2d(enc, "min-sm.reduce.rows", &self.rows_pipeline, &[&group], w.div_ceil(RUN), h);
+            }
+            enc.copy_buffer_to_buffer(&self.red, 0, &self.staging, 0, self.red.size());
+        });
+        let t0 = std::time::Instant::now();
+        let words = self.read_reduction(gpu)?;
+        timer.add("min-sm.readback", t0.elapsed().as_secs_f64() * 1e3);
+
+        // CPU: hull, calipers, projection
+        let t1 = std::time::Instant::now();
+        let red = Reduction::from_words(&words, self.grid as usize, prior);
+        self.last_count = red.as_ref().map_or(0, |r| r.count);
+        self.prior = red.as_ref().map(|r| (r.lo.y as f32, r.hi.y as f32));
+        self.last = red.and_then(|r| frustum::fit(&self.light, &self.bounds, &self.frame, &r, self.res, self.pad_texels, self.shape));
+        let (vp, texel, persp) = match &self.last {
+            Some(m) => (m.view_proj_f32(), m.texel as f32, m.perspective),
+            None => (self.scene_fit.view_proj, self.scene_fit.texel, self.scene_fit.perspective),
+        };
+        self.params.light_view_proj = vp.to_cols_array_2d();
+        self.params.texel[0] = texel;
+        self.params.texel[1] = persp as u32 as f32;
+        let fit_ms = t1.elapsed().as_secs_f64() * 1e3;
+        self.fit_ms.push(fit_ms);
+        timer.add("min-sm.fit", fit_ms);
+        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        Ok(())
+    }
+
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let map_view = self.map.create_view(&Default::default());
+        timer.stage(gpu, "min-sm.render", |enc| {
+            let mut pass = raster::begin_pass(enc, "min-sm.render", &[], &map_view);
+            pass.set_pipeline(&self.depth_pipeline);
+            pass.set_bind_group(0, &self.depth_group, &[]);
+            pass.set_bind_group(1, &f.scene.group, &[]);
+            pass.draw(0..f.scene.triangle_count * 3, 0..1);
+        });
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let map_view = self.map.create_view(&Default::default());
+        let group = f.view_group(
+            gpu,
+            "min-sm.eval",
+            &self.eval_layout,
+            &[
+                self.uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&map_view),
+                wgpu::BindingResource::Sampler(&self.sampler),
+                self.counts.as_entire_binding(),
+            ],
+        );
+        timer.stage(gpu, "min-sm.evaluate", |enc| {
+            enc.clear_buffer(&self.counts, 0, None);
+            gpu.dispatch_2d(enc, "min-sm.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let n = (self.res * self.res) as usize;
+        let counts: Vec<u32> = gpu.read_buffer_as(&self.counts, n);
+        let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4));
+        let mut r = TechniqueReport { shadow_data_bytes: n as u64 * 4, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+        let in_map: u64 = counts.iter().map(|&c| c as u64).sum();
+        let c = &mut r.counters;
+        c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
+        c.insert("shadow_map_texels".into(), n as f64);
+        c.insert("view_samples".into(), self.last_count as f64);
+        c.insert("samples_in_map".into(), in_map as f64);
+        c.insert("samples_outside_map".into(), self.last_count.saturating_sub(in_map) as f64);
+        // median and max over the frames run so far (a single frame can be preempted)
+        c.insert("cpu_fit_ms".into(), crate::timing::median(&self.fit_ms));
+        c.insert("cpu_fit_ms_max".into(), self.fit_ms.iter().copied().fold(0.0, f64::max));
+        c.insert("readback_bytes".into(), self.red.size() as f64);
+        c.insert("fallback_scene_fit".into(), self.last.is_none() as u32 as f64);
+        c.insert("reduce_passes".into(), self.last_passes as f64);
+        if let Some(m) = &self.last {
+            c.insert("reduced_points".into(), m.input_points as f64);
+            c.insert("hull_points".into(), m.hull_points as f64);
+            c.insert("rect_area_vs_scene_map".into(), m.area_ratio);
+            c.insert("texel_vs_sm".into(), m.texel / self.scene_fit.texel as f64);
+            c.insert("rect_aspect".into(), m.padded.half.max_element() / m.padded.half.min_element().max(1e-30));
+        }
+        r.images.push(depth_image("shadow map (depth)", self.res, &depth));
+        r.images.push(count_image("view samples per texel", self.res, &counts));
+        r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shares_sm_parameters_by_key() {
+        let keys: Vec<_> = super::PARAMS.iter().map(|p| p.key).collect();
+        assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid", "fit", "one_pass"]);
+    }
+}
