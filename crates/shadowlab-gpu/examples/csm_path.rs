@@ -4,15 +4,13 @@
 //! the frames (`Lab::instantiate` + `Lab::step`).
 //!
 //! `cargo run -p shadowlab-gpu --example csm_path -- [scene] [frames] [size] [span] [spec...]`
-//! (`scene`: a built-in scene, or `city`: the city-scale grid of tests/csm_city)
+//! (`scene`: a built-in scene, e.g. `city`)
 //! (defaults: courtyard, 24, 512, span 1, and csm with/without snapping and tightening, the box
 //! fit, sm). `span` < 1 walks only that fraction of the path's first segment: small, sub-texel
 //! steps, where the screen barely changes and shimmering shows alone in the flicker; a negative
 //! `span` instead turns the camera at the path's first key by |span| degrees per frame about
 //! the vertical (the case where a sphere-fitted box keeps its size and a tight box does not).
 
-#[path = "../tests/csm_city/mod.rs"]
-mod csm_city;
 
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera, CameraKey};
@@ -42,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let specs: Vec<String> = if args.len() > 4 { args[4..].to_vec() } else { DEFAULT_SPECS.iter().map(|s| s.to_string()).collect() };
 
     let gpu = Gpu::new()?;
-    let scene = if scene_name == "city" { csm_city::city() } else { builtin(scene_name).ok_or("no such built-in scene")? };
+    let scene = builtin(scene_name).ok_or("no such built-in scene")?;
     let lab = Lab::new(&gpu, &scene)?;
     let light = scene.lights[0];
     let keys = match (span < 1.0, scene.camera_path.as_slice()) {

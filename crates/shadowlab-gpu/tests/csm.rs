@@ -8,7 +8,6 @@ use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::reduce::MinMax;
 
 mod common;
-mod csm_city;
 use common::*;
 
 fn spec(s: &str) -> TechniqueSpec {
@@ -116,7 +115,7 @@ fn cascades_beat_one_map_of_the_same_texels_on_courtyard() {
 #[test]
 fn cascades_beat_one_map_by_far_on_a_city() {
     let Some(gpu) = gpu() else { return };
-    let scene = csm_city::city();
+    let scene = shadowlab_core::builtin::builtin("city").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 384);
     let rt = lab.reference(&v, 1).unwrap();
