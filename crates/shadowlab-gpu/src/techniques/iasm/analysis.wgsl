@@ -9,7 +9,6 @@
 
 @group(0) @binding(6) var<uniform> ip: IasmParams;
 @group(0) @binding(7) var<storage, read_write> stats: array<atomic<u32>>;
-@group(0) @binding(8) var<storage, read_write> camera: array<vec4<f32>, 5>;
 
 const FIXED: f32 = 64.0;
 
@@ -49,14 +48,4 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let k = key(dot(p, ip.dir.xyz));
     atomicMin(&stats[b + 3u], k);
     atomicMax(&stats[b + 4u], k);
-}
-
-// Copies the camera of this view (the lab hands techniques the frame uniform only): view_proj
-// columns, then camera_pos.
-@compute @workgroup_size(1)
-fn copy_camera() {
-    for (var c = 0; c < 4; c++) {
-        camera[c] = frame.view_proj[c];
-    }
-    camera[4] = frame.camera_pos;
 }

@@ -1,10 +1,9 @@
 //! GPU side of `iasm`: resources, the per-frame plan (from the analysis read back) and the
-//! passes. Stage names (timing keys): `iasm.camera` (copy of the view's camera to the CPU, an
-//! artifact of the lab handing techniques only the frame uniform), `iasm.importance` (analysis
+//! passes. Stage names (timing keys): `iasm.importance` (analysis
 //! pass), `iasm.readback` (waiting for and mapping the 16 tiles' stats: the sync cost),
 //! `iasm.shadows.clear`, `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use shadowlab_core::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
@@ -46,7 +45,6 @@ pub struct Iasm {
     current: Placement,
     pub(super) params_buf: wgpu::Buffer,
     stats_buf: wgpu::Buffer,
-    camera_buf: wgpu::Buffer,
     pub(super) shadow: wgpu::Buffer,
     pub(super) counts: wgpu::Buffer,
     tile_buf: wgpu::Buffer,
@@ -54,7 +52,6 @@ pub struct Iasm {
     dummy: wgpu::TextureView,
     analysis_layout: wgpu::BindGroupLayout,
     analysis: wgpu::ComputePipeline,
-    copy_camera: wgpu::ComputePipeline,
     render: wgpu::RenderPipeline,
     eval_layout: wgpu::BindGroupLayout,
     eval: wgpu::ComputePipeline,
@@ -83,7 +80,6 @@ impl Iasm {
 
         let params_buf = gpu.uniform("iasm.params", &<IasmParams as bytemuck::Zeroable>::zeroed());
         let stats_buf = gpu.storage("iasm.stats", TILE_COUNT as u64 * 32 + 4);
-        let camera_buf = gpu.storage("iasm.camera", 80);
         let shadow = gpu.storage("iasm.shadow", texels * core::TEXEL_BYTES);
         let counts = gpu.storage("iasm.counts", texels * 4);
         let tile_buf = d.create_buffer(&wgpu::BufferDescriptor {
@@ -121,9 +117,8 @@ impl Iasm {
                 view_formats: &[],
             })
             .create_view(&Default::default());
-        let analysis_layout = view_layout(gpu, "iasm.analysis", &[binding::uniform(), binding::storage(false), binding::storage(false)]);
+        let analysis_layout = view_layout(gpu, "iasm.analysis", &[binding::uniform(), binding::storage(false)]);
         let analysis = gpu.compute_pipeline("iasm.analysis", &analysis_src(), "main", &[&analysis_layout]);
-        let copy_camera = gpu.compute_pipeline("iasm.camera", &analysis_src(), "copy_camera", &[&analysis_layout]);
         let eval_layout = view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false)]);
         let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
@@ -149,7 +144,6 @@ impl Iasm {
             current: basis,
             params_buf,
             stats_buf,
-            camera_buf,
             shadow,
             counts,
             tile_buf,
@@ -157,7 +151,6 @@ impl Iasm {
             dummy,
             analysis_layout,
             analysis,
-            copy_camera,
             render,
             eval_layout,
             eval,
@@ -192,31 +185,17 @@ impl Iasm {
         }
     }
 
-    /// Places the square for the camera of `f` (read back from the frame uniform).
-    fn place(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
-        let group = f.view_group(gpu, "iasm.camera", &self.analysis_layout, &self.analysis_extra());
-        let t0 = std::time::Instant::now();
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.copy_camera);
-            pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
-        }
-        gpu.queue.submit([enc.finish()]);
-        let cam: Vec<[f32; 4]> = gpu.read_buffer_as(&self.camera_buf, 5);
-        timer.add("iasm.camera", t0.elapsed().as_secs_f64() * 1e3);
-        let vp = Mat4::from_cols_array_2d(&[cam[0], cam[1], cam[2], cam[3]]);
-        let inv = vp.inverse();
-        let forward = (inv.project_point3(Vec3::new(0.0, 0.0, 1.0)) - inv.project_point3(Vec3::ZERO)).normalize_or_zero();
+    /// Places the square for the camera of `f`.
+    fn place(&mut self, f: &FrameInputs) {
+        let cam = &f.camera;
+        let forward = (cam.target - cam.position).normalize_or_zero();
         let min_res = *THESIS_RESOLUTIONS.iter().min().unwrap_or(&16) as f32;
         let step = self.snap.then_some(self.size / core::TILES_PER_SIDE as f32 / min_res);
-        let pos = Vec3::new(cam[4][0], cam[4][1], cam[4][2]);
-        self.placement = core::place(self.light_dir, pos, forward, self.size, step, self.anchor);
+        self.placement = core::place(self.light_dir, cam.position, forward, self.size, step, self.anchor);
     }
 
-    fn analysis_extra(&self) -> [wgpu::BindingResource<'_>; 3] {
-        [self.params_buf.as_entire_binding(), self.stats_buf.as_entire_binding(), self.camera_buf.as_entire_binding()]
+    fn analysis_extra(&self) -> [wgpu::BindingResource<'_>; 2] {
+        [self.params_buf.as_entire_binding(), self.stats_buf.as_entire_binding()]
     }
 
     /// Dispatches the analysis of `f` with the current placement into `stats_buf`.
@@ -290,7 +269,7 @@ impl Iasm {
 
 impl Technique for Iasm {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.place(gpu, f, timer);
+        self.place(f);
         self.current = self.placement;
         if self.delayed && self.pending {
             // the previous frame's analysis belongs to the previous frame's square: keep both
