@@ -11,7 +11,6 @@
 //! `span` instead turns the camera at the path's first key by |span| degrees per frame about
 //! the vertical (the case where a sphere-fitted box keeps its size and a tight box does not).
 
-
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera, CameraKey};
 use shadowlab_core::metrics::{compare, flicker_pct};

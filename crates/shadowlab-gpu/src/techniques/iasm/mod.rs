@@ -192,7 +192,7 @@ pub const PARAMS: &[ParamDef] = &[
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "iasm",
     summary:
-        "Irregular Adaptive Shadow Maps: 4x4 tiles ahead of the camera, resolutions 1x1024..4x16 by importance rank, one linear buffer",
+        "Irregular Adaptive Shadow Maps: 4x4 tiles ahead of the camera, resolutions 1x1024..4x16 by importance rank, in a depth atlas (default) or the thesis's linear buffer",
     cost: "importance pass + 512-byte readback, up to 16 culled tile passes (atlas: depth test; buffer: atomic max), 1 fetch per pixel",
     quality: "resolution follows the camera; tile seams where neighbours differ (four-tile corners, thesis Fig. 4.4)",
     source: "seed 001 (IASM thesis) chapter 3",
