@@ -56,7 +56,11 @@ pub fn load_scene(source: &SceneSource, xf: &SceneTransform) -> Result<Scene> {
         }),
         SceneSource::File(p) => {
             if !p.exists() {
-                bail!("scene file {} not found", p.display());
+                bail!(
+                    "scene file {} not found (a setup's scene path is relative to the setup file; set {}=/path/to/scenes to find the real scenes elsewhere)",
+                    p.display(),
+                    shadowlab_core::setup::SCENES_ENV
+                );
             }
             Ok(loaders::load(p, xf)?)
         }

@@ -104,6 +104,33 @@ pub enum SceneSource {
     File(PathBuf),
 }
 
+/// Environment variable naming the directory that holds the real scenes; a setup's scene path
+/// that does not exist as written and has a `scenes` component is looked up under it.
+pub const SCENES_ENV: &str = "SHADOWLAB_SCENES";
+
+/// `base/p` when that exists (or when no scenes directory is given); else, when `p` has a
+/// `scenes` component, the part after it under `scenes_dir` (setups written for the repository's
+/// `../../shared/scenes` layout then work from any checkout with `SHADOWLAB_SCENES=/path/to/scenes`).
+pub fn resolve_scene_path(base: &Path, p: &Path, scenes_dir: Option<&Path>) -> PathBuf {
+    let direct = base.join(p);
+    let Some(dir) = scenes_dir else { return direct };
+    if direct.exists() {
+        return direct;
+    }
+    let comps: Vec<_> = p.components().collect();
+    match comps.iter().rposition(|c| c.as_os_str() == "scenes") {
+        Some(i) => {
+            let alt: PathBuf = dir.join(comps[i + 1..].iter().collect::<PathBuf>());
+            if alt.exists() {
+                alt
+            } else {
+                direct
+            }
+        }
+        None => direct,
+    }
+}
+
 impl Setup {
     pub fn parse(text: &str) -> Result<Setup, String> {
         toml::from_str(text).map_err(|e| e.to_string())
@@ -115,7 +142,8 @@ impl Setup {
         let mut s = Setup::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?;
         if let Some(p) = &s.scene.path {
             let base = path.parent().unwrap_or(Path::new("."));
-            s.scene.path = Some(base.join(p));
+            let scenes_dir = std::env::var_os(SCENES_ENV).map(PathBuf::from);
+            s.scene.path = Some(resolve_scene_path(base, p, scenes_dir.as_deref()));
         }
         s.validate().map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(s)
@@ -203,6 +231,20 @@ spec = "sm:res=512,pcf=3"
         let bad = text.replace("target = [1, 1, -1]", "target = [1, 1, 0]");
         assert!(Setup::parse(&bad).unwrap().validate().unwrap_err().contains("camera.path[1]"));
         assert!(Setup::parse(&text.replace("[[camera.path]]\nposition = [0", "[[camera.path]]\nfov = 3\nposition = [0")).is_err());
+    }
+    #[test]
+    fn scene_paths_fall_back_to_the_scenes_directory() {
+        let tmp = std::env::temp_dir().join(format!("shadowlab-scenes-{}", std::process::id()));
+        std::fs::create_dir_all(tmp.join("sponza")).unwrap();
+        std::fs::write(tmp.join("sponza/sponza.obj"), "").unwrap();
+        let p = Path::new("../../shared/scenes/sponza/sponza.obj");
+        let base = Path::new("/nonexistent/setups");
+        assert_eq!(resolve_scene_path(base, p, Some(&tmp)), tmp.join("sponza/sponza.obj"));
+        assert_eq!(resolve_scene_path(base, p, None), base.join(p), "no directory: as written");
+        let missing = Path::new("../scenes/other/x.obj");
+        assert_eq!(resolve_scene_path(base, missing, Some(&tmp)), base.join(missing), "not under the directory: as written");
+        assert_eq!(resolve_scene_path(&tmp, Path::new("sponza/sponza.obj"), Some(Path::new("/x"))), tmp.join("sponza/sponza.obj"));
+        std::fs::remove_dir_all(&tmp).unwrap();
     }
     #[test]
     fn defaults_are_the_identity_transform() {
