@@ -12,3 +12,4 @@ pub mod metrics;
 pub mod params;
 pub mod scene;
 pub mod setup;
+pub mod warp;
