@@ -10,6 +10,7 @@ pub mod context;
 pub mod frame;
 pub mod gbuffer;
 pub mod lab;
+pub mod prefix_sum;
 pub mod raster;
 pub mod reference;
 pub mod scene_gpu;

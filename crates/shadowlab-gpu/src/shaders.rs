@@ -20,6 +20,7 @@ pub fn all() -> Vec<(&'static str, String)> {
     v.extend(crate::gbuffer::shaders());
     v.extend(crate::reference::shaders());
     v.extend(crate::shade::shaders());
+    v.extend(crate::prefix_sum::shaders());
     v.extend(crate::techniques::shaders());
     v
 }

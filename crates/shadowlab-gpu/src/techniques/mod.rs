@@ -2,6 +2,7 @@
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
 pub mod sm;
+pub mod warp;
 
 use std::collections::BTreeMap;
 
@@ -124,12 +125,13 @@ pub struct TechniqueInfo {
 }
 
 /// Every technique, in listing order.
-pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO];
+pub static REGISTRY: &[&TechniqueInfo] = &[&crate::reference::INFO, &sm::INFO, &warp::RTW_INFO, &warp::NOTW_INFO, &warp::DV_INFO];
 
 /// Every technique's composed WGSL, for the naga validation test.
 pub fn shaders() -> Vec<(&'static str, String)> {
     let mut v = Vec::new();
     v.extend(sm::shaders());
+    v.extend(warp::shaders());
     v
 }
 
