@@ -88,11 +88,25 @@ pub struct Warp2D {
     pub cols_y: usize,
     pub ox: Vec<f32>,
     pub oy: Vec<f32>,
+    /// Offsets interpolated linearly between the two nearest functions (centres at
+    /// (i + 0.5) / w): a continuous warp. False: eq. 6 as printed (function floor(v w)).
+    pub interp: bool,
+}
+
+/// Nearest functions (i0, i1) and the weight of i1 at coordinate v (shared with params.wgsl).
+pub fn neighbours(v: f32, res: usize, interp: bool) -> (usize, usize, f32) {
+    if !interp {
+        let i = texel(v, res);
+        return (i, i, 0.0);
+    }
+    let s = (v * res as f32 - 0.5).clamp(0.0, (res - 1) as f32);
+    let i0 = s.floor();
+    (i0 as usize, (i0 as usize + 1).min(res - 1), s - i0)
 }
 
 impl Warp2D {
     pub fn identity(res: usize) -> Warp2D {
-        Warp2D { res, rows_x: 1, cols_y: 1, ox: vec![0.0; res], oy: vec![0.0; res] }
+        Warp2D { res, rows_x: 1, cols_y: 1, ox: vec![0.0; res], oy: vec![0.0; res], interp: true }
     }
 
     /// Row function i's offsets.
@@ -107,18 +121,20 @@ impl Warp2D {
         (0..self.res).map(|k| self.oy[k * self.cols_y + j]).collect()
     }
 
-    /// x' of the row pass: x + o_x^(i)(x), i = floor(y w).
+    /// x' of the row pass: x + o_x^(i)(x), i = floor(y w) (or interpolated).
     pub fn warp_x(&self, x: f32, y: f32) -> f32 {
-        x + eval_offset(self.row(texel(y, self.res)), x)
+        let (a, b, t) = neighbours(y, self.res, self.interp);
+        let (oa, ob) = (eval_offset(self.row(a), x), eval_offset(self.row(b), x));
+        x + (oa + (ob - oa) * t)
     }
 
     /// Seed 000 eq. 6: (x + o_x^(i)(x), y + o_y^(j)(y)), i = floor(y w), j = floor(x' w).
     /// Points outside [0,1]^2 keep the offsets of the border functions (0 along the axis).
     pub fn apply(&self, x: f32, y: f32) -> (f32, f32) {
         let xw = self.warp_x(x, y);
-        let j = texel(xw, self.res).min(self.cols_y - 1);
-        let col: Vec<f32> = (0..self.res).map(|k| self.oy[k * self.cols_y + j]).collect();
-        (xw, y + eval_offset(&col, y))
+        let (a, b, t) = neighbours(xw, self.res, self.interp);
+        let (oa, ob) = (eval_offset(&self.column(a), y), eval_offset(&self.column(b), y));
+        (xw, y + (oa + (ob - oa) * t))
     }
 }
 
@@ -147,18 +163,19 @@ pub struct Notw {
 
 /// NoTW on points in map coordinates: count map, row warps (smoothed over `window` rows
 /// weighted by their totals), the count map rebuilt through them, column warps (smoothed over
-/// `window` columns), the final warp of eq. 6.
-pub fn notw(points: &[[f32; 2]], res: usize, window: usize) -> Notw {
+/// `window` columns), the final warp of eq. 6 (`interp`: offsets interpolated between
+/// neighbouring functions).
+pub fn notw(points: &[[f32; 2]], res: usize, window: usize, interp: bool) -> Notw {
     let counts = count_map(points, res, None);
     let cf: Vec<f32> = counts.iter().map(|&c| c as f32).collect();
     let ox = row_warps(&cf, res, window);
-    let rows_only = Warp2D { res, rows_x: res, cols_y: 1, ox, oy: vec![0.0; res] };
+    let rows_only = Warp2D { res, rows_x: res, cols_y: 1, ox, oy: vec![0.0; res], interp };
     let counts_rows = count_map(points, res, Some((&rows_only, false)));
     // columns: transpose, warp as rows, transpose back into the image layout
     let t: Vec<f32> = (0..res * res).map(|idx| counts_rows[(idx % res) * res + idx / res] as f32).collect();
     let oy_t = row_warps(&t, res, window);
     let oy: Vec<f32> = (0..res * res).map(|idx| oy_t[(idx % res) * res + idx / res]).collect();
-    Notw { counts, counts_rows, warp: Warp2D { res, rows_x: res, cols_y: res, ox: rows_only.ox, oy } }
+    Notw { counts, counts_rows, warp: Warp2D { res, rows_x: res, cols_y: res, ox: rows_only.ox, oy, interp } }
 }
 
 /// Box blur of half-width `radius` (clamped at the ends, normalised by the taps inside).
@@ -180,7 +197,7 @@ pub fn rtw(importance: &[f32], res: usize, radius: usize) -> Warp2D {
     let rowmax: Vec<f32> = (0..res).map(|i| importance[i * res..(i + 1) * res].iter().copied().fold(0.0, f32::max)).collect();
     let fx = offsets_from_prefix(&row_prefix(&blur(&colmax, radius), 1, res));
     let fy = offsets_from_prefix(&row_prefix(&blur(&rowmax, radius), 1, res));
-    Warp2D { res, rows_x: 1, cols_y: 1, ox: fx, oy: fy }
+    Warp2D { res, rows_x: 1, cols_y: 1, ox: fx, oy: fy, interp: true }
 }
 
 /// RTW importance of one view sample (GUIDE: the desired-view mask plus the distance-to-eye

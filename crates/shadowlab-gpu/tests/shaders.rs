@@ -150,6 +150,7 @@ fn warp_struct_layouts_match_rust() {
                 ("cfg", offset_of!(WarpParams, cfg)),
                 ("imp", offset_of!(WarpParams, imp)),
                 ("ints", offset_of!(WarpParams, ints)),
+                ("flags", offset_of!(WarpParams, flags)),
             ],
         );
     }

@@ -163,6 +163,22 @@ fn smooth_cols(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(warp_y_out, vec2<u32>(id.y, id.x), vec4<f32>(smoothed(1u, id.y, id.x), 0.0, 0.0, 0.0));
 }
 
+// o_x^(i)(x) from the smoothed row offsets in fwork.
+fn row_offset(i: u32, x: f32) -> f32 {
+    let w = res_u();
+    if x < 0.0 || x >= 1.0 {
+        return 0.0;
+    }
+    let sx = x * f32(w);
+    let k = min(u32(sx), w - 1u);
+    let row = 2u * w * w + i * w;
+    var left = 0.0;
+    if k > 0u {
+        left = fwork[row + k - 1u];
+    }
+    return edge_lerp(left, fwork[row + k], sx, k);
+}
+
 // The count map rebuilt through the smoothed row warps (step 6).
 @compute @workgroup_size(8, 8)
 fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -176,14 +192,8 @@ fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let w = res_u();
     let i = texel_of(u.y, w);
-    let sx = u.x * f32(w);
-    let k = min(u32(sx), w - 1u);
-    let row = 2u * w * w + i * w;
-    var left = 0.0;
-    if k > 0u {
-        left = fwork[row + k - 1u];
-    }
-    let xw = u.x + edge_lerp(left, fwork[row + k], sx, k);
+    let a = neighbours(u.y, w, wp.flags.x != 0u);
+    let xw = u.x + mix(row_offset(u32(a.x), u.x), row_offset(u32(a.y), u.x), a.z);
     if xw >= 0.0 && xw < 1.0 {
         atomicAdd(&work[w * w + i * w + texel_of(xw, w)], 1u);
     }

@@ -48,14 +48,18 @@ fn offset_y(j: u32, y: f32) -> f32 {
     return edge_lerp(left, textureLoad(warp_y, vec2<u32>(col, k), 0).x, s, k);
 }
 
-// Seed 000 eq. 6: (x + o_x^(i)(x), y + o_y^(j)(y)), i = floor(y w), j = floor(x' w).
+// Seed 000 eq. 6: (x + o_x^(i)(x), y + o_y^(j)(y)), i = floor(y w), j = floor(x' w); with
+// `flags.x` the offsets are interpolated between the two nearest functions instead.
 fn warp(u: vec2<f32>) -> vec2<f32> {
     if wp.cfg.z < 0.5 {
         return u;
     }
     let res = u32(wp.texel.z);
-    let xw = u.x + offset_x(texel_of(u.y, res), u.x);
-    return vec2<f32>(xw, u.y + offset_y(texel_of(xw, res), u.y));
+    let interp = wp.flags.x != 0u;
+    let a = neighbours(u.y, res, interp);
+    let xw = u.x + mix(offset_x(u32(a.x), u.x), offset_x(u32(a.y), u.x), a.z);
+    let b = neighbours(xw, res, interp);
+    return vec2<f32>(xw, u.y + mix(offset_y(u32(b.x), u.y), offset_y(u32(b.y), u.y), b.z));
 }
 
 // Clip position of a world point in the warped map (Algorithm 1 of seed 000): crop to the DV,

@@ -67,6 +67,8 @@ pub const DEFAULT_BLUR: f64 = 8.0;
 pub const DEFAULT_SUBDIV: f64 = 0.0;
 /// Subdivision level cap per triangle: the tessellation factor 16 of the authors' OpenGL code.
 pub const DEFAULT_SUBDIV_MAX: f64 = 16.0;
+/// Offsets interpolated between neighbouring functions (1) or eq. 6 as printed (0).
+pub const DEFAULT_INTERP: f64 = 1.0;
 /// DV margin (texels): samples moved by the bias offsets must stay inside the cropped map.
 pub const DEFAULT_DV_MARGIN: f64 = 2.0;
 
@@ -94,11 +96,21 @@ const BLUR: ParamDef = p("blur", DEFAULT_BLUR, 0.0, 512.0, true, "RTW blur half-
 const W_DV: ParamDef = p("w_dv", 1.0, 0.0, 100.0, false, "RTW desired-view importance (every sampled texel)", "GUIDE: importance = DV mask + (maxDistance - distance)");
 const W_EYE: ParamDef = p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
 const SUBDIV: ParamDef = p("subdiv", DEFAULT_SUBDIV, 0.0, 1024.0, false, "split triangles whose warped edge exceeds this many texels; 0 = off", "shadowlab measurement (docs/bench/warp.md)");
-const SUBDIV_MAX: ParamDef = p("subdiv_max", DEFAULT_SUBDIV_MAX, 2.0, 64.0, true, "max subdivision level n (n^2 pieces) per triangle", "tessellation factor 16 of the authors' OpenGL code (GUIDE)");
+const INTERP: ParamDef = ParamDef {
+    key: "interp",
+    default: DEFAULT_INTERP,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "interpolate offsets between neighbouring row/column functions (a continuous warp); false = eq. 6 as printed (one function per texel row: a sub-triangle crossing rows is rasterised across an offset jump)",
+    source: "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard",
+    choices: shadowlab_core::params::BOOL,
+};
+const SUBDIV_MAX: ParamDef = p("subdiv_max", DEFAULT_SUBDIV_MAX, 2.0, 255.0, true, "max subdivision level n (n^2 pieces) per triangle", "tessellation factor 16 of the authors' OpenGL code (GUIDE)");
 
-pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, SUBDIV, SUBDIV_MAX, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
-pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, SUBDIV, SUBDIV_MAX, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
-pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, INTERP, SUBDIV, SUBDIV_MAX, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_MAX, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const DV_PARAMS: &[ParamDef] = &[RES, INTERP, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 
 const LIGHTS: &[&str] = &["directional", "spot"];
 
@@ -162,6 +174,7 @@ pub struct WarpParams {
     pub cfg: [f32; 4],
     pub imp: [f32; 4],
     pub ints: [u32; 4],
+    pub flags: [u32; 4],
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -235,6 +248,7 @@ impl Warped {
             cfg: [p.get("dv_margin") as f32, 1.0, (variant != Variant::Dv) as u32 as f32, window as f32],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, subdiv],
             ints: [tris, opt("subdiv_max", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
+            flags: [p.get_u32("interp"), 0, 0, 0],
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;

@@ -19,6 +19,9 @@ struct WarpParams {
     imp: vec4<f32>,
     // x: triangles, y: max subdivision level, z: extra sub-triangle capacity, w: 1 = RTW importance
     ints: vec4<u32>,
+    // x: 1 = offsets interpolated linearly between neighbouring functions (continuous warp),
+    // 0 = eq. 6 as printed (function floor(y w) / floor(x' w))
+    flags: vec4<u32>,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.
@@ -55,4 +58,16 @@ fn edge_lerp(left: f32, right: f32, s: f32, k: u32) -> f32 {
 
 fn texel_of(v: f32, res: u32) -> u32 {
     return min(u32(max(floor(v * f32(res)), 0.0)), res - 1u);
+}
+
+// Neighbouring functions i0, i1 and weight t of i1 at coordinate v (function centres at
+// (i + 0.5) / res); without interpolation the function floor(v res) alone (eq. 6).
+fn neighbours(v: f32, res: u32, interp: bool) -> vec3<f32> {
+    if !interp {
+        let i = f32(texel_of(v, res));
+        return vec3<f32>(i, i, 0.0);
+    }
+    let s = clamp(v * f32(res) - 0.5, 0.0, f32(res - 1u));
+    let i0 = floor(s);
+    return vec3<f32>(i0, min(i0 + 1.0, f32(res - 1u)), s - i0);
 }

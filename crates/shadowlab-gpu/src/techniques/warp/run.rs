@@ -78,7 +78,7 @@ impl Warped {
     pub fn read_warp(&self, gpu: &Gpu) -> Warp2D {
         let ox: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.warp_x, 4));
         let oy: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.warp_y, 4));
-        Warp2D { res: self.res as usize, rows_x: self.warp_x.height() as usize, cols_y: self.warp_y.width() as usize, ox, oy }
+        Warp2D { res: self.res as usize, rows_x: self.warp_x.height() as usize, cols_y: self.warp_y.width() as usize, ox, oy, interp: self.params.flags[0] != 0 }
     }
 
     /// Bytes of the warps kept per light.
