@@ -65,8 +65,10 @@ pub const DEFAULT_WINDOW: f64 = 16.0;
 pub const DEFAULT_BLUR: f64 = 8.0;
 /// Subdivision threshold (longest warped edge, texels); 0 = off. See docs/bench/warp.md.
 pub const DEFAULT_SUBDIV: f64 = 0.0;
-/// Subdivision level cap per triangle: the tessellation factor 16 of the authors' OpenGL code.
-pub const DEFAULT_SUBDIV_MAX: f64 = 16.0;
+/// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
+/// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
+/// tessellation factor of 16 (4 levels); measured too few for the big floor triangles here.
+pub const DEFAULT_SUBDIV_LEVELS: f64 = 10.0;
 /// Offsets interpolated between neighbouring functions (1) or eq. 6 as printed (0).
 pub const DEFAULT_INTERP: f64 = 1.0;
 /// DV margin (texels): samples moved by the bias offsets must stay inside the cropped map.
@@ -106,10 +108,18 @@ const INTERP: ParamDef = ParamDef {
     source: "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard",
     choices: shadowlab_core::params::BOOL,
 };
-const SUBDIV_MAX: ParamDef = p("subdiv_max", DEFAULT_SUBDIV_MAX, 2.0, 255.0, true, "max subdivision level n (n^2 pieces) per triangle", "tessellation factor 16 of the authors' OpenGL code (GUIDE)");
+const SUBDIV_LEVELS: ParamDef = p(
+    "subdiv_levels",
+    DEFAULT_SUBDIV_LEVELS,
+    1.0,
+    15.0,
+    true,
+    "max edge halvings per triangle (4^levels pieces); low: big triangles stay bent",
+    "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
+);
 
-pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, INTERP, SUBDIV, SUBDIV_MAX, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
-pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_MAX, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 pub const DV_PARAMS: &[ParamDef] = &[RES, INTERP, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 
 const LIGHTS: &[&str] = &["directional", "spot"];
@@ -192,16 +202,21 @@ pub struct Warped {
     warp_y: wgpu::Texture,
     map: wgpu::Texture,
     counts: wgpu::Buffer,
-    records: wgpu::Buffer,
-    args: wgpu::Buffer,
+    /// Subdivision: finished pieces, counters + draw/dispatch args, two queues, one uniform per level.
+    pieces: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    queues: [wgpu::Buffer; 2],
+    /// Indirect dispatch args of the current level (copied from `counters`).
+    dispatch: wgpu::Buffer,
+    level_uniforms: Vec<wgpu::Buffer>,
     prefix: PrefixSum,
     analyze_layout: wgpu::BindGroupLayout,
     analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
     lookup_layout: wgpu::BindGroupLayout,
     depth_pipeline: wgpu::RenderPipeline,
     split_layout: wgpu::BindGroupLayout,
-    split: wgpu::ComputePipeline,
-    split_args: wgpu::ComputePipeline,
+    /// split_root, split_args, split_level, draw_args.
+    split: [wgpu::ComputePipeline; 4],
     eval_layout: wgpu::BindGroupLayout,
     eval_pipeline: wgpu::ComputePipeline,
     sampler: wgpu::Sampler,
@@ -239,15 +254,17 @@ impl Warped {
         }
         let subdiv = opt("subdiv", 0.0) as f32;
         let tris = scene.triangle_count;
-        let limit = gpu.limits.max_storage_buffer_binding_size as u64 / 8;
-        let extra = if subdiv > 0.0 { (3 * tris as u64).max(1 << 20).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
+        let limit = gpu.limits.max_storage_buffer_binding_size as u64 / 16;
+        let on = subdiv > 0.0 && variant != Variant::Dv;
+        let extra = if on { (8 * tris as u64).max(1 << 21).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
+        let queue = if on { (tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
         let params = WarpParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
             texel: [lp.texel, lp.perspective as u32 as f32, res as f32, p.get("pcf") as f32],
             bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
             cfg: [p.get("dv_margin") as f32, 1.0, (variant != Variant::Dv) as u32 as f32, window as f32],
-            imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, subdiv],
-            ints: [tris, opt("subdiv_max", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
+            imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
+            ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
             flags: [p.get_u32("interp"), 0, 0, 0],
         };
         let d = &gpu.device;
@@ -272,13 +289,18 @@ impl Warped {
         let scratch = variant != Variant::Dv;
         let work = gpu.storage(&format!("{name}.work"), if scratch { (3 * n + 2 * res as u64) * 4 } else { 4 });
         let fwork = gpu.storage(&format!("{name}.fwork"), if scratch { (3 * n + 3 * res as u64) * 4 } else { 4 });
-        let records = gpu.storage(&format!("{name}.records"), (tris as u64 + extra as u64) * 8 * (subdiv > 0.0) as u64);
-        let args = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(&format!("{name}.args")),
-            size: 32,
+        let pieces = gpu.storage(&format!("{name}.pieces"), (tris as u64 + extra as u64) * 16 * on as u64);
+        let queues = [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16));
+        let counters = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&format!("{name}.counters")),
+            size: 64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
+        let levels = params.ints[1];
+        let level_uniforms = (1..=levels)
+            .map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue]))
+            .collect();
         let ro = binding::storage(true);
         let rw = binding::storage(false);
         let tex = binding::texture_float();
@@ -298,10 +320,15 @@ impl Warped {
         let look = [(6, binding::uniform()), (7, ro), (8, tex), (9, tex)];
         let lookup_layout = layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX, &[look[0], look[1], look[2], look[3], (10, ro)]);
         let depth_pipeline = raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(), &[&lookup_layout, &scene.layout], &[]);
-        let split_layout = layout_at(gpu, &format!("{name}.subdivide"), wgpu::ShaderStages::COMPUTE, &[look[0], look[1], look[2], look[3], (10, rw), (11, rw)]);
+        let split_layout = layout_at(
+            gpu,
+            &format!("{name}.subdivide"),
+            wgpu::ShaderStages::COMPUTE,
+            &[look[0], look[1], look[2], look[3], (10, rw), (11, rw), (12, rw), (13, rw), (14, binding::uniform())],
+        );
         let ssrc = subdiv_src();
-        let split = gpu.compute_pipeline(&format!("{name}.subdivide"), &ssrc, "split", &[&split_layout, &scene.layout]);
-        let split_args = gpu.compute_pipeline(&format!("{name}.subdivide_args"), &ssrc, "split_args", &[&split_layout, &scene.layout]);
+        let split = ["split_root", "split_args", "split_level", "draw_args"]
+            .map(|e| gpu.compute_pipeline(&format!("{name}.{e}"), &ssrc, e, &[&split_layout, &scene.layout]));
         let eval_layout = view_layout(
             gpu,
             &format!("{name}.final_pass"),
@@ -330,8 +357,16 @@ impl Warped {
             warp_y,
             map,
             counts: gpu.storage(&format!("{name}.counts"), n * 4),
-            records,
-            args,
+            pieces,
+            counters,
+            queues,
+            dispatch: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{name}.dispatch")),
+                size: 12,
+                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            level_uniforms,
             prefix: PrefixSum::new(gpu),
             analyze_layout,
             analyze,
@@ -339,7 +374,6 @@ impl Warped {
             depth_pipeline,
             split_layout,
             split,
-            split_args,
             eval_layout,
             eval_pipeline,
             sampler,

@@ -151,30 +151,50 @@ impl Technique for Warped {
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         let name = self.name();
         let (xv, yv) = (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()));
-        let subdiv = self.params.imp[3] > 0.0 && self.variant != Variant::Dv;
-        let records = if subdiv { &self.records } else { &self.args };
-        let res_look = self.lookup_resources(&xv, &yv);
+        let subdiv = self.params.imp[3] > 0.0;
+        let pieces = if subdiv { &self.pieces } else { &self.counters };
+        let look = self.lookup_resources(&xv, &yv);
         let mut entries: Vec<wgpu::BindGroupEntry> =
-            res_look.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: 6 + i as u32, resource: r.clone() }).collect();
-        entries.push(wgpu::BindGroupEntry { binding: 10, resource: records.as_entire_binding() });
+            look.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: 6 + i as u32, resource: r.clone() }).collect();
+        entries.push(wgpu::BindGroupEntry { binding: 10, resource: pieces.as_entire_binding() });
         let depth_group =
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.lookup_layout, entries: &entries });
         if subdiv {
-            entries.push(wgpu::BindGroupEntry { binding: 11, resource: self.args.as_entire_binding() });
-            let split_group =
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &entries });
+            entries.push(wgpu::BindGroupEntry { binding: 11, resource: self.counters.as_entire_binding() });
+            // level l reads queue (l + 1) % 2 and writes the other; the root writes queue 0
+            let groups: Vec<wgpu::BindGroup> = (0..=self.level_uniforms.len())
+                .map(|l| {
+                    let qi = (l + 1) % 2;
+                    let mut e = entries.clone();
+                    e.push(wgpu::BindGroupEntry { binding: 12, resource: self.queues[qi].as_entire_binding() });
+                    e.push(wgpu::BindGroupEntry { binding: 13, resource: self.queues[1 - qi].as_entire_binding() });
+                    let u = &self.level_uniforms[l.saturating_sub(1)];
+                    e.push(wgpu::BindGroupEntry { binding: 14, resource: u.as_entire_binding() });
+                    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &e })
+                })
+                .collect();
             let tris = self.params.ints[0];
-            let groups = tris.div_ceil(64);
+            let n = tris.div_ceil(64);
             timer.stage(gpu, &format!("{name}.subdivide"), |enc| {
-                enc.clear_buffer(&self.records, 0, None);
-                enc.clear_buffer(&self.args, 0, None);
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
-                pass.set_bind_group(0, &split_group, &[]);
-                pass.set_bind_group(1, &f.scene.group, &[]);
-                pass.set_pipeline(&self.split);
-                pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
-                pass.set_pipeline(&self.split_args);
-                pass.dispatch_workgroups(1, 1, 1);
+                enc.clear_buffer(&self.counters, 0, None);
+                let pass = |enc: &mut wgpu::CommandEncoder, g: &wgpu::BindGroup, p: usize, groups: Option<u32>| {
+                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
+                    pass.set_bind_group(1, &f.scene.group, &[]);
+                    pass.set_bind_group(0, g, &[]);
+                    pass.set_pipeline(&self.split[p]);
+                    match groups {
+                        Some(n) => pass.dispatch_workgroups(n.min(65535), n.div_ceil(65535), 1),
+                        None => pass.dispatch_workgroups_indirect(&self.dispatch, 0),
+                    }
+                };
+                pass(enc, &groups[0], 0, Some(n));
+                for (l, g) in groups.iter().enumerate().skip(1) {
+                    pass(enc, g, 1, Some(1));
+                    // the input queue's group counts, out of the storage buffer into the indirect one
+                    enc.copy_buffer_to_buffer(&self.counters, 32 + 16 * ((l as u64 + 1) % 2) + 4, &self.dispatch, 0, 12);
+                    pass(enc, g, 2, None);
+                }
+                pass(enc, &groups[0], 3, Some(1));
             });
         }
         let map_view = self.map.create_view(&Default::default());
@@ -184,7 +204,7 @@ impl Technique for Warped {
             pass.set_bind_group(0, &depth_group, &[]);
             pass.set_bind_group(1, &f.scene.group, &[]);
             if subdiv {
-                pass.draw_indirect(&self.args, 0);
+                pass.draw_indirect(&self.counters, 16);
             } else {
                 pass.draw(0..f.scene.triangle_count * 3, 0..1);
             }
@@ -225,13 +245,14 @@ impl Technique for Warped {
         c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
         c.insert("shadow_map_texels".into(), n as f64);
         c.insert("warp_bytes".into(), self.warp_bytes() as f64);
-        c.insert("scratch_bytes".into(), (self.work.size() + self.fwork.size() + self.counts.size() + self.records.size()) as f64);
+        c.insert("scratch_bytes".into(), (self.work.size() + self.fwork.size() + self.counts.size() + self.pieces.size() + 2 * self.queues[0].size()) as f64);
         let dv = self.read_dv_rect(gpu);
         c.insert("dv_area_fraction".into(), ((dv[2] - dv[0]) * (dv[3] - dv[1])) as f64);
-        if self.params.imp[3] > 0.0 && self.variant != Variant::Dv {
-            let a: Vec<u32> = gpu.read_buffer_as(&self.args, 6);
-            c.insert("subdiv_triangles_drawn".into(), (a[0] / 3) as f64);
-            c.insert("subdiv_overflow_triangles".into(), a[5] as f64);
+        if self.params.imp[3] > 0.0 {
+            let a: Vec<u32> = gpu.read_buffer_as(&self.counters, 8);
+            c.insert("subdiv_triangles_drawn".into(), (a[4] / 3) as f64);
+            c.insert("subdiv_pieces_dropped".into(), a[1] as f64);
+            c.insert("subdiv_queue_full_finishes".into(), a[2] as f64);
         }
         if self.variant != Variant::Dv {
             let before = self.read_counts_before(gpu);

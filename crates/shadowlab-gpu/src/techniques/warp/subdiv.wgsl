@@ -1,17 +1,42 @@
-// Subdivision against the bending of long warped edges (both seeds' limitation; wgpu has no
-// tessellation). Per triangle: the length of each edge through the warp (a 4-piece polyline in
-// warped texels); a triangle whose longest edge exceeds the threshold is cut into n x n
-// sub-triangles, n = ceil(length / threshold) up to the max level. Sub-triangle 0 goes to the
-// triangle's own slot; the other n^2 - 1 are appended after the triangles (atomic counter);
-// when the extra capacity is full the triangle stays whole (counted as overflow).
-// args: [vertex count, instances, first vertex, first instance, appended, overflow].
+// Adaptive subdivision against the bending of long warped edges (both seeds' limitation; wgpu
+// has no tessellation stage). A piece is a triangle index and three corners as barycentrics
+// (b1, b2) in unorm16x2. A piece needs splitting when one of its edges, followed through the
+// warp (a 4-piece polyline), is longer than the threshold in warped texels and it is in front
+// of the light and overlaps the cropped map. split_root sorts the scene's triangles: kept whole
+// in their own slot of `pieces`, or queued. Each split_level pass halves the queued pieces'
+// edges (4 children), appends the finished ones after the triangles and queues the rest
+// (queue in/out ping-pong, indirect dispatch). The last level finishes everything. Full
+// queues finish early; a full piece list drops pieces (counted: holes in the map).
+//
+// counters: [appended, dropped, queue-full finishes, -, draw args (4), queue 0: count, groups
+// x, y, z, queue 1: count, groups x, y, z].
 
-@group(0) @binding(10) var<storage, read_write> records: array<u32>;
-@group(0) @binding(11) var<storage, read_write> args: array<atomic<u32>, 8>;
+struct Level {
+    // x: level (1..), y: 1 on the last level, z: input queue (0 or 1), w: capacity per queue
+    v: vec4<u32>,
+}
 
-fn edge_length(a: vec4<f32>, b: vec4<f32>, r: vec4<f32>) -> f32 {
-    let ma = to_dv(clip_to_map(a).xy, r);
-    let mb = to_dv(clip_to_map(b).xy, r);
+@group(0) @binding(10) var<storage, read_write> pieces: array<vec4<u32>>;
+@group(0) @binding(11) var<storage, read_write> counters: array<atomic<u32>, 16>;
+@group(0) @binding(12) var<storage, read_write> q_in: array<vec4<u32>>;
+@group(0) @binding(13) var<storage, read_write> q_out: array<vec4<u32>>;
+@group(0) @binding(14) var<uniform> lv: Level;
+
+fn corner(c: u32) -> vec2<u32> {
+    return vec2<u32>(c & 0xffffu, c >> 16u);
+}
+
+fn pack_corner(b: vec2<u32>) -> u32 {
+    return b.x | (b.y << 16u);
+}
+
+fn corner_pos(tri: u32, c: u32) -> vec3<f32> {
+    let b = vec2<f32>(corner(c)) / 65535.0;
+    let v0 = vertices[3u * tri].pos;
+    return v0 + (vertices[3u * tri + 1u].pos - v0) * b.x + (vertices[3u * tri + 2u].pos - v0) * b.y;
+}
+
+fn edge_length(ma: vec2<f32>, mb: vec2<f32>) -> f32 {
     var prev = warp(ma);
     var len = 0.0;
     for (var s = 1u; s <= 4u; s++) {
@@ -22,64 +47,105 @@ fn edge_length(a: vec4<f32>, b: vec4<f32>, r: vec4<f32>) -> f32 {
     return len * wp.texel.z;
 }
 
-fn pack(n: u32, i: u32, j: u32, down: u32) -> u32 {
-    return n | (i << 8u) | (j << 16u) | (down << 24u);
+fn needs_split(p: vec4<u32>) -> bool {
+    let r = dv_rect();
+    let a = base_clip(wp, corner_pos(p.x, p.y));
+    let b = base_clip(wp, corner_pos(p.x, p.z));
+    let c = base_clip(wp, corner_pos(p.x, p.w));
+    if min(min(a.w, b.w), c.w) <= 1e-7 {
+        return false;
+    }
+    let ua = to_dv(clip_to_map(a).xy, r);
+    let ub = to_dv(clip_to_map(b).xy, r);
+    let uc = to_dv(clip_to_map(c).xy, r);
+    let lo = min(min(ua, ub), uc);
+    let hi = max(max(ua, ub), uc);
+    if any(hi < vec2<f32>(0.0)) || any(lo > vec2<f32>(1.0)) {
+        return false;
+    }
+    let len = max(max(edge_length(ua, ub), edge_length(ub, uc)), edge_length(uc, ua));
+    return len > wp.imp.w;
+}
+
+fn finish(p: vec4<u32>) {
+    let i = atomicAdd(&counters[0], 1u);
+    if i >= wp.ints.z {
+        atomicAdd(&counters[1], 1u);
+        return;
+    }
+    pieces[wp.ints.x + i] = p;
+}
+
+fn enqueue(p: vec4<u32>, q: u32) {
+    let i = atomicAdd(&counters[8u + 4u * q], 1u);
+    if i >= lv.v.w {
+        atomicAdd(&counters[2], 1u);
+        finish(p);
+        return;
+    }
+    q_out[i] = p;
 }
 
 @compute @workgroup_size(64)
-fn split(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
-    let tris = wp.ints.x;
-    if tri >= tris {
+    if tri >= wp.ints.x {
         return;
     }
-    let r = dv_rect();
-    let a = base_clip(wp, vertices[3u * tri].pos);
-    let b = base_clip(wp, vertices[3u * tri + 1u].pos);
-    let c = base_clip(wp, vertices[3u * tri + 2u].pos);
-    var n = 1u;
-    if min(min(a.w, b.w), c.w) > 1e-7 {
-        let u = array<vec2<f32>, 3>(to_dv(clip_to_map(a).xy, r), to_dv(clip_to_map(b).xy, r), to_dv(clip_to_map(c).xy, r));
-        let lo = min(min(u[0], u[1]), u[2]);
-        let hi = max(max(u[0], u[1]), u[2]);
-        // triangles wholly outside the cropped map are clipped anyway
-        if all(hi >= vec2<f32>(0.0)) && all(lo <= vec2<f32>(1.0)) {
-            let len = max(max(edge_length(a, b, r), edge_length(b, c, r)), edge_length(c, a, r));
-            n = clamp(u32(ceil(len / wp.imp.w)), 1u, wp.ints.y);
-        }
+    let p = vec4<u32>(tri, 0u, 0xffffu, 0xffff0000u);
+    if needs_split(p) {
+        pieces[tri] = vec4<u32>(tri, 0u, 0u, 0u);
+        enqueue(p, 0u);
+    } else {
+        pieces[tri] = p;
     }
-    records[2u * tri] = tri;
-    records[2u * tri + 1u] = pack(1u, 0u, 0u, 0u);
-    if n == 1u {
+}
+
+// Before level lv.x: groups for the input queue, an empty output queue.
+@compute @workgroup_size(1)
+fn split_args() {
+    let qi = 8u + 4u * lv.v.z;
+    let qo = 8u + 4u * (1u - lv.v.z);
+    let n = min(atomicLoad(&counters[qi]), lv.v.w);
+    atomicStore(&counters[qi + 1u], (n + 63u) / 64u);
+    atomicStore(&counters[qi + 2u], 1u);
+    atomicStore(&counters[qi + 3u], 1u);
+    atomicStore(&counters[qo], 0u);
+}
+
+@compute @workgroup_size(64)
+fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = min(atomicLoad(&counters[8u + 4u * lv.v.z]), lv.v.w);
+    if id.x >= n {
         return;
     }
-    let extra = n * n - 1u;
-    let base = atomicAdd(&args[4], extra);
-    if base + extra > wp.ints.z {
-        atomicAdd(&args[5], 1u);
-        return;
-    }
-    records[2u * tri + 1u] = pack(n, 0u, 0u, 0u);
-    var slot = tris + base;
-    for (var i = 0u; i < n; i++) {
-        for (var j = 0u; i + j < n; j++) {
-            for (var down = 0u; down < 2u; down++) {
-                if (down == 1u && i + j + 1u >= n) || (i == 0u && j == 0u && down == 0u) {
-                    continue;
-                }
-                records[2u * slot] = tri;
-                records[2u * slot + 1u] = pack(n, i, j, down);
-                slot += 1u;
-            }
+    let p = q_in[id.x];
+    let a = corner(p.y);
+    let b = corner(p.z);
+    let c = corner(p.w);
+    let ab = pack_corner((a + b) / 2u);
+    let bc = pack_corner((b + c) / 2u);
+    let ca = pack_corner((c + a) / 2u);
+    let kids = array<vec4<u32>, 4>(
+        vec4<u32>(p.x, p.y, ab, ca),
+        vec4<u32>(p.x, ab, p.z, bc),
+        vec4<u32>(p.x, ca, bc, p.w),
+        vec4<u32>(p.x, ab, bc, ca),
+    );
+    for (var k = 0u; k < 4u; k++) {
+        if lv.v.y != 0u || !needs_split(kids[k]) {
+            finish(kids[k]);
+        } else {
+            enqueue(kids[k], 1u - lv.v.z);
         }
     }
 }
 
 @compute @workgroup_size(1)
-fn split_args() {
-    let appended = min(atomicLoad(&args[4]), wp.ints.z);
-    atomicStore(&args[0], 3u * (wp.ints.x + appended));
-    atomicStore(&args[1], 1u);
-    atomicStore(&args[2], 0u);
-    atomicStore(&args[3], 0u);
+fn draw_args() {
+    let appended = min(atomicLoad(&counters[0]), wp.ints.z);
+    atomicStore(&counters[4], 3u * (wp.ints.x + appended));
+    atomicStore(&counters[5], 1u);
+    atomicStore(&counters[6], 0u);
+    atomicStore(&counters[7], 0u);
 }
