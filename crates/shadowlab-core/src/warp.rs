@@ -164,15 +164,16 @@ pub struct Notw {
 /// NoTW on points in map coordinates: count map, row warps (smoothed over `window` rows
 /// weighted by their totals), the count map rebuilt through them, column warps (smoothed over
 /// `window` columns), the final warp of eq. 6 (`interp`: offsets interpolated between
-/// neighbouring functions).
-pub fn notw(points: &[[f32; 2]], res: usize, window: usize, interp: bool) -> Notw {
+/// neighbouring functions). `blur` > 0 box-blurs the counts along each row (column) first.
+pub fn notw(points: &[[f32; 2]], res: usize, window: usize, interp: bool, blur_radius: usize) -> Notw {
+    let blur_rows = |v: Vec<f32>| -> Vec<f32> { v.chunks(res).flat_map(|r| blur(r, blur_radius)).collect() };
     let counts = count_map(points, res, None);
-    let cf: Vec<f32> = counts.iter().map(|&c| c as f32).collect();
+    let cf = blur_rows(counts.iter().map(|&c| c as f32).collect());
     let ox = row_warps(&cf, res, window);
     let rows_only = Warp2D { res, rows_x: res, cols_y: 1, ox, oy: vec![0.0; res], interp };
     let counts_rows = count_map(points, res, Some((&rows_only, false)));
     // columns: transpose, warp as rows, transpose back into the image layout
-    let t: Vec<f32> = (0..res * res).map(|idx| counts_rows[(idx % res) * res + idx / res] as f32).collect();
+    let t = blur_rows((0..res * res).map(|idx| counts_rows[(idx % res) * res + idx / res] as f32).collect());
     let oy_t = row_warps(&t, res, window);
     let oy: Vec<f32> = (0..res * res).map(|idx| oy_t[(idx % res) * res + idx / res]).collect();
     Notw { counts, counts_rows, warp: Warp2D { res, rows_x: res, cols_y: res, ox: rows_only.ox, oy, interp } }

@@ -1,10 +1,10 @@
 // Building the warp from the view samples (seed 000 section 3, steps 2-7; RTW: seed 002
-// Algorithm 1). Entry points run in this order: dv_reduce, count, then for NoTW (prefix sums of
-// the rows in between) offsets_rows, smooth_rows, rebuild, (column prefix sums) offsets_cols,
-// smooth_cols; for RTW rtw_collapse, rtw_blur, (prefix sums) rtw_offsets.
+// Algorithm 1). Entry points run in this order: dv_reduce, count, then for NoTW blur_rows,
+// (prefix sums of the rows) offsets_rows, smooth_rows, rebuild, blur_cols, (column prefix
+// sums) offsets_cols, smooth_cols; for RTW rtw_collapse, rtw_blur, (prefix sums) rtw_offsets.
 //
-// work (u32): counts [0,n) | counts rebuilt through the row warps [n,2n) | importance as f32
-// bits [2n,3n) | blurred 1D importance as f32 bits [3n,3n+2w).  fwork (f32): prefix sums [0,n) |
+// work (u32): counts [0,n) | counts rebuilt through the row warps [n,2n) | RTW importance or
+// NoTW blurred counts as f32 bits [2n,3n) | blurred 1D importance as f32 bits [3n,3n+2w).  fwork (f32): prefix sums [0,n) |
 // unsmoothed offsets [n,2n) | smoothed row offsets [2n,3n) | totals [3n,3n+w) | collapsed
 // importance [3n+w,3n+3w).  n = w*w.
 
@@ -92,6 +92,37 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
 fn at(axis: u32, r: u32, k: u32) -> u32 {
     let w = res_u();
     return select(k * w + r, r * w + k, axis == 0u);
+}
+
+// Box blur of the counts along each function (half-width imp.z; 0 copies), from work[src..]
+// into work[2n..] as f32 bits: without it the per-texel count noise puts a kink into the warp
+// at every texel, which linear rasterisation cannot follow (docs/bench/warp.md).
+fn blur_along(axis: u32, src: u32, id: vec3<u32>) {
+    let w = res_u();
+    let k = id.x;
+    let r = id.y;
+    if k >= w || r >= w {
+        return;
+    }
+    let rad = u32(wp.imp.z);
+    let a = u32(max(i32(k) - i32(rad), 0));
+    let b = min(k + rad, w - 1u);
+    var sum = 0.0;
+    for (var j = a; j <= b; j++) {
+        sum += f32(atomicLoad(&work[src + at(axis, r, j)]));
+    }
+    atomicStore(&work[2u * w * w + at(axis, r, k)], bitcast<u32>(sum / f32(b - a + 1u)));
+}
+
+@compute @workgroup_size(8, 8)
+fn blur_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    blur_along(0u, 0u, id);
+}
+
+@compute @workgroup_size(8, 8)
+fn blur_cols(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = res_u();
+    blur_along(1u, w * w, id);
 }
 
 // Eq. 4 at the right texel edges: o = g / N - x; identity for empty functions.

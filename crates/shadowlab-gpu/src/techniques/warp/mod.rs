@@ -63,7 +63,10 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 pub const DEFAULT_WINDOW: f64 = 16.0;
 /// RTW blur half-width (texels of the 1D importance): the same 16-wide window.
 pub const DEFAULT_BLUR: f64 = 8.0;
-/// Subdivision threshold (longest warped edge, texels); 0 = off. See docs/bench/warp.md.
+/// NoTW blur of the counts along each function (half-width, texels); 0 = as the seeds.
+pub const DEFAULT_NOTW_BLUR: f64 = 0.0;
+/// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
+/// texels); 0 = off. See docs/bench/warp.md.
 pub const DEFAULT_SUBDIV: f64 = 0.0;
 /// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
 /// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
@@ -95,9 +98,26 @@ const NORMAL_OFFSET: ParamDef = p(
 const DV_MARGIN: ParamDef = p("dv_margin", DEFAULT_DV_MARGIN, 0.0, 64.0, false, "texels added around the desired view; low: biased samples fall outside (lit)", "shadowlab: covers bias + normal offset");
 const WINDOW: ParamDef = p("window", DEFAULT_WINDOW, 0.0, 1024.0, true, "NoTW smoothing window across rows/columns; low: bent edges, high: RTW-like", "authors' public code (GUIDE)");
 const BLUR: ParamDef = p("blur", DEFAULT_BLUR, 0.0, 512.0, true, "RTW blur half-width of the 1D importance; low: abrupt warps, high: flat warps", "window 16 (GUIDE)");
+const NOTW_BLUR: ParamDef = p(
+    "blur",
+    DEFAULT_NOTW_BLUR,
+    0.0,
+    512.0,
+    true,
+    "NoTW box blur half-width of the counts along each row/column before the prefix sums; 0 = the seeds' method; low: a kink per texel that subdivision must follow, high: less even sampling",
+    "shadowlab measurement (docs/bench/warp.md)",
+);
 const W_DV: ParamDef = p("w_dv", 1.0, 0.0, 100.0, false, "RTW desired-view importance (every sampled texel)", "GUIDE: importance = DV mask + (maxDistance - distance)");
 const W_EYE: ParamDef = p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
-const SUBDIV: ParamDef = p("subdiv", DEFAULT_SUBDIV, 0.0, 1024.0, false, "split triangles whose warped edge exceeds this many texels; 0 = off", "shadowlab measurement (docs/bench/warp.md)");
+const SUBDIV: ParamDef = p(
+    "subdiv",
+    DEFAULT_SUBDIV,
+    0.0,
+    1024.0,
+    false,
+    "split triangles until the warp bends no edge (or centroid) by more than this many warped texels from the rasterised line; 0 = off; low: many pieces, high: bent edges",
+    "shadowlab measurement (docs/bench/warp.md)",
+);
 const INTERP: ParamDef = ParamDef {
     key: "interp",
     default: DEFAULT_INTERP,
@@ -118,7 +138,7 @@ const SUBDIV_LEVELS: ParamDef = p(
     "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
 );
 
-pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, NOTW_BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 pub const DV_PARAMS: &[ParamDef] = &[RES, INTERP, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 
@@ -312,7 +332,7 @@ impl Warped {
         let analyze_layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store]);
         let src = analyze_src();
         let entries: &[&str] = match variant {
-            Variant::Notw => &["dv_reduce", "count", "offsets_rows", "smooth_rows", "rebuild", "offsets_cols", "smooth_cols"],
+            Variant::Notw => &["dv_reduce", "count", "blur_rows", "offsets_rows", "smooth_rows", "rebuild", "blur_cols", "offsets_cols", "smooth_cols"],
             Variant::Rtw => &["dv_reduce", "count", "rtw_collapse", "rtw_blur", "rtw_offsets"],
             Variant::Dv => &["dv_reduce"],
         };

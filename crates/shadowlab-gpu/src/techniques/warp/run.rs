@@ -122,11 +122,15 @@ impl Technique for Warped {
             gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
             match self.variant {
                 Variant::Notw => {
-                    self.prefix.encode(gpu, enc, &self.work, &self.fwork, ScanParams::rows(res, res));
+                    gpu.dispatch_2d(enc, "notw.blur_rows", self.pipeline("blur_rows"), &[&group], res, res);
+                    let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::rows(res, res) };
+                    self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
                     gpu.dispatch_2d(enc, "notw.offsets_rows", self.pipeline("offsets_rows"), &[&group], res, res);
                     gpu.dispatch_2d(enc, "notw.smooth_rows", self.pipeline("smooth_rows"), &[&group], res, res);
                     gpu.dispatch_2d(enc, "notw.rebuild", self.pipeline("rebuild"), &[&group], w, h);
-                    self.prefix.encode(gpu, enc, &self.work, &self.fwork, ScanParams { in_base: n, ..ScanParams::columns(res, res) });
+                    gpu.dispatch_2d(enc, "notw.blur_cols", self.pipeline("blur_cols"), &[&group], res, res);
+                    let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::columns(res, res) };
+                    self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
                     gpu.dispatch_2d(enc, "notw.offsets_cols", self.pipeline("offsets_cols"), &[&group], res, res);
                     gpu.dispatch_2d(enc, "notw.smooth_cols", self.pipeline("smooth_cols"), &[&group], res, res);
                 }

@@ -1,8 +1,8 @@
 // Adaptive subdivision against the bending of long warped edges (both seeds' limitation; wgpu
 // has no tessellation stage). A piece is a triangle index and three corners as barycentrics
-// (b1, b2) in unorm16x2. A piece needs splitting when one of its edges, followed through the
-// warp (a 4-piece polyline), is longer than the threshold in warped texels and it is in front
-// of the light and overlaps the cropped map. split_root sorts the scene's triangles: kept whole
+// (b1, b2) in unorm16x2. A piece needs splitting when the warp bends it by more than the
+// threshold: the distance, in warped texels, between the warped image of points on its edges
+// (and its centroid) and where linear rasterisation puts them. split_root sorts the scene's triangles: kept whole
 // in their own slot of `pieces`, or queued. Each split_level pass halves the queued pieces'
 // edges (4 children), appends the finished ones after the triangles and queues the rest
 // (queue in/out ping-pong, indirect dispatch). The last level finishes everything. Full
@@ -36,17 +36,19 @@ fn corner_pos(tri: u32, c: u32) -> vec3<f32> {
     return v0 + (vertices[3u * tri + 1u].pos - v0) * b.x + (vertices[3u * tri + 2u].pos - v0) * b.y;
 }
 
-fn edge_length(ma: vec2<f32>, mb: vec2<f32>) -> f32 {
-    var prev = warp(ma);
-    var len = 0.0;
-    for (var s = 1u; s <= 4u; s++) {
-        let q = warp(mix(ma, mb, f32(s) / 4.0));
-        len += distance(q, prev);
-        prev = q;
+// How far the warped edge strays from the straight line the rasteriser draws between its
+// warped ends (warped texels), sampled at 1/4, 1/2 and 3/4.
+fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32 {
+    var e = 0.0;
+    for (var s = 1u; s <= 3u; s++) {
+        let t = f32(s) / 4.0;
+        e = max(e, distance(warp(mix(ma, mb, t)), mix(wa, wb, t)));
     }
-    return len * wp.texel.z;
+    return e * wp.texel.z;
 }
 
+// A piece needs splitting when the warp bends it by more than the threshold (warped texels)
+// along an edge or at its centroid, it is in front of the light and overlaps the cropped map.
 fn needs_split(p: vec4<u32>) -> bool {
     let r = dv_rect();
     let a = base_clip(wp, corner_pos(p.x, p.y));
@@ -63,8 +65,12 @@ fn needs_split(p: vec4<u32>) -> bool {
     if any(hi < vec2<f32>(0.0)) || any(lo > vec2<f32>(1.0)) {
         return false;
     }
-    let len = max(max(edge_length(ua, ub), edge_length(ub, uc)), edge_length(uc, ua));
-    return len > wp.imp.w;
+    let wa = warp(ua);
+    let wb = warp(ub);
+    let wc = warp(uc);
+    let centre = distance(warp((ua + ub + uc) / 3.0), (wa + wb + wc) / 3.0) * wp.texel.z;
+    let e = max(max(edge_error(ua, ub, wa, wb), edge_error(ub, uc, wb, wc)), max(edge_error(uc, ua, wc, wa), centre));
+    return e > wp.imp.w;
 }
 
 fn finish(p: vec4<u32>) {
