@@ -164,9 +164,11 @@ pub struct Notw {
 /// NoTW on points in map coordinates: count map, row warps (smoothed over `window` rows
 /// weighted by their totals), the count map rebuilt through them, column warps (smoothed over
 /// `window` columns), the final warp of eq. 6 (`interp`: offsets interpolated between
-/// neighbouring functions). `blur` > 0 box-blurs the counts along each row (column) first.
-pub fn notw(points: &[[f32; 2]], res: usize, window: usize, interp: bool, blur_radius: usize) -> Notw {
-    let blur_rows = |v: Vec<f32>| -> Vec<f32> { v.chunks(res).flat_map(|r| blur(r, blur_radius)).collect() };
+/// neighbouring functions). `blur` > 0 box-blurs the counts along each row (column) first;
+/// `mix` adds a uniform floor of `mix` x the mean count per texel (points / res^2) to each.
+pub fn notw(points: &[[f32; 2]], res: usize, window: usize, interp: bool, blur_radius: usize, mix: f32) -> Notw {
+    let floor = mix * points.len() as f32 / (res * res) as f32;
+    let blur_rows = |v: Vec<f32>| -> Vec<f32> { v.chunks(res).flat_map(|r| blur(r, blur_radius)).map(|c| c + floor).collect() };
     let counts = count_map(points, res, None);
     let cf = blur_rows(counts.iter().map(|&c| c as f32).collect());
     let ox = row_warps(&cf, res, window);

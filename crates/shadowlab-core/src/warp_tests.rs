@@ -32,7 +32,7 @@ fn prefix_sum_by_hand() {
 #[test]
 fn uniform_samples_give_the_identity_warp() {
     let res = 32;
-    let n = notw(&uniform_points(res), res, 16, true, 0);
+    let n = notw(&uniform_points(res), res, 16, true, 0, 0.0);
     assert!(n.warp.ox.iter().chain(&n.warp.oy).all(|o| o.abs() < 1e-6));
     let w = rtw(&vec![1.0; res * res], res, 4);
     for s in 0..=100 {
@@ -97,7 +97,8 @@ fn random_warps_are_monotonic_and_onto() {
         })
         .collect();
     for (window, interp, blur) in [(0, false, 0), (4, true, 0), (16, true, 0), (16, false, 0), (16, true, 4)] {
-        let n = notw(&pts, res, window, interp, blur);
+        let mix = if blur > 0 { 0.5 } else { 0.0 };
+        let n = notw(&pts, res, window, interp, blur, mix);
         for i in 0..res {
             check_monotonic_onto(n.warp.row(i));
             check_monotonic_onto(&n.warp.column(i));
@@ -131,7 +132,7 @@ fn warping_evens_out_the_counts() {
     let mut seed = 3u64;
     let res = 64;
     let pts: Vec<[f32; 2]> = (0..200_000).map(|_| [0.3 + 0.4 * lcg(&mut seed), lcg(&mut seed).powi(3)]).collect();
-    let n = notw(&pts, res, 4, true, 0);
+    let n = notw(&pts, res, 4, true, 0, 0.0);
     let stats = |c: &[u32]| {
         let used: Vec<f64> = c.iter().filter(|&&v| v > 0).map(|&v| v as f64).collect();
         let m = used.iter().sum::<f64>() / used.len() as f64;
@@ -152,7 +153,7 @@ fn the_final_warp_follows_equation_6() {
     let res = 8;
     let mut seed = 11u64;
     let pts: Vec<[f32; 2]> = (0..3000).map(|_| [lcg(&mut seed).powi(2), lcg(&mut seed)]).collect();
-    let n = notw(&pts, res, 2, false, 0);
+    let n = notw(&pts, res, 2, false, 0, 0.0);
     let (x, y) = (0.37f32, 0.81f32);
     let i = (y * res as f32) as usize;
     let xw = x + eval_offset(n.warp.row(i), x);
@@ -160,7 +161,7 @@ fn the_final_warp_follows_equation_6() {
     let yw = y + eval_offset(&n.warp.column(j), y);
     assert_eq!(n.warp.apply(x, y), (xw, yw));
     // the column functions were built from the counts rebuilt through the row warps
-    let again = notw(&pts, res, 2, false, 0);
+    let again = notw(&pts, res, 2, false, 0, 0.0);
     assert_eq!(again.counts_rows, count_map(&pts, res, Some((&n.warp, false))));
 }
 
@@ -199,7 +200,7 @@ fn interpolated_warp_is_continuous_across_rows() {
     let res = 16;
     let mut seed = 5u64;
     let pts: Vec<[f32; 2]> = (0..5000).map(|_| [lcg(&mut seed).powi(3), lcg(&mut seed)]).collect();
-    let n = notw(&pts, res, 0, true, 0);
+    let n = notw(&pts, res, 0, true, 0, 0.0);
     // crossing the boundary between rows 7 and 8 moves x' by (almost) nothing
     let (a, _) = n.warp.apply(0.4, 0.5 - 1e-5);
     let (b, _) = n.warp.apply(0.4, 0.5 + 1e-5);
@@ -208,7 +209,7 @@ fn interpolated_warp_is_continuous_across_rows() {
     let y = 7.5 / 16.0;
     assert!((n.warp.warp_x(0.4, y) - (0.4 + eval_offset(n.warp.row(7), 0.4))).abs() < 1e-6);
     // eq. 6 as printed jumps there
-    let e = notw(&pts, res, 0, false, 0);
+    let e = notw(&pts, res, 0, false, 0, 0.0);
     let (a, _) = e.warp.apply(0.4, 0.5 - 1e-5);
     let (b, _) = e.warp.apply(0.4, 0.5 + 1e-5);
     assert!((a - b).abs() > 1e-3, "rows 7 and 8 happen to agree: the test needs other points");

@@ -15,7 +15,7 @@
 @group(0) @binding(10) var warp_x_out: texture_storage_2d<r32float, write>;
 @group(0) @binding(11) var warp_y_out: texture_storage_2d<r32float, write>;
 
-var<workgroup> wg_bounds: array<atomic<u32>, 5>;
+var<workgroup> wg_bounds: array<atomic<u32>, 6>;
 
 fn res_u() -> u32 {
     return u32(wp.texel.z);
@@ -35,6 +35,7 @@ fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
         atomicStore(&wg_bounds[2], 0u);
         atomicStore(&wg_bounds[3], 0u);
         atomicStore(&wg_bounds[4], 0u);
+        atomicStore(&wg_bounds[5], 0u);
     }
     workgroupBarrier();
     var s: Sample;
@@ -46,6 +47,7 @@ fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
         atomicMax(&wg_bounds[2], f.x);
         atomicMax(&wg_bounds[3], f.y);
         atomicMax(&wg_bounds[4], bitcast<u32>(distance(s.p, frame.camera_pos.xyz)));
+        atomicAdd(&wg_bounds[5], 1u);
     }
     workgroupBarrier();
     if t == 0u {
@@ -54,6 +56,7 @@ fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
         atomicMax(&dv[2], atomicLoad(&wg_bounds[2]));
         atomicMax(&dv[3], atomicLoad(&wg_bounds[3]));
         atomicMax(&dv[4], atomicLoad(&wg_bounds[4]));
+        atomicAdd(&dv[5], atomicLoad(&wg_bounds[5]));
     }
 }
 
@@ -94,8 +97,9 @@ fn at(axis: u32, r: u32, k: u32) -> u32 {
     return select(k * w + r, r * w + k, axis == 0u);
 }
 
-// Box blur of the counts along each function (half-width imp.z; 0 copies), from work[src..]
-// into work[2n..] as f32 bits: without it the per-texel count noise puts a kink into the warp
+// Box blur of the counts along each function (half-width imp.z; 0 copies) plus a uniform
+// floor (`mix`, a fraction of the mean count per texel), from work[src..] into work[2n..] as
+// f32 bits. The floor bounds the magnification where a function has few samples; without it the per-texel count noise puts a kink into the warp
 // at every texel, which linear rasterisation cannot follow (docs/bench/warp.md).
 fn blur_along(axis: u32, src: u32, id: vec3<u32>) {
     let w = res_u();
@@ -111,7 +115,9 @@ fn blur_along(axis: u32, src: u32, id: vec3<u32>) {
     for (var j = a; j <= b; j++) {
         sum += f32(atomicLoad(&work[src + at(axis, r, j)]));
     }
-    atomicStore(&work[2u * w * w + at(axis, r, k)], bitcast<u32>(sum / f32(b - a + 1u)));
+    // plus the uniform floor: `mix` x the mean count per texel of the whole map
+    let floor_density = bitcast<f32>(wp.flags.y) * f32(atomicLoad(&dv[5])) / f32(w * w);
+    atomicStore(&work[2u * w * w + at(axis, r, k)], bitcast<u32>(sum / f32(b - a + 1u) + floor_density));
 }
 
 @compute @workgroup_size(8, 8)

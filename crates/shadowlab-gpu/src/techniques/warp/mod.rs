@@ -65,6 +65,8 @@ pub const DEFAULT_WINDOW: f64 = 16.0;
 pub const DEFAULT_BLUR: f64 = 8.0;
 /// NoTW blur of the counts along each function (half-width, texels); 0 = as the seeds.
 pub const DEFAULT_NOTW_BLUR: f64 = 0.0;
+/// NoTW uniform floor (fraction of the mean count per texel); 0 = as the seeds.
+pub const DEFAULT_MIX: f64 = 0.0;
 /// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
 /// texels); 0 = off. See docs/bench/warp.md.
 pub const DEFAULT_SUBDIV: f64 = 0.0;
@@ -107,6 +109,15 @@ const NOTW_BLUR: ParamDef = p(
     "NoTW box blur half-width of the counts along each row/column before the prefix sums; 0 = the seeds' method; low: a kink per texel that subdivision must follow, high: less even sampling",
     "shadowlab measurement (docs/bench/warp.md)",
 );
+const MIX: ParamDef = p(
+    "mix",
+    DEFAULT_MIX,
+    0.0,
+    100.0,
+    false,
+    "NoTW uniform floor added to every texel's count, as a fraction of the mean count per texel; 0 = the seeds' method; low: rows with few samples warp wildly (extreme magnification, folds), high: the warp fades to the identity",
+    "shadowlab measurement (docs/bench/warp.md)",
+);
 const W_DV: ParamDef = p("w_dv", 1.0, 0.0, 100.0, false, "RTW desired-view importance (every sampled texel)", "GUIDE: importance = DV mask + (maxDistance - distance)");
 const W_EYE: ParamDef = p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
 const SUBDIV: ParamDef = p(
@@ -138,7 +149,7 @@ const SUBDIV_LEVELS: ParamDef = p(
     "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
 );
 
-pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, NOTW_BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, NOTW_BLUR, MIX, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 pub const DV_PARAMS: &[ParamDef] = &[RES, INTERP, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 
@@ -285,7 +296,7 @@ impl Warped {
             cfg: [p.get("dv_margin") as f32, 1.0, (variant != Variant::Dv) as u32 as f32, window as f32],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
             ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
-            flags: [p.get_u32("interp"), 0, 0, 0],
+            flags: [p.get_u32("interp"), (opt("mix", 0.0) as f32).to_bits(), 0, 0],
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;

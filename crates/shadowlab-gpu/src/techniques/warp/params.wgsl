@@ -20,7 +20,8 @@ struct WarpParams {
     // x: triangles, y: max subdivision level, z: extra sub-triangle capacity, w: 1 = RTW importance
     ints: vec4<u32>,
     // x: 1 = offsets interpolated linearly between neighbouring functions (continuous warp),
-    // 0 = eq. 6 as printed (function floor(y w) / floor(x' w))
+    // 0 = eq. 6 as printed (function floor(y w) / floor(x' w)); y: NoTW uniform floor `mix`
+    // (f32 bits)
     flags: vec4<u32>,
 }
 
