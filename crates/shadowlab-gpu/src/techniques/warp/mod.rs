@@ -64,12 +64,21 @@ pub const DEFAULT_WINDOW: f64 = 16.0;
 /// RTW blur half-width (texels of the 1D importance): the same 16-wide window.
 pub const DEFAULT_BLUR: f64 = 8.0;
 /// NoTW blur of the counts along each function (half-width, texels); 0 = as the seeds.
-pub const DEFAULT_NOTW_BLUR: f64 = 0.0;
-/// NoTW uniform floor (fraction of the mean count per texel); 0 = as the seeds.
-pub const DEFAULT_MIX: f64 = 0.0;
+/// Measured on courtyard (512 map, 512x512 view, subdiv 2): 0 needs ~10 M subdivision pieces
+/// (per-texel kinks), 8 about 1.3 M with mix 2. Too high: the sampling evens out less.
+pub const DEFAULT_NOTW_BLUR: f64 = 8.0;
+/// NoTW uniform floor (fraction of the mean count per texel); 0 = as the seeds. Courtyard:
+/// 0.5 -> 2.9 % wrong, 2 -> 2.0 % (bias 0.5); too high: CV and used texels drift to plain sm's.
+pub const DEFAULT_MIX: f64 = 2.0;
+/// NoTW constant bias (warped texels): rasterised depth between subdivided vertices is off by
+/// up to the subdivision threshold; courtyard: 0.5 -> 2.0 %, 1.5 -> 1.26 %, 3 -> 1.06 % wrong.
+pub const DEFAULT_NOTW_BIAS: f64 = 3.0;
 /// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
-/// texels); 0 = off. See docs/bench/warp.md.
-pub const DEFAULT_SUBDIV: f64 = 0.0;
+/// texels); 0 = off. Courtyard 512 view: off -> 70 % wrong (rtw and notw: the floor is two
+/// triangles); rtw 1 -> 0.60 % with 23 k pieces; notw 2 -> 2.0 % with 1.3 M pieces. Lower:
+/// more pieces (time, capacity), higher: bent depth. See docs/bench/warp.md.
+pub const DEFAULT_SUBDIV: f64 = 1.0;
+pub const DEFAULT_NOTW_SUBDIV: f64 = 2.0;
 /// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
 /// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
 /// tessellation factor of 16 (4 levels); measured too few for the big floor triangles here.
@@ -120,6 +129,12 @@ const MIX: ParamDef = p(
 );
 const W_DV: ParamDef = p("w_dv", 1.0, 0.0, 100.0, false, "RTW desired-view importance (every sampled texel)", "GUIDE: importance = DV mask + (maxDistance - distance)");
 const W_EYE: ParamDef = p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
+const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
+const NOTW_BIASP: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_BIAS,
+    source: "shadowlab courtyard sweep 0.5/1.5/3 (docs/bench/warp.md)",
+    ..BIAS
+};
 const SUBDIV: ParamDef = p(
     "subdiv",
     DEFAULT_SUBDIV,
@@ -149,9 +164,9 @@ const SUBDIV_LEVELS: ParamDef = p(
     "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
 );
 
-pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, NOTW_BLUR, MIX, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, NOTW_BLUR, MIX, INTERP, NOTW_SUBDIV, SUBDIV_LEVELS, PCF, NOTW_BIASP, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
-pub const DV_PARAMS: &[ParamDef] = &[RES, INTERP, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 
 const LIGHTS: &[&str] = &["directional", "spot"];
 
@@ -296,7 +311,7 @@ impl Warped {
             cfg: [p.get("dv_margin") as f32, 1.0, (variant != Variant::Dv) as u32 as f32, window as f32],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
             ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
-            flags: [p.get_u32("interp"), (opt("mix", 0.0) as f32).to_bits(), 0, 0],
+            flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), 0, 0],
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;
