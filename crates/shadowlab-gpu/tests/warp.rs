@@ -191,7 +191,12 @@ fn warping_evens_out_the_samples_on_courtyard() {
     let notw = lab.run(&v, &TechniqueSpec::parse("notw").unwrap(), 1).unwrap();
     let s = notw.report.sampling.unwrap();
     // the targets: CV at most half of sm's, used texels at least doubled
-    assert!(s.samples_per_used_texel_cv <= 0.5 * sm.samples_per_used_texel_cv, "CV {} vs sm {}", s.samples_per_used_texel_cv, sm.samples_per_used_texel_cv);
+    assert!(
+        s.samples_per_used_texel_cv <= 0.5 * sm.samples_per_used_texel_cv,
+        "CV {} vs sm {}",
+        s.samples_per_used_texel_cv,
+        sm.samples_per_used_texel_cv
+    );
     assert!(s.used_texel_fraction >= 2.0 * sm.used_texel_fraction, "used {} vs sm {}", s.used_texel_fraction, sm.used_texel_fraction);
     assert_eq!(notw.report.shadow_data_bytes, 512 * 512 * 4 + 8 * 512 * 512 + 32);
     let names: Vec<&str> = notw.report.images.iter().map(|i| i.name.as_str()).collect();

@@ -15,12 +15,15 @@
 //! CPU reference of the math is `shadowlab_core::warp`. Stored depth: post-projective, 0 = near
 //! the light (orthographic: linear), as in `sm`.
 
+mod params;
 mod run;
+
+pub use params::*;
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::ParamValues;
 
 use crate::prefix_sum::PrefixSum;
 use crate::scene_gpu::GpuScene;
@@ -56,117 +59,6 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("warp/eval.wgsl", eval_src()),
     ]
 }
-
-/// Smoothing window (functions averaged: [i - window/2, i + window/2]). 16 is the authors'
-/// public code (GUIDE). Too low: neighbouring rows warp differently and long triangles bend
-/// (wrong pixels along edges); too high: the warp tends to RTW's rectilinear grid.
-pub const DEFAULT_WINDOW: f64 = 16.0;
-/// RTW blur half-width (texels of the 1D importance): the same 16-wide window.
-pub const DEFAULT_BLUR: f64 = 8.0;
-/// NoTW blur of the counts along each function (half-width, texels); 0 = as the seeds.
-/// Measured on courtyard (512 map, 512x512 view, subdiv 2): 0 needs ~10 M subdivision pieces
-/// (per-texel kinks), 8 about 1.3 M with mix 2. Too high: the sampling evens out less.
-pub const DEFAULT_NOTW_BLUR: f64 = 8.0;
-/// NoTW uniform floor (fraction of the mean count per texel); 0 = as the seeds. Courtyard:
-/// 0.5 -> 2.9 % wrong, 2 -> 2.0 % (bias 0.5); too high: CV and used texels drift to plain sm's.
-pub const DEFAULT_MIX: f64 = 2.0;
-/// NoTW constant bias (warped texels): rasterised depth between subdivided vertices is off by
-/// up to the subdivision threshold; courtyard: 0.5 -> 2.0 %, 1.5 -> 1.26 %, 3 -> 1.06 % wrong.
-pub const DEFAULT_NOTW_BIAS: f64 = 3.0;
-/// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
-/// texels); 0 = off. Courtyard 512 view: off -> 70 % wrong (rtw and notw: the floor is two
-/// triangles); rtw 1 -> 0.60 % with 23 k pieces; notw 2 -> 2.0 % with 1.3 M pieces. Lower:
-/// more pieces (time, capacity), higher: bent depth. See docs/bench/warp.md.
-pub const DEFAULT_SUBDIV: f64 = 1.0;
-pub const DEFAULT_NOTW_SUBDIV: f64 = 2.0;
-/// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
-/// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
-/// tessellation factor of 16 (4 levels); measured too few for the big floor triangles here.
-pub const DEFAULT_SUBDIV_LEVELS: f64 = 10.0;
-/// Offsets interpolated between neighbouring functions (1) or eq. 6 as printed (0).
-pub const DEFAULT_INTERP: f64 = 1.0;
-/// DV margin (texels): samples moved by the bias offsets must stay inside the cropped map.
-pub const DEFAULT_DV_MARGIN: f64 = 2.0;
-
-const fn p(key: &'static str, default: f64, min: f64, max: f64, integer: bool, doc: &'static str, source: &'static str) -> ParamDef {
-    ParamDef { key, default, min, max, integer, doc, source, choices: &[] }
-}
-
-const RES: ParamDef = p("res", 512.0, 16.0, 8192.0, true, "shadow map side (texels); warps are res x res", "seeds 000/002 evaluation: 512 with 1024x1024 output");
-const PCF: ParamDef = p("pcf", 1.0, 1.0, 7.0, true, "PCF kernel width N in warped texels; 1 = hard test", "Reeves et al. 1987");
-const BIAS: ParamDef = p("bias", 0.5, 0.0, 100.0, false, "constant depth bias, warped texels; low: acne, high: peter-panning", "as sm (shadowlab sweep 2026-11-22)");
-const SLOPE: ParamDef = p("slope_bias", 0.0, 0.0, 100.0, false, "slope-scaled bias, warped texels x tan(angle)", "as sm: 0 (normal offset covers slopes)");
-const MAX_SLOPE: ParamDef = p("max_slope", 4.0, 0.0, 1000.0, false, "clamp on tan(angle to light) for slope and PCF bias", "as sm");
-const NORMAL_OFFSET: ParamDef = p(
-    "normal_offset",
-    0.5,
-    0.0,
-    100.0,
-    false,
-    "offset along the normal in warped texels (local size from the warp's Jacobian); low: acne, high: shifted shadows",
-    "Holbert 2011; value as sm",
-);
-const DV_MARGIN: ParamDef = p("dv_margin", DEFAULT_DV_MARGIN, 0.0, 64.0, false, "texels added around the desired view; low: biased samples fall outside (lit)", "shadowlab: covers bias + normal offset");
-const WINDOW: ParamDef = p("window", DEFAULT_WINDOW, 0.0, 1024.0, true, "NoTW smoothing window across rows/columns; low: bent edges, high: RTW-like", "authors' public code (GUIDE)");
-const BLUR: ParamDef = p("blur", DEFAULT_BLUR, 0.0, 512.0, true, "RTW blur half-width of the 1D importance; low: abrupt warps, high: flat warps", "window 16 (GUIDE)");
-const NOTW_BLUR: ParamDef = p(
-    "blur",
-    DEFAULT_NOTW_BLUR,
-    0.0,
-    512.0,
-    true,
-    "NoTW box blur half-width of the counts along each row/column before the prefix sums; 0 = the seeds' method; low: a kink per texel that subdivision must follow, high: less even sampling",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-const MIX: ParamDef = p(
-    "mix",
-    DEFAULT_MIX,
-    0.0,
-    100.0,
-    false,
-    "NoTW uniform floor added to every texel's count, as a fraction of the mean count per texel; 0 = the seeds' method; low: rows with few samples warp wildly (extreme magnification, folds), high: the warp fades to the identity",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-const W_DV: ParamDef = p("w_dv", 1.0, 0.0, 100.0, false, "RTW desired-view importance (every sampled texel)", "GUIDE: importance = DV mask + (maxDistance - distance)");
-const W_EYE: ParamDef = p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
-const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
-const NOTW_BIASP: ParamDef = ParamDef {
-    default: DEFAULT_NOTW_BIAS,
-    source: "shadowlab courtyard sweep 0.5/1.5/3 (docs/bench/warp.md)",
-    ..BIAS
-};
-const SUBDIV: ParamDef = p(
-    "subdiv",
-    DEFAULT_SUBDIV,
-    0.0,
-    1024.0,
-    false,
-    "split triangles until the warp bends no edge (or centroid) by more than this many warped texels from the rasterised line; 0 = off; low: many pieces, high: bent edges",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-const INTERP: ParamDef = ParamDef {
-    key: "interp",
-    default: DEFAULT_INTERP,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "interpolate offsets between neighbouring row/column functions (a continuous warp); false = eq. 6 as printed (one function per texel row: a sub-triangle crossing rows is rasterised across an offset jump)",
-    source: "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard",
-    choices: shadowlab_core::params::BOOL,
-};
-const SUBDIV_LEVELS: ParamDef = p(
-    "subdiv_levels",
-    DEFAULT_SUBDIV_LEVELS,
-    1.0,
-    15.0,
-    true,
-    "max edge halvings per triangle (4^levels pieces); low: big triangles stay bent",
-    "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
-);
-
-pub const NOTW_PARAMS: &[ParamDef] = &[RES, WINDOW, NOTW_BLUR, MIX, INTERP, NOTW_SUBDIV, SUBDIV_LEVELS, PCF, NOTW_BIASP, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
-pub const RTW_PARAMS: &[ParamDef] = &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
-pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 
 const LIGHTS: &[&str] = &["directional", "spot"];
 
@@ -291,8 +183,9 @@ impl Warped {
         let name = variant.name();
         let res = p.get_u32("res");
         gpu.check_size(res, res, "shadow map")?;
-        let lp = lightspace::fit(light, &scene.bounds, res)
-            .ok_or_else(|| GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)")))?;
+        let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
+            GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
+        })?;
         let opt = |k: &str, d: f64| if p.0.contains_key(k) { p.get(k) } else { d };
         let window = opt("window", 0.0);
         if window >= res as f64 {
@@ -300,7 +193,7 @@ impl Warped {
         }
         let subdiv = opt("subdiv", 0.0) as f32;
         let tris = scene.triangle_count;
-        let limit = gpu.limits.max_storage_buffer_binding_size as u64 / 16;
+        let limit = gpu.limits.max_storage_buffer_binding_size / 16;
         let on = subdiv > 0.0 && variant != Variant::Dv;
         let extra = if on { (8 * tris as u64).max(1 << 21).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
         let queue = if on { (tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
@@ -344,9 +237,8 @@ impl Warped {
             mapped_at_creation: false,
         });
         let levels = params.ints[1];
-        let level_uniforms = (1..=levels)
-            .map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue]))
-            .collect();
+        let level_uniforms =
+            (1..=levels).map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue])).collect();
         let ro = binding::storage(true);
         let rw = binding::storage(false);
         let tex = binding::texture_float();
@@ -358,14 +250,18 @@ impl Warped {
         let analyze_layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store]);
         let src = analyze_src();
         let entries: &[&str] = match variant {
-            Variant::Notw => &["dv_reduce", "count", "blur_rows", "offsets_rows", "smooth_rows", "rebuild", "blur_cols", "offsets_cols", "smooth_cols"],
+            Variant::Notw => {
+                &["dv_reduce", "count", "blur_rows", "offsets_rows", "smooth_rows", "rebuild", "blur_cols", "offsets_cols", "smooth_cols"]
+            }
             Variant::Rtw => &["dv_reduce", "count", "rtw_collapse", "rtw_blur", "rtw_offsets"],
             Variant::Dv => &["dv_reduce"],
         };
         let analyze = entries.iter().map(|&e| (e, gpu.compute_pipeline(&format!("{name}.{e}"), &src, e, &[&analyze_layout]))).collect();
         let look = [(6, binding::uniform()), (7, ro), (8, tex), (9, tex)];
-        let lookup_layout = layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX, &[look[0], look[1], look[2], look[3], (10, ro)]);
-        let depth_pipeline = raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(), &[&lookup_layout, &scene.layout], &[]);
+        let lookup_layout =
+            layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX, &[look[0], look[1], look[2], look[3], (10, ro)]);
+        let depth_pipeline =
+            raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(), &[&lookup_layout, &scene.layout], &[]);
         let split_layout = layout_at(
             gpu,
             &format!("{name}.subdivide"),

@@ -78,7 +78,14 @@ impl Warped {
     pub fn read_warp(&self, gpu: &Gpu) -> Warp2D {
         let ox: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.warp_x, 4));
         let oy: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.warp_y, 4));
-        Warp2D { res: self.res as usize, rows_x: self.warp_x.height() as usize, cols_y: self.warp_y.width() as usize, ox, oy, interp: self.params.flags[0] != 0 }
+        Warp2D {
+            res: self.res as usize,
+            rows_x: self.warp_x.height() as usize,
+            cols_y: self.warp_y.width() as usize,
+            ox,
+            oy,
+            interp: self.params.flags[0] != 0,
+        }
     }
 
     /// Bytes of the warps kept per light.
@@ -182,7 +189,8 @@ impl Technique for Warped {
             timer.stage(gpu, &format!("{name}.subdivide"), |enc| {
                 enc.clear_buffer(&self.counters, 0, None);
                 let pass = |enc: &mut wgpu::CommandEncoder, g: &wgpu::BindGroup, p: usize, groups: Option<u32>| {
-                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
+                    let mut pass =
+                        enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
                     pass.set_bind_group(1, &f.scene.group, &[]);
                     pass.set_bind_group(0, g, &[]);
                     pass.set_pipeline(&self.split[p]);
@@ -249,7 +257,10 @@ impl Technique for Warped {
         c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
         c.insert("shadow_map_texels".into(), n as f64);
         c.insert("warp_bytes".into(), self.warp_bytes() as f64);
-        c.insert("scratch_bytes".into(), (self.work.size() + self.fwork.size() + self.counts.size() + self.pieces.size() + 2 * self.queues[0].size()) as f64);
+        c.insert(
+            "scratch_bytes".into(),
+            (self.work.size() + self.fwork.size() + self.counts.size() + self.pieces.size() + 2 * self.queues[0].size()) as f64,
+        );
         let dv = self.read_dv_rect(gpu);
         c.insert("dv_area_fraction".into(), ((dv[2] - dv[0]) * (dv[3] - dv[1])) as f64);
         if self.params.imp[3] > 0.0 {
