@@ -201,7 +201,7 @@ impl Warped {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
             texel: [lp.texel, lp.perspective as u32 as f32, res as f32, p.get("pcf") as f32],
             bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
-            cfg: [p.get("dv_margin") as f32, 1.0, (variant != Variant::Dv) as u32 as f32, window as f32],
+            cfg: [p.get("dv_margin") as f32, 1.0 + opt("close_cracks", 0.0) as f32, (variant != Variant::Dv) as u32 as f32, window as f32],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
             ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
             flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), 0, 0],

@@ -157,8 +157,35 @@ const SUBDIV_LEVELS: ParamDef = p(
     "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
 );
 
-pub const NOTW_PARAMS: &[ParamDef] =
-    &[RES, WINDOW, NOTW_BLUR, MIX, INTERP, NOTW_SUBDIV, SUBDIV_LEVELS, PCF, NOTW_BIASP, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+/// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.
+pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
+pub const CLOSE_CRACKS: ParamDef = ParamDef {
+    key: "close_cracks",
+    default: DEFAULT_CLOSE_CRACKS,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap",
+    source: "shadowlab measurement (docs/bench/warp.md)",
+    choices: shadowlab_core::params::BOOL,
+};
+
+pub const NOTW_PARAMS: &[ParamDef] = &[
+    RES,
+    WINDOW,
+    NOTW_BLUR,
+    MIX,
+    INTERP,
+    NOTW_SUBDIV,
+    SUBDIV_LEVELS,
+    CLOSE_CRACKS,
+    PCF,
+    NOTW_BIASP,
+    SLOPE,
+    MAX_SLOPE,
+    NORMAL_OFFSET,
+    DV_MARGIN,
+];
 pub const RTW_PARAMS: &[ParamDef] =
-    &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+    &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, CLOSE_CRACKS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
 pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];

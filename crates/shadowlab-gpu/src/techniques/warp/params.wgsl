@@ -12,7 +12,8 @@ struct WarpParams {
     texel: vec4<f32>,
     // x: constant bias, y: slope-scaled bias, z: normal offset (all in warped texels), w: max slope
     bias: vec4<f32>,
-    // x: DV margin (texels), y: DV on, z: warp on, w: smoothing window (functions)
+    // x: DV margin (texels), y: DV on (1; 2: DV on and cracks closed by a 3x3 depth minimum),
+    // z: warp on, w: smoothing window (functions)
     cfg: vec4<f32>,
     // x: RTW desired-view weight, y: RTW distance-to-eye weight, z: RTW blur radius, w: subdiv
     // threshold (warped texels per edge)

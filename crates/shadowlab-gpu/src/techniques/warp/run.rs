@@ -254,7 +254,8 @@ impl Technique for Warped {
             ..Default::default()
         };
         let c = &mut r.counters;
-        c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
+        let per_tap = if self.params.cfg[1] > 1.5 { 9.0 } else { 1.0 };
+        c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64 * per_tap);
         c.insert("shadow_map_texels".into(), n as f64);
         c.insert("warp_bytes".into(), self.warp_bytes() as f64);
         c.insert(
