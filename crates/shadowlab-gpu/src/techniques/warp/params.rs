@@ -17,13 +17,17 @@ pub const DEFAULT_NOTW_BLUR: f64 = 8.0;
 /// 0.5 -> 2.9 % wrong, 2 -> 2.0 % (bias 0.5); too high: CV and used texels drift to plain sm's.
 pub const DEFAULT_MIX: f64 = 2.0;
 /// NoTW constant bias (warped texels): rasterised depth between subdivided vertices is off by
-/// up to the subdivision threshold; courtyard: 0.5 -> 2.0 %, 1.5 -> 1.26 %, 3 -> 1.06 % wrong.
-pub const DEFAULT_NOTW_BIAS: f64 = 3.0;
+/// up to the subdivision threshold. 512x512 views, crack-free subdivision: courtyard sun
+/// 1 -> 1.78 %, 1.5 -> 1.43, 2 -> 1.25, 3 -> 1.06; conference sun 1 -> 0.37, 1.5 -> 0.48,
+/// 2 -> 0.65, 3 -> 1.19 (leaks). 2 is the best sum.
+pub const DEFAULT_NOTW_BIAS: f64 = 2.0;
 /// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
 /// texels); 0 = off. Courtyard 512 view: off -> 70 % wrong (rtw and notw: the floor is two
-/// triangles); rtw 1 -> 0.60 % with 23 k pieces; notw 2 -> 2.0 % with 1.3 M pieces. Lower:
-/// more pieces (time, capacity), higher: bent depth. See docs/bench/warp.md.
+/// triangles); rtw 1 -> 0.58 % with 24 k pieces (crack-free subdivision); notw 2 -> 1.25 %
+/// with 0.3 M pieces. Lower: more pieces (time, capacity), higher: bent depth, more bias
+/// needed. See docs/bench/warp.md.
 pub const DEFAULT_SUBDIV: f64 = 1.0;
+/// NoTW's warp bends more (a function per row and column): 2 keeps the piece count near 0.3 M.
 pub const DEFAULT_NOTW_SUBDIV: f64 = 2.0;
 /// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
 /// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
@@ -127,7 +131,7 @@ const W_EYE: ParamDef =
     p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
 const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
 const NOTW_BIASP: ParamDef =
-    ParamDef { default: DEFAULT_NOTW_BIAS, source: "shadowlab courtyard sweep 0.5/1.5/3 (docs/bench/warp.md)", ..BIAS };
+    ParamDef { default: DEFAULT_NOTW_BIAS, source: "shadowlab sweep 1/1.5/2/3 on courtyard and conference (docs/bench/warp.md)", ..BIAS };
 const SUBDIV: ParamDef = p(
     "subdiv",
     DEFAULT_SUBDIV,

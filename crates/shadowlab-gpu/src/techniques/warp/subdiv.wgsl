@@ -171,43 +171,56 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
     let ab = pack_corner((corner(a) + corner(b)) / 2u);
     let bc = pack_corner((corner(b) + corner(c)) / 2u);
     let ca = pack_corner((corner(c) + corner(a)) / 2u);
+    // the children as corner triples (one place() loop: cheap on SIMD software rasterisers)
+    var kids: array<vec3<u32>, 4>;
+    var count = 0u;
     switch split_mask(p) {
         case 1u {
-            place(vec4<u32>(t, a, ab, c));
-            place(vec4<u32>(t, ab, b, c));
+            kids[0] = vec3<u32>(a, ab, c);
+            kids[1] = vec3<u32>(ab, b, c);
+            count = 2u;
         }
         case 2u {
-            place(vec4<u32>(t, a, b, bc));
-            place(vec4<u32>(t, a, bc, c));
+            kids[0] = vec3<u32>(a, b, bc);
+            kids[1] = vec3<u32>(a, bc, c);
+            count = 2u;
         }
         case 4u {
-            place(vec4<u32>(t, a, b, ca));
-            place(vec4<u32>(t, ca, b, c));
+            kids[0] = vec3<u32>(a, b, ca);
+            kids[1] = vec3<u32>(ca, b, c);
+            count = 2u;
         }
         case 3u {
-            place(vec4<u32>(t, ab, b, bc));
-            place(vec4<u32>(t, a, ab, bc));
-            place(vec4<u32>(t, a, bc, c));
+            kids[0] = vec3<u32>(ab, b, bc);
+            kids[1] = vec3<u32>(a, ab, bc);
+            kids[2] = vec3<u32>(a, bc, c);
+            count = 3u;
         }
         case 6u {
-            place(vec4<u32>(t, ca, bc, c));
-            place(vec4<u32>(t, a, b, bc));
-            place(vec4<u32>(t, a, bc, ca));
+            kids[0] = vec3<u32>(ca, bc, c);
+            kids[1] = vec3<u32>(a, b, bc);
+            kids[2] = vec3<u32>(a, bc, ca);
+            count = 3u;
         }
         case 5u {
-            place(vec4<u32>(t, a, ab, ca));
-            place(vec4<u32>(t, ab, b, c));
-            place(vec4<u32>(t, ab, c, ca));
+            kids[0] = vec3<u32>(a, ab, ca);
+            kids[1] = vec3<u32>(ab, b, c);
+            kids[2] = vec3<u32>(ab, c, ca);
+            count = 3u;
         }
         case 7u {
-            place(vec4<u32>(t, a, ab, ca));
-            place(vec4<u32>(t, ab, b, bc));
-            place(vec4<u32>(t, ca, bc, c));
-            place(vec4<u32>(t, ab, bc, ca));
+            kids[0] = vec3<u32>(a, ab, ca);
+            kids[1] = vec3<u32>(ab, b, bc);
+            kids[2] = vec3<u32>(ca, bc, c);
+            kids[3] = vec3<u32>(ab, bc, ca);
+            count = 4u;
         }
         default {
             finish(p);
         }
+    }
+    for (var i = 0u; i < count; i++) {
+        place(vec4<u32>(t, kids[i]));
     }
 }
 
