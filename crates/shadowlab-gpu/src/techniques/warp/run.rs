@@ -8,7 +8,7 @@ use crate::prefix_sum::ScanParams;
 use crate::techniques::sm::{count_image, depth_image};
 use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, raster, Gpu, GpuError};
+use crate::{raster, Gpu, GpuError};
 
 /// Signed picture of warp offsets (seed 000 Figure 4): yellow positive, blue negative, black 0.
 pub fn offset_image(name: &str, w: u32, h: u32, o: &[f32]) -> NamedImage {
@@ -300,7 +300,6 @@ impl Technique for Warped {
             r.images.push(offset_image("row warping functions o_x (row i, position x)", res, res, &full(w.rows_x, 1, &w.ox, true)));
             r.images.push(offset_image("column warping functions o_y (column j, position y)", res, res, &full(1, w.cols_y, &w.oy, false)));
         }
-        let _ = binding::uniform;
         r
     }
 }
