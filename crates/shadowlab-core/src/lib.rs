@@ -18,3 +18,4 @@ pub mod moments;
 pub mod params;
 pub mod scene;
 pub mod setup;
+pub mod warp;

@@ -57,6 +57,22 @@ pub struct Instance {
     pub setup_ms: f64,
 }
 
+impl View {
+    /// What a technique reads for this view of `scene` (for driving techniques directly).
+    pub fn inputs<'a>(&'a self, scene: &'a GpuScene) -> FrameInputs<'a> {
+        FrameInputs {
+            scene,
+            gbuffer: &self.gbuffer,
+            light: self.light,
+            camera: self.camera,
+            prev_camera: self.prev_camera,
+            light_buf: &self.light_buf,
+            frame: &self.frame,
+            visibility: &self.visibility,
+        }
+    }
+}
+
 /// The result of one technique on one view.
 pub struct Run {
     pub label: String,
@@ -157,16 +173,7 @@ impl<'a> Lab<'a> {
     /// once); then shades and reads back its visibility and report.
     pub fn step(&self, view: &View, inst: &mut Instance, warm_up: bool, repeat: usize) -> Result<Run, GpuError> {
         let gpu = self.gpu;
-        let inputs = FrameInputs {
-            scene: &self.gscene,
-            gbuffer: &view.gbuffer,
-            light: view.light,
-            camera: view.camera,
-            prev_camera: view.prev_camera,
-            light_buf: &view.light_buf,
-            frame: &view.frame,
-            visibility: &view.visibility,
-        };
+        let inputs = view.inputs(&self.gscene);
         let tech = inst.tech.as_mut();
         if warm_up {
             techniques::run_frame(tech, gpu, &inputs, &mut StageTimer::default())?;

@@ -11,6 +11,7 @@ pub mod context;
 pub mod frame;
 pub mod gbuffer;
 pub mod lab;
+pub mod prefix_sum;
 pub mod raster;
 pub mod reduce;
 pub mod reference;

@@ -22,6 +22,7 @@ pub fn all() -> Vec<(&'static str, String)> {
     v.extend(crate::shade::shaders());
     v.extend(crate::reduce::shaders());
     v.extend(crate::blur::shaders());
+    v.extend(crate::prefix_sum::shaders());
     v.extend(crate::techniques::shaders());
     v
 }

@@ -8,7 +8,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::techniques::mdsm::{MultiDepthMap, INFO};
-use shadowlab_gpu::techniques::{run_frame, FrameInputs};
+use shadowlab_gpu::techniques::run_frame;
 use shadowlab_gpu::timing::StageTimer;
 use shadowlab_gpu::Gpu;
 
@@ -24,16 +24,7 @@ fn spec(s: &str) -> TechniqueSpec {
 fn run_direct(gpu: &Gpu, lab: &Lab, v: &View, args: &str) -> (MultiDepthMap, Vec<f32>) {
     let params = spec(&format!("mdsm:{args}")).resolve(INFO.params).unwrap();
     let mut t = MultiDepthMap::new(gpu, &lab.gscene, &params, &v.light).unwrap();
-    let inputs = FrameInputs {
-        scene: &lab.gscene,
-        gbuffer: &v.gbuffer,
-        light: v.light,
-        camera: v.camera,
-        prev_camera: v.prev_camera,
-        light_buf: &v.light_buf,
-        frame: &v.frame,
-        visibility: &v.visibility,
-    };
+    let inputs = v.inputs(&lab.gscene);
     run_frame(&mut t, gpu, &inputs, &mut StageTimer::default()).unwrap();
     gpu.take_error().unwrap();
     let vis = gpu.read_buffer_as(&v.visibility, v.gbuffer.pixels());

@@ -249,3 +249,38 @@ fn min_sm_reduce_layout_matches_rust() {
         &[("mode", offset_of!(MsfReduce, mode)), ("prev", offset_of!(MsfReduce, prev))],
     );
 }
+
+#[test]
+fn warp_struct_layouts_match_rust() {
+    use shadowlab_gpu::prefix_sum::ScanParams;
+    use shadowlab_gpu::techniques::warp::WarpParams;
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl"] {
+        check(
+            &get(w),
+            "WarpParams",
+            size_of::<WarpParams>(),
+            &[
+                ("texel", offset_of!(WarpParams, texel)),
+                ("bias", offset_of!(WarpParams, bias)),
+                ("cfg", offset_of!(WarpParams, cfg)),
+                ("imp", offset_of!(WarpParams, imp)),
+                ("ints", offset_of!(WarpParams, ints)),
+                ("flags", offset_of!(WarpParams, flags)),
+            ],
+        );
+    }
+    check(
+        &get("prefix_sum/scan.wgsl"),
+        "ScanParams",
+        size_of::<ScanParams>(),
+        &[
+            ("len", offset_of!(ScanParams, len)),
+            ("elem_step", offset_of!(ScanParams, elem_step)),
+            ("in_base", offset_of!(ScanParams, in_base)),
+            ("out_base", offset_of!(ScanParams, out_base)),
+            ("input_f32", offset_of!(ScanParams, input_f32)),
+        ],
+    );
+}

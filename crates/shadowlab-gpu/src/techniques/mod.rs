@@ -8,6 +8,7 @@ pub mod mdsm;
 pub mod min_sm;
 pub mod sm;
 pub mod sv;
+pub mod warp;
 
 use std::collections::BTreeMap;
 
@@ -140,6 +141,9 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &crate::reference::INFO,
     &sm::INFO,
     &sv::INFO,
+    &warp::RTW_INFO,
+    &warp::NOTW_INFO,
+    &warp::DV_INFO,
     &min_sm::INFO,
     &mdsm::INFO,
     &filtered::VSM_INFO,
@@ -160,6 +164,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(iasm::shaders());
     v.extend(filtered::shaders());
     v.extend(min_sm::shaders());
+    v.extend(warp::shaders());
     v
 }
 

@@ -1,0 +1,297 @@
+// Building the warp from the view samples (seed 000 section 3, steps 2-7; RTW: seed 002
+// Algorithm 1). Entry points run in this order: dv_reduce, count, then for NoTW blur_rows,
+// (prefix sums of the rows) offsets_rows, smooth_rows, rebuild, blur_cols, (column prefix
+// sums) offsets_cols, smooth_cols; for RTW rtw_collapse, rtw_blur, (prefix sums) rtw_offsets.
+//
+// work (u32): counts [0,n) | counts rebuilt through the row warps [n,2n) | RTW importance or
+// NoTW blurred counts as f32 bits [2n,3n) | blurred 1D importance as f32 bits [3n,3n+2w).  fwork (f32): prefix sums [0,n) |
+// unsmoothed offsets [n,2n) | smoothed row offsets [2n,3n) | totals [3n,3n+w) | collapsed
+// importance [3n+w,3n+3w).  n = w*w.
+
+@group(0) @binding(6) var<uniform> wp: WarpParams;
+@group(0) @binding(7) var<storage, read_write> dv: array<atomic<u32>, 8>;
+@group(0) @binding(8) var<storage, read_write> work: array<atomic<u32>>;
+@group(0) @binding(9) var<storage, read_write> fwork: array<f32>;
+@group(0) @binding(10) var warp_x_out: texture_storage_2d<r32float, write>;
+@group(0) @binding(11) var warp_y_out: texture_storage_2d<r32float, write>;
+
+var<workgroup> wg_bounds: array<atomic<u32>, 6>;
+
+fn res_u() -> u32 {
+    return u32(wp.texel.z);
+}
+
+fn dv_now() -> vec4<f32> {
+    return dv_from_bounds(wp, vec4<u32>(atomicLoad(&dv[0]), atomicLoad(&dv[1]), atomicLoad(&dv[2]), atomicLoad(&dv[3])));
+}
+
+// DV: parallel min/max of the samples' map coordinates (fixed point), per workgroup in shared
+// memory, then one global atomic per workgroup; also the largest eye distance (RTW).
+@compute @workgroup_size(8, 8)
+fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) t: u32) {
+    if t == 0u {
+        atomicStore(&wg_bounds[0], 0xffffffffu);
+        atomicStore(&wg_bounds[1], 0xffffffffu);
+        atomicStore(&wg_bounds[2], 0u);
+        atomicStore(&wg_bounds[3], 0u);
+        atomicStore(&wg_bounds[4], 0u);
+        atomicStore(&wg_bounds[5], 0u);
+    }
+    workgroupBarrier();
+    var s: Sample;
+    if load_sample(id, &s) {
+        let m = clamp(clip_to_map(base_clip(wp, s.p)).xy, vec2<f32>(0.0), vec2<f32>(1.0));
+        let f = vec2<u32>(min(m * DV_SCALE, vec2<f32>(DV_SCALE)));
+        atomicMin(&wg_bounds[0], f.x);
+        atomicMin(&wg_bounds[1], f.y);
+        atomicMax(&wg_bounds[2], f.x);
+        atomicMax(&wg_bounds[3], f.y);
+        atomicMax(&wg_bounds[4], bitcast<u32>(distance(s.p, frame.camera_pos.xyz)));
+        atomicAdd(&wg_bounds[5], 1u);
+    }
+    workgroupBarrier();
+    if t == 0u {
+        atomicMin(&dv[0], atomicLoad(&wg_bounds[0]));
+        atomicMin(&dv[1], atomicLoad(&wg_bounds[1]));
+        atomicMax(&dv[2], atomicLoad(&wg_bounds[2]));
+        atomicMax(&dv[3], atomicLoad(&wg_bounds[3]));
+        atomicMax(&dv[4], atomicLoad(&wg_bounds[4]));
+        atomicAdd(&dv[5], atomicLoad(&wg_bounds[5]));
+    }
+}
+
+fn sample_dv(p: vec3<f32>) -> vec2<f32> {
+    let r = dv_now();
+    return (clip_to_map(base_clip(wp, p)).xy - r.xy) / (r.zw - r.xy);
+}
+
+fn inside(u: vec2<f32>) -> bool {
+    return all(u >= vec2<f32>(0.0)) && all(u < vec2<f32>(1.0));
+}
+
+// Count map (NoTW importance) by atomic adds; RTW: importance map, maximum per texel.
+@compute @workgroup_size(8, 8)
+fn count(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let u = sample_dv(s.p);
+    if !inside(u) {
+        return;
+    }
+    let w = res_u();
+    let t = texel_of(u.y, w) * w + texel_of(u.x, w);
+    atomicAdd(&work[t], 1u);
+    if wp.ints.w != 0u {
+        let maxd = bitcast<f32>(atomicLoad(&dv[4]));
+        let d = distance(s.p, frame.camera_pos.xyz);
+        let imp = wp.imp.x + wp.imp.y * clamp((maxd - d) / max(maxd, 1e-20), 0.0, 1.0);
+        atomicMax(&work[2u * w * w + t], bitcast<u32>(imp));
+    }
+}
+
+// Index of edge k of function r: rows (axis 0) are row-major, columns (axis 1) column-major.
+fn at(axis: u32, r: u32, k: u32) -> u32 {
+    let w = res_u();
+    return select(k * w + r, r * w + k, axis == 0u);
+}
+
+// Box blur of the counts along each function (half-width imp.z; 0 copies) plus a uniform
+// floor (`mix`, a fraction of the mean count per texel), from work[src..] into work[2n..] as
+// f32 bits. The floor bounds the magnification where a function has few samples; without it the per-texel count noise puts a kink into the warp
+// at every texel, which linear rasterisation cannot follow (docs/bench/warp.md).
+fn blur_along(axis: u32, src: u32, id: vec3<u32>) {
+    let w = res_u();
+    let k = id.x;
+    let r = id.y;
+    if k >= w || r >= w {
+        return;
+    }
+    let rad = u32(wp.imp.z);
+    let a = u32(max(i32(k) - i32(rad), 0));
+    let b = min(k + rad, w - 1u);
+    var sum = 0.0;
+    for (var j = a; j <= b; j++) {
+        sum += f32(atomicLoad(&work[src + at(axis, r, j)]));
+    }
+    // plus the uniform floor: `mix` x the mean count per texel of the whole map
+    let floor_density = bitcast<f32>(wp.flags.y) * f32(atomicLoad(&dv[5])) / f32(w * w);
+    atomicStore(&work[2u * w * w + at(axis, r, k)], bitcast<u32>(sum / f32(b - a + 1u) + floor_density));
+}
+
+@compute @workgroup_size(8, 8)
+fn blur_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    blur_along(0u, 0u, id);
+}
+
+@compute @workgroup_size(8, 8)
+fn blur_cols(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = res_u();
+    blur_along(1u, w * w, id);
+}
+
+// Eq. 4 at the right texel edges: o = g / N - x; identity for empty functions.
+fn offsets(axis: u32, id: vec3<u32>) {
+    let w = res_u();
+    let k = id.x;
+    let r = id.y;
+    if k >= w || r >= w {
+        return;
+    }
+    let n = w * w;
+    let total = fwork[at(axis, r, w - 1u)];
+    var o = 0.0;
+    if total > 0.0 {
+        o = fwork[at(axis, r, k)] / total - f32(k + 1u) / f32(w);
+    }
+    fwork[n + at(axis, r, k)] = o;
+    if k == 0u {
+        fwork[3u * n + r] = total;
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn offsets_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    offsets(0u, id);
+}
+
+@compute @workgroup_size(8, 8)
+fn offsets_cols(@builtin(global_invocation_id) id: vec3<u32>) {
+    offsets(1u, id);
+}
+
+// Smoothing across neighbouring functions: the average over [r - window/2, r + window/2]
+// weighted by their sample totals (seed 000 Figure 4).
+fn smoothed(axis: u32, r: u32, k: u32) -> f32 {
+    let w = res_u();
+    let n = w * w;
+    let half = u32(wp.cfg.w) / 2u;
+    let a = max(i32(r) - i32(half), 0);
+    let b = min(r + half, w - 1u);
+    var num = 0.0;
+    var den = 0.0;
+    for (var j = u32(a); j <= b; j++) {
+        let tj = fwork[3u * n + j];
+        num += tj * fwork[n + at(axis, j, k)];
+        den += tj;
+    }
+    return select(0.0, num / den, den > 0.0);
+}
+
+@compute @workgroup_size(8, 8)
+fn smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = res_u();
+    if id.x >= w || id.y >= w {
+        return;
+    }
+    let o = smoothed(0u, id.y, id.x);
+    fwork[2u * w * w + id.y * w + id.x] = o;
+    textureStore(warp_x_out, id.xy, vec4<f32>(o, 0.0, 0.0, 0.0));
+}
+
+@compute @workgroup_size(8, 8)
+fn smooth_cols(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = res_u();
+    if id.x >= w || id.y >= w {
+        return;
+    }
+    // id.y = column, id.x = edge: stored as an image, (column, edge)
+    textureStore(warp_y_out, vec2<u32>(id.y, id.x), vec4<f32>(smoothed(1u, id.y, id.x), 0.0, 0.0, 0.0));
+}
+
+// o_x^(i)(x) from the smoothed row offsets in fwork.
+fn row_offset(i: u32, x: f32) -> f32 {
+    let w = res_u();
+    if x < 0.0 || x >= 1.0 {
+        return 0.0;
+    }
+    let sx = x * f32(w);
+    let k = min(u32(sx), w - 1u);
+    let row = 2u * w * w + i * w;
+    var left = 0.0;
+    if k > 0u {
+        left = fwork[row + k - 1u];
+    }
+    return edge_lerp(left, fwork[row + k], sx, k);
+}
+
+// The count map rebuilt through the smoothed row warps (step 6).
+@compute @workgroup_size(8, 8)
+fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let u = sample_dv(s.p);
+    if !inside(u) {
+        return;
+    }
+    let w = res_u();
+    let i = texel_of(u.y, w);
+    let a = neighbours(u.y, w, wp.flags.x != 0u);
+    let xw = u.x + mix(row_offset(u32(a.x), u.x), row_offset(u32(a.y), u.x), a.z);
+    if xw >= 0.0 && xw < 1.0 {
+        atomicAdd(&work[w * w + i * w + texel_of(xw, w)], 1u);
+    }
+}
+
+// RTW: importance collapsed by maximum per column (t < w: the density of x) and per row
+// (t >= w: the density of y).
+@compute @workgroup_size(64)
+fn rtw_collapse(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = res_u();
+    let t = id.x;
+    if t >= 2u * w {
+        return;
+    }
+    let base = 2u * w * w;
+    var m = 0.0;
+    for (var j = 0u; j < w; j++) {
+        let idx = select(base + j * w + t, base + (t - w) * w + j, t >= w);
+        m = max(m, bitcast<f32>(atomicLoad(&work[idx])));
+    }
+    fwork[3u * w * w + w + t] = m;
+}
+
+// Box blur of half-width imp.z (normalised by the taps inside), into work as f32 bits.
+@compute @workgroup_size(64)
+fn rtw_blur(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = res_u();
+    let t = id.x;
+    if t >= 2u * w {
+        return;
+    }
+    let k = t % w;
+    let first = t - k;
+    let rad = u32(wp.imp.z);
+    let a = max(i32(k) - i32(rad), 0);
+    let b = min(k + rad, w - 1u);
+    var sum = 0.0;
+    for (var j = u32(a); j <= b; j++) {
+        sum += fwork[3u * w * w + w + first + j];
+    }
+    atomicStore(&work[3u * w * w + t], bitcast<u32>(sum / f32(b - u32(a) + 1u)));
+}
+
+// RTW's two 1D warps from the prefix sums of the blurred importance (runs 0: x, 1: y).
+@compute @workgroup_size(64)
+fn rtw_offsets(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = res_u();
+    let t = id.x;
+    if t >= 2u * w {
+        return;
+    }
+    let k = t % w;
+    let first = t - k;
+    let total = fwork[first + w - 1u];
+    var o = 0.0;
+    if total > 0.0 {
+        o = fwork[t] / total - f32(k + 1u) / f32(w);
+    }
+    if t < w {
+        textureStore(warp_x_out, vec2<u32>(k, 0u), vec4<f32>(o, 0.0, 0.0, 0.0));
+    } else {
+        textureStore(warp_y_out, vec2<u32>(0u, k), vec4<f32>(o, 0.0, 0.0, 0.0));
+    }
+}

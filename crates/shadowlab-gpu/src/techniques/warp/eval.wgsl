@@ -1,0 +1,97 @@
+// Warped shadow-map evaluation: each evaluated sample is offset (normal offset, constant and
+// slope-scaled bias) in world units of one *warped* texel at the sample, projected, cropped to
+// the desired view, warped through the same function as the depth pass, and compared with an
+// NxN kernel of warped texels. The warped texel's world size is the cropped texel divided by
+// the smallest singular value of the warp's Jacobian (finite differences over one texel):
+// where the warp magnifies, texels shrink and so does the bias. Also counts the samples per
+// warped texel (sampling statistics after warping).
+
+@group(0) @binding(10) var shadow_map: texture_depth_2d;
+@group(0) @binding(11) var cmp: sampler_comparison;
+@group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
+
+// The nearest depth of the 3x3 texels around uv: closes the sub-texel cracks that adaptive
+// subdivision leaves at T-junctions (the finer side's midpoints are warped, the coarser side's
+// edge is straight), at the price of growing occluders by one warped texel.
+fn min_depth_3x3(uv: vec2<f32>, res: u32) -> f32 {
+    let c = vec2<i32>(clamp(uv * f32(res), vec2<f32>(0.0), vec2<f32>(f32(res) - 1.0)));
+    var d = 1.0;
+    for (var y = -1; y <= 1; y++) {
+        for (var x = -1; x <= 1; x++) {
+            let t = clamp(c + vec2<i32>(x, y), vec2<i32>(0), vec2<i32>(i32(res) - 1));
+            d = min(d, textureLoad(shadow_map, t, 0));
+        }
+    }
+    return d;
+}
+
+// Smallest singular value of the 2x2 matrix with columns a and b.
+fn sigma_min(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    let e = dot(a, a);
+    let g = dot(b, b);
+    let f = dot(a, b);
+    let tr = 0.5 * (e + g);
+    let det = e * g - f * f;
+    return sqrt(max(tr - sqrt(max(tr * tr - det, 0.0)), 0.0));
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let p = s.p;
+    let n = s.n;
+    let l = to_light(light, p);
+    let res = wp.texel.z;
+    let r = dv_rect();
+
+    let m0 = clip_to_map(base_clip(wp, p));
+    let u0 = to_dv(m0.xy, r);
+    let c0 = warp(u0);
+    if all(c0 >= vec2<f32>(0.0)) && all(c0 < vec2<f32>(1.0)) {
+        let t = vec2<u32>(c0 * res);
+        atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
+    }
+
+    // world size of one cropped texel at p, then of one warped texel
+    var texel = wp.texel.x * max(r.z - r.x, r.w - r.y);
+    if wp.texel.y > 0.5 {
+        texel *= max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
+    }
+    if wp.cfg.z > 0.5 {
+        let h = 0.5 / res;
+        let jx = (warp(u0 + vec2<f32>(h, 0.0)) - warp(u0 - vec2<f32>(h, 0.0))) / (2.0 * h);
+        let jy = (warp(u0 + vec2<f32>(0.0, h)) - warp(u0 - vec2<f32>(0.0, h))) / (2.0 * h);
+        // clamped: a collapsed (unsampled) region would ask for an unbounded bias
+        texel /= clamp(sigma_min(jx, jy), MIN_WARP_SCALE, 1e3);
+    }
+    let cos_t = clamp(dot(n, l), 1e-4, 1.0);
+    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, wp.bias.w);
+    let k = i32(wp.texel.w);
+    let half = f32(k - 1) * 0.5;
+    let q = p + n * (wp.bias.z * texel) + l * ((wp.bias.x + (wp.bias.y + half) * tan_t) * texel);
+    let a = base_clip(wp, q);
+    let m = clip_to_map(a);
+    let u = warp(to_dv(m.xy, r));
+    if a.w <= 0.0 || any(u < vec2<f32>(0.0)) || any(u > vec2<f32>(1.0)) || m.z > 1.0 {
+        visibility[s.i] = 1.0;
+        return;
+    }
+    var lit = 0.0;
+    for (var y = 0; y < k; y++) {
+        for (var x = 0; x < k; x++) {
+            let uv = u + (vec2<f32>(f32(x), f32(y)) - half) / res;
+            if wp.cfg.y > 1.5 {
+                lit += select(0.0, 1.0, m.z <= min_depth_3x3(uv, u32(res)));
+            } else {
+                lit += textureSampleCompareLevel(shadow_map, cmp, uv, m.z);
+            }
+        }
+    }
+    visibility[s.i] = lit / f32(k * k);
+}
+
+// Smallest local magnification of the warp used for the bias (1/8: at most 8 cropped texels).
+const MIN_WARP_SCALE: f32 = 0.125;

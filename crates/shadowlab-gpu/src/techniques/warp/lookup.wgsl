@@ -1,0 +1,76 @@
+// Applying a finished warp (depth, subdivision and evaluation passes): the DV rectangle and the
+// two R32Float warp textures at fixed bindings 6-9 of group 0. warp_x holds one row function
+// per texture row (one row for RTW), warp_y one column function per texture column.
+
+@group(0) @binding(6) var<uniform> wp: WarpParams;
+@group(0) @binding(7) var<storage, read> dv_bounds: array<u32>;
+@group(0) @binding(8) var warp_x: texture_2d<f32>;
+@group(0) @binding(9) var warp_y: texture_2d<f32>;
+
+fn dv_rect() -> vec4<f32> {
+    return dv_from_bounds(wp, vec4<u32>(dv_bounds[0], dv_bounds[1], dv_bounds[2], dv_bounds[3]));
+}
+
+// Base map coordinates -> DV-cropped coordinates.
+fn to_dv(m: vec2<f32>, r: vec4<f32>) -> vec2<f32> {
+    return (m - r.xy) / (r.zw - r.xy);
+}
+
+// o_x^(i)(x): row i (clamped to the texture), 0 outside [0,1).
+fn offset_x(i: u32, x: f32) -> f32 {
+    let d = textureDimensions(warp_x);
+    if x < 0.0 || x >= 1.0 {
+        return 0.0;
+    }
+    let row = min(i, d.y - 1u);
+    let s = x * f32(d.x);
+    let k = min(u32(s), d.x - 1u);
+    var left = 0.0;
+    if k > 0u {
+        left = textureLoad(warp_x, vec2<u32>(k - 1u, row), 0).x;
+    }
+    return edge_lerp(left, textureLoad(warp_x, vec2<u32>(k, row), 0).x, s, k);
+}
+
+// o_y^(j)(y): column j (clamped to the texture), 0 outside [0,1).
+fn offset_y(j: u32, y: f32) -> f32 {
+    let d = textureDimensions(warp_y);
+    if y < 0.0 || y >= 1.0 {
+        return 0.0;
+    }
+    let col = min(j, d.x - 1u);
+    let s = y * f32(d.y);
+    let k = min(u32(s), d.y - 1u);
+    var left = 0.0;
+    if k > 0u {
+        left = textureLoad(warp_y, vec2<u32>(col, k - 1u), 0).x;
+    }
+    return edge_lerp(left, textureLoad(warp_y, vec2<u32>(col, k), 0).x, s, k);
+}
+
+// Seed 000 eq. 6: (x + o_x^(i)(x), y + o_y^(j)(y)), i = floor(y w), j = floor(x' w); with
+// `flags.x` the offsets are interpolated between the two nearest functions instead.
+fn warp(u: vec2<f32>) -> vec2<f32> {
+    if wp.cfg.z < 0.5 {
+        return u;
+    }
+    let res = u32(wp.texel.z);
+    let interp = wp.flags.x != 0u;
+    let a = neighbours(u.y, res, interp);
+    let xw = u.x + mix(offset_x(u32(a.x), u.x), offset_x(u32(a.y), u.x), a.z);
+    let b = neighbours(xw, res, interp);
+    return vec2<f32>(xw, u.y + mix(offset_y(u32(b.x), u.y), offset_y(u32(b.y), u.y), b.z));
+}
+
+// Clip position of a world point in the warped map (Algorithm 1 of seed 000): crop to the DV,
+// warp, back to clip space. Behind a spot light only the (affine) crop applies.
+fn warped_clip(p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
+    let a = base_clip(wp, p);
+    if a.w <= 1e-7 {
+        let m = vec2<f32>(a.x * 0.5 + 0.5 * a.w, 0.5 * a.w - a.y * 0.5);
+        let u = (m - r.xy * a.w) / (r.zw - r.xy);
+        return vec4<f32>(u.x * 2.0 - a.w, a.w - 2.0 * u.y, a.z, a.w);
+    }
+    let u = warp(to_dv(clip_to_map(a).xy, r));
+    return vec4<f32>((u.x * 2.0 - 1.0) * a.w, (1.0 - 2.0 * u.y) * a.w, a.z, a.w);
+}

@@ -1,0 +1,324 @@
+//! Warped shadow maps (seed 000 sections 2.2-3.3, seed 002 chapter 4), one folder, three
+//! registry entries sharing every pass:
+//! - `notw`: Non-orthogonal Texture Warping. Desired view (DV) by a parallel min/max reduction,
+//!   count map at shadow-map resolution by atomic adds, per-row prefix sums, row warps
+//!   o(x) = g(x)/N - x smoothed across neighbouring rows weighted by their counts, the count map
+//!   rebuilt through them, the same for columns, the final warp of eq. 6; the warps live in two
+//!   R32Float textures (8 w^2 bytes per light).
+//! - `rtw`: Rectilinear Texture Warping (Rosen 2012), backward analysis: importance map
+//!   (desired-view + distance-to-eye), max-collapsed per column and row, blurred, two 1D warps
+//!   (w x 1 and 1 x w textures, 8 w bytes).
+//! - `notw-dv`: the desired view only, no warping (the seeds' "Ours-DV").
+//!
+//! The shadow map is rendered with the warp applied per vertex (optionally after subdividing
+//! triangles whose warped edges are long, `subdiv`), and evaluated through the same warp. The
+//! CPU reference of the math is `shadowlab_core::warp`. Stored depth: post-projective, 0 = near
+//! the light (orthographic: linear), as in `sm`.
+
+mod params;
+mod run;
+
+pub use params::*;
+
+use bytemuck::{Pod, Zeroable};
+use shadowlab_core::light::Light;
+use shadowlab_core::lightspace;
+use shadowlab_core::params::ParamValues;
+
+use crate::prefix_sum::PrefixSum;
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose;
+use crate::techniques::{compose_view, view_layout, TechniqueInfo};
+use crate::{binding, raster, Gpu, GpuError};
+
+const PARAMS_WGSL: &str = include_str!("params.wgsl");
+const LOOKUP_WGSL: &str = include_str!("lookup.wgsl");
+const ANALYZE_WGSL: &str = include_str!("analyze.wgsl");
+const DEPTH_WGSL: &str = include_str!("depth.wgsl");
+const SUBDIV_WGSL: &str = include_str!("subdiv.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+
+fn analyze_src() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{ANALYZE_WGSL}"), false)
+}
+fn depth_src() -> String {
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{DEPTH_WGSL}"), true)
+}
+fn subdiv_src() -> String {
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{SUBDIV_WGSL}"), true)
+}
+fn eval_src() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{EVAL_WGSL}"), false)
+}
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![
+        ("warp/analyze.wgsl", analyze_src()),
+        ("warp/depth.wgsl", depth_src()),
+        ("warp/subdiv.wgsl", subdiv_src()),
+        ("warp/eval.wgsl", eval_src()),
+    ]
+}
+
+const LIGHTS: &[&str] = &["directional", "spot"];
+
+pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
+    name: "notw",
+    summary: "non-orthogonal texture warping: per-row and per-column warps from the view-sample count map, smoothed, DV crop",
+    cost: "DV reduction + count map + 2 prefix-sum passes + 2 rebuilds over the samples; one warped depth pass; 8 w^2 bytes of warps",
+    quality: "samples spread evenly over the map; long triangles bend unless subdivided",
+    source: "seed 000 section 3, seed 002 chapter 4 (Navratil et al.)",
+    lights: LIGHTS,
+    params: NOTW_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Notw)?)),
+};
+
+pub const RTW_INFO: TechniqueInfo = TechniqueInfo {
+    name: "rtw",
+    summary: "rectilinear texture warping, backward analysis: importance map max-collapsed to two blurred 1D warps, DV crop",
+    cost: "DV reduction + importance map + 1D collapse/blur/scan; one warped depth pass; 8 w bytes of warps",
+    quality: "rectilinear grid: a row/column gets the resolution of its most important texel",
+    source: "Rosen 2012; seed 000 section 2.2, seed 002 section 3.2.2",
+    lights: LIGHTS,
+    params: RTW_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Rtw)?)),
+};
+
+pub const DV_INFO: TechniqueInfo = TechniqueInfo {
+    name: "notw-dv",
+    summary: "desired view only: the shadow map cropped to the bounding rectangle of the projected view samples, no warp",
+    cost: "DV reduction (parallel min/max) + one depth pass",
+    quality: "wins on close-ups; on wide views the crop barely shrinks (seed 000 section 4)",
+    source: "seed 000 section 3.2 (\"Ours-DV\"), Rosen 2012's desired view",
+    lights: LIGHTS,
+    params: DV_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Dv)?)),
+};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    Notw,
+    Rtw,
+    Dv,
+}
+
+impl Variant {
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Notw => "notw",
+            Variant::Rtw => "rtw",
+            Variant::Dv => "notw-dv",
+        }
+    }
+}
+
+/// WGSL `WarpParams` (params.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct WarpParams {
+    pub light_view_proj: [[f32; 4]; 4],
+    pub texel: [f32; 4],
+    pub bias: [f32; 4],
+    pub cfg: [f32; 4],
+    pub imp: [f32; 4],
+    pub ints: [u32; 4],
+    pub flags: [u32; 4],
+}
+
+/// One light's warped shadow map with its warps and scratch buffers.
+pub struct Warped {
+    variant: Variant,
+    res: u32,
+    pcf: u32,
+    params: WarpParams,
+    uniform: wgpu::Buffer,
+    /// Reduced DV bounds (fixed point) and the largest eye distance: 8 words.
+    dv: wgpu::Buffer,
+    work: wgpu::Buffer,
+    fwork: wgpu::Buffer,
+    warp_x: wgpu::Texture,
+    warp_y: wgpu::Texture,
+    map: wgpu::Texture,
+    counts: wgpu::Buffer,
+    /// Subdivision: finished pieces, counters + draw/dispatch args, two queues, one uniform per level.
+    pieces: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    queues: [wgpu::Buffer; 2],
+    /// Indirect dispatch args of the current level (copied from `counters`).
+    dispatch: wgpu::Buffer,
+    level_uniforms: Vec<wgpu::Buffer>,
+    prefix: PrefixSum,
+    analyze_layout: wgpu::BindGroupLayout,
+    analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
+    lookup_layout: wgpu::BindGroupLayout,
+    depth_pipeline: wgpu::RenderPipeline,
+    split_layout: wgpu::BindGroupLayout,
+    /// split_root, split_args, split_level, draw_args.
+    split: [wgpu::ComputePipeline; 4],
+    eval_layout: wgpu::BindGroupLayout,
+    eval_pipeline: wgpu::ComputePipeline,
+    sampler: wgpu::Sampler,
+}
+
+fn layout_at(gpu: &Gpu, label: &str, vis: wgpu::ShaderStages, entries: &[(u32, wgpu::BindingType)]) -> wgpu::BindGroupLayout {
+    let e: Vec<_> = entries.iter().map(|&(binding, ty)| wgpu::BindGroupLayoutEntry { binding, visibility: vis, ty, count: None }).collect();
+    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &e })
+}
+
+fn r32_texture(gpu: &Gpu, label: &str, w: u32, h: u32) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+impl Warped {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, variant: Variant) -> Result<Warped, GpuError> {
+        let name = variant.name();
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "shadow map")?;
+        let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
+            GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
+        })?;
+        let opt = |k: &str, d: f64| if p.0.contains_key(k) { p.get(k) } else { d };
+        let window = opt("window", 0.0);
+        if window >= res as f64 {
+            return Err(GpuError::Invalid(format!("{name}: window {window} must be below res {res}")));
+        }
+        let subdiv = opt("subdiv", 0.0) as f32;
+        let tris = scene.triangle_count;
+        let limit = gpu.limits.max_storage_buffer_binding_size / 16;
+        let on = subdiv > 0.0 && variant != Variant::Dv;
+        let extra = if on { (8 * tris as u64).max(1 << 21).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
+        let queue = if on { (tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
+        let params = WarpParams {
+            light_view_proj: lp.view_proj.to_cols_array_2d(),
+            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, p.get("pcf") as f32],
+            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
+            cfg: [p.get("dv_margin") as f32, 1.0 + opt("close_cracks", 0.0) as f32, (variant != Variant::Dv) as u32 as f32, window as f32],
+            imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
+            ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
+            flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), 0, 0],
+        };
+        let d = &gpu.device;
+        let n = res as u64 * res as u64;
+        let (wx, wy) = match variant {
+            Variant::Notw => ((res, res), (res, res)),
+            Variant::Rtw => ((res, 1), (1, res)),
+            Variant::Dv => ((1, 1), (1, 1)),
+        };
+        let warp_x = r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1);
+        let warp_y = r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1);
+        let map = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some(&format!("{name}.map")),
+            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: raster::DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let scratch = variant != Variant::Dv;
+        let work = gpu.storage(&format!("{name}.work"), if scratch { (3 * n + 2 * res as u64) * 4 } else { 4 });
+        let fwork = gpu.storage(&format!("{name}.fwork"), if scratch { (3 * n + 3 * res as u64) * 4 } else { 4 });
+        let pieces = gpu.storage(&format!("{name}.pieces"), (tris as u64 + extra as u64) * 16 * on as u64);
+        let queues = [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16));
+        let counters = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&format!("{name}.counters")),
+            size: 64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let levels = params.ints[1];
+        let level_uniforms =
+            (1..=levels).map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue])).collect();
+        let ro = binding::storage(true);
+        let rw = binding::storage(false);
+        let tex = binding::texture_float();
+        let store = wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: wgpu::TextureFormat::R32Float,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        };
+        let analyze_layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store]);
+        let src = analyze_src();
+        let entries: &[&str] = match variant {
+            Variant::Notw => {
+                &["dv_reduce", "count", "blur_rows", "offsets_rows", "smooth_rows", "rebuild", "blur_cols", "offsets_cols", "smooth_cols"]
+            }
+            Variant::Rtw => &["dv_reduce", "count", "rtw_collapse", "rtw_blur", "rtw_offsets"],
+            Variant::Dv => &["dv_reduce"],
+        };
+        let analyze = entries.iter().map(|&e| (e, gpu.compute_pipeline(&format!("{name}.{e}"), &src, e, &[&analyze_layout]))).collect();
+        let look = [(6, binding::uniform()), (7, ro), (8, tex), (9, tex)];
+        let lookup_layout =
+            layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX, &[look[0], look[1], look[2], look[3], (10, ro)]);
+        let depth_pipeline =
+            raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(), &[&lookup_layout, &scene.layout], &[]);
+        let split_layout = layout_at(
+            gpu,
+            &format!("{name}.subdivide"),
+            wgpu::ShaderStages::COMPUTE,
+            &[look[0], look[1], look[2], look[3], (10, rw), (11, rw), (12, rw), (13, rw), (14, binding::uniform())],
+        );
+        let ssrc = subdiv_src();
+        let split = ["split_root", "split_args", "split_level", "draw_args"]
+            .map(|e| gpu.compute_pipeline(&format!("{name}.{e}"), &ssrc, e, &[&split_layout, &scene.layout]));
+        let eval_layout = view_layout(
+            gpu,
+            &format!("{name}.final_pass"),
+            &[binding::uniform(), ro, tex, tex, binding::texture_depth(), binding::comparison_sampler(), rw],
+        );
+        let eval_pipeline = gpu.compute_pipeline(&format!("{name}.final_pass"), &eval_src(), "main", &[&eval_layout]);
+        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("warp.cmp"),
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            mag_filter: wgpu::FilterMode::Nearest,
+            min_filter: wgpu::FilterMode::Nearest,
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            ..Default::default()
+        });
+        Ok(Warped {
+            variant,
+            res,
+            pcf: p.get_u32("pcf"),
+            params,
+            uniform: gpu.uniform(&format!("{name}.params"), &params),
+            dv: gpu.storage(&format!("{name}.dv"), 32),
+            work,
+            fwork,
+            warp_x,
+            warp_y,
+            map,
+            counts: gpu.storage(&format!("{name}.counts"), n * 4),
+            pieces,
+            counters,
+            queues,
+            dispatch: d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{name}.dispatch")),
+                size: 12,
+                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            level_uniforms,
+            prefix: PrefixSum::new(gpu),
+            analyze_layout,
+            analyze,
+            lookup_layout,
+            depth_pipeline,
+            split_layout,
+            split,
+            eval_layout,
+            eval_pipeline,
+            sampler,
+        })
+    }
+}

@@ -1,0 +1,195 @@
+//! The parameters of `rtw`, `notw` and `notw-dv`: defaults as named constants with where they
+//! come from and what goes wrong when too low or high.
+
+use shadowlab_core::params::ParamDef;
+
+/// Smoothing window (functions averaged: [i - window/2, i + window/2]). 16 is the authors'
+/// public code (GUIDE). Too low: neighbouring rows warp differently and long triangles bend
+/// (wrong pixels along edges); too high: the warp tends to RTW's rectilinear grid.
+pub const DEFAULT_WINDOW: f64 = 16.0;
+/// RTW blur half-width (texels of the 1D importance): the same 16-wide window.
+pub const DEFAULT_BLUR: f64 = 8.0;
+/// NoTW blur of the counts along each function (half-width, texels); 0 = as the seeds.
+/// Measured on courtyard (512 map, 512x512 view, subdiv 2): 0 needs ~10 M subdivision pieces
+/// (per-texel kinks), 8 about 1.3 M with mix 2. Too high: the sampling evens out less.
+pub const DEFAULT_NOTW_BLUR: f64 = 8.0;
+/// NoTW uniform floor (fraction of the mean count per texel); 0 = as the seeds. Courtyard:
+/// 0.5 -> 2.9 % wrong, 2 -> 2.0 % (bias 0.5); too high: CV and used texels drift to plain sm's.
+pub const DEFAULT_MIX: f64 = 2.0;
+/// NoTW constant bias (warped texels): rasterised depth between subdivided vertices is off by
+/// up to the subdivision threshold. 512x512 views, crack-free subdivision: courtyard sun
+/// 1 -> 1.78 %, 1.5 -> 1.43, 2 -> 1.25, 3 -> 1.06; conference sun 1 -> 0.37, 1.5 -> 0.48,
+/// 2 -> 0.65, 3 -> 1.19 (leaks). 2 is the best sum.
+pub const DEFAULT_NOTW_BIAS: f64 = 2.0;
+/// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
+/// texels); 0 = off. Courtyard 512 view: off -> 70 % wrong (rtw and notw: the floor is two
+/// triangles); rtw 1 -> 0.58 % with 24 k pieces (crack-free subdivision); notw 2 -> 1.25 %
+/// with 0.3 M pieces. Lower: more pieces (time, capacity), higher: bent depth, more bias
+/// needed. See docs/bench/warp.md.
+pub const DEFAULT_SUBDIV: f64 = 1.0;
+/// NoTW's warp bends more (a function per row and column): 2 keeps the piece count near 0.3 M.
+pub const DEFAULT_NOTW_SUBDIV: f64 = 2.0;
+/// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
+/// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
+/// tessellation factor of 16 (4 levels); measured too few for the big floor triangles here.
+pub const DEFAULT_SUBDIV_LEVELS: f64 = 10.0;
+/// Offsets interpolated between neighbouring functions (1) or eq. 6 as printed (0).
+pub const DEFAULT_INTERP: f64 = 1.0;
+/// DV margin (texels): samples moved by the bias offsets must stay inside the cropped map.
+pub const DEFAULT_DV_MARGIN: f64 = 2.0;
+
+const fn p(key: &'static str, default: f64, min: f64, max: f64, integer: bool, doc: &'static str, source: &'static str) -> ParamDef {
+    ParamDef { key, default, min, max, integer, doc, source, choices: &[] }
+}
+
+const RES: ParamDef = p(
+    "res",
+    512.0,
+    16.0,
+    8192.0,
+    true,
+    "shadow map side (texels); warps are res x res",
+    "seeds 000/002 evaluation: 512 with 1024x1024 output",
+);
+const PCF: ParamDef = p("pcf", 1.0, 1.0, 7.0, true, "PCF kernel width N in warped texels; 1 = hard test", "Reeves et al. 1987");
+const BIAS: ParamDef = p(
+    "bias",
+    0.5,
+    0.0,
+    100.0,
+    false,
+    "constant depth bias, warped texels; low: acne, high: peter-panning",
+    "as sm (shadowlab sweep 2026-11-22)",
+);
+const SLOPE: ParamDef =
+    p("slope_bias", 0.0, 0.0, 100.0, false, "slope-scaled bias, warped texels x tan(angle)", "as sm: 0 (normal offset covers slopes)");
+const MAX_SLOPE: ParamDef = p("max_slope", 4.0, 0.0, 1000.0, false, "clamp on tan(angle to light) for slope and PCF bias", "as sm");
+const NORMAL_OFFSET: ParamDef = p(
+    "normal_offset",
+    0.5,
+    0.0,
+    100.0,
+    false,
+    "offset along the normal in warped texels (local size from the warp's Jacobian); low: acne, high: shifted shadows",
+    "Holbert 2011; value as sm",
+);
+const DV_MARGIN: ParamDef = p(
+    "dv_margin",
+    DEFAULT_DV_MARGIN,
+    0.0,
+    64.0,
+    false,
+    "texels added around the desired view; low: biased samples fall outside (lit)",
+    "shadowlab: covers bias + normal offset",
+);
+const WINDOW: ParamDef = p(
+    "window",
+    DEFAULT_WINDOW,
+    0.0,
+    1024.0,
+    true,
+    "NoTW smoothing window across rows/columns; low: bent edges, high: RTW-like",
+    "authors' public code (GUIDE)",
+);
+const BLUR: ParamDef = p(
+    "blur",
+    DEFAULT_BLUR,
+    0.0,
+    512.0,
+    true,
+    "RTW blur half-width of the 1D importance; low: abrupt warps, high: flat warps",
+    "window 16 (GUIDE)",
+);
+const NOTW_BLUR: ParamDef = p(
+    "blur",
+    DEFAULT_NOTW_BLUR,
+    0.0,
+    512.0,
+    true,
+    "NoTW box blur half-width of the counts along each row/column before the prefix sums; 0 = the seeds' method; low: a kink per texel that subdivision must follow, high: less even sampling",
+    "shadowlab measurement (docs/bench/warp.md)",
+);
+const MIX: ParamDef = p(
+    "mix",
+    DEFAULT_MIX,
+    0.0,
+    100.0,
+    false,
+    "NoTW uniform floor added to every texel's count, as a fraction of the mean count per texel; 0 = the seeds' method; low: rows with few samples warp wildly (extreme magnification, folds), high: the warp fades to the identity",
+    "shadowlab measurement (docs/bench/warp.md)",
+);
+const W_DV: ParamDef = p(
+    "w_dv",
+    1.0,
+    0.0,
+    100.0,
+    false,
+    "RTW desired-view importance (every sampled texel)",
+    "GUIDE: importance = DV mask + (maxDistance - distance)",
+);
+const W_EYE: ParamDef =
+    p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
+const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
+const NOTW_BIASP: ParamDef =
+    ParamDef { default: DEFAULT_NOTW_BIAS, source: "shadowlab sweep 1/1.5/2/3 on courtyard and conference (docs/bench/warp.md)", ..BIAS };
+const SUBDIV: ParamDef = p(
+    "subdiv",
+    DEFAULT_SUBDIV,
+    0.0,
+    1024.0,
+    false,
+    "split triangles until the warp bends no edge (or centroid) by more than this many warped texels from the rasterised line; 0 = off; low: many pieces, high: bent edges",
+    "shadowlab measurement (docs/bench/warp.md)",
+);
+const INTERP: ParamDef = ParamDef {
+    key: "interp",
+    default: DEFAULT_INTERP,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "interpolate offsets between neighbouring row/column functions (a continuous warp); false = eq. 6 as printed (one function per texel row: a sub-triangle crossing rows is rasterised across an offset jump)",
+    source: "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard",
+    choices: shadowlab_core::params::BOOL,
+};
+const SUBDIV_LEVELS: ParamDef = p(
+    "subdiv_levels",
+    DEFAULT_SUBDIV_LEVELS,
+    1.0,
+    15.0,
+    true,
+    "max edge halvings per triangle (4^levels pieces); low: big triangles stay bent",
+    "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
+);
+
+/// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.
+pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
+pub const CLOSE_CRACKS: ParamDef = ParamDef {
+    key: "close_cracks",
+    default: DEFAULT_CLOSE_CRACKS,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap",
+    source: "shadowlab measurement (docs/bench/warp.md)",
+    choices: shadowlab_core::params::BOOL,
+};
+
+pub const NOTW_PARAMS: &[ParamDef] = &[
+    RES,
+    WINDOW,
+    NOTW_BLUR,
+    MIX,
+    INTERP,
+    NOTW_SUBDIV,
+    SUBDIV_LEVELS,
+    CLOSE_CRACKS,
+    PCF,
+    NOTW_BIASP,
+    SLOPE,
+    MAX_SLOPE,
+    NORMAL_OFFSET,
+    DV_MARGIN,
+];
+pub const RTW_PARAMS: &[ParamDef] =
+    &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, CLOSE_CRACKS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];

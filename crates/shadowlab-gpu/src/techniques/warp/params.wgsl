@@ -1,0 +1,75 @@
+// Shared by every warp shader: the parameters (mod.rs `WarpParams`), the base light projection
+// to map coordinates, the desired-view (DV) rectangle rule and the 1D offset interpolation
+// (shadowlab-core warp.rs is the CPU reference of all of it).
+//
+// Map coordinates: x = column, y = row (0 at the top, like the texture), [0,1]^2 on the map.
+// A warping function is stored as `res` offsets at the texels' right edges (o(0) = 0 implicit).
+
+struct WarpParams {
+    light_view_proj: mat4x4<f32>,
+    // x: world size of one texel of the full (un-cropped) map (perspective: per unit of depth)
+    // y: 1 if perspective; z: resolution; w: pcf kernel width
+    texel: vec4<f32>,
+    // x: constant bias, y: slope-scaled bias, z: normal offset (all in warped texels), w: max slope
+    bias: vec4<f32>,
+    // x: DV margin (texels), y: DV on (1; 2: DV on and cracks closed by a 3x3 depth minimum),
+    // z: warp on, w: smoothing window (functions)
+    cfg: vec4<f32>,
+    // x: RTW desired-view weight, y: RTW distance-to-eye weight, z: RTW blur radius, w: subdiv
+    // threshold (warped texels per edge)
+    imp: vec4<f32>,
+    // x: triangles, y: max subdivision level, z: extra sub-triangle capacity, w: 1 = RTW importance
+    ints: vec4<u32>,
+    // x: 1 = offsets interpolated linearly between neighbouring functions (continuous warp),
+    // 0 = eq. 6 as printed (function floor(y w) / floor(x' w)); y: NoTW uniform floor `mix`
+    // (f32 bits)
+    flags: vec4<u32>,
+}
+
+// Fixed-point scale of DV coordinates for the atomic min/max.
+const DV_SCALE: f32 = 16777216.0;
+
+// Base map coordinates (x, y) and post-projective depth of a world point; w <= 0 behind a spot.
+fn base_clip(pw: WarpParams, p: vec3<f32>) -> vec4<f32> {
+    return pw.light_view_proj * vec4<f32>(p, 1.0);
+}
+
+fn clip_to_map(c: vec4<f32>) -> vec3<f32> {
+    let ndc = c.xyz / c.w;
+    return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, ndc.z);
+}
+
+// The DV rectangle (lo.xy, hi.xy) from the reduced fixed-point bounds: extent e = max(hi - lo,
+// 1/res), grown by margin * e / res per side (warp.rs `grow_rect`). Full map when off or empty.
+fn dv_from_bounds(pw: WarpParams, b: vec4<u32>) -> vec4<f32> {
+    if pw.cfg.y < 0.5 || b.x > b.z || b.y > b.w {
+        return vec4<f32>(0.0, 0.0, 1.0, 1.0);
+    }
+    let res = pw.texel.z;
+    let lo = vec2<f32>(b.xy) / DV_SCALE;
+    let hi = vec2<f32>(b.zw) / DV_SCALE;
+    let e = max(hi - lo, vec2<f32>(1.0 / res));
+    let m = pw.cfg.x * e / res;
+    return vec4<f32>(lo - m, lo + e + m);
+}
+
+// Offset at s = x * res between the stored edge offsets `left` (edge k) and `right` (edge k+1).
+fn edge_lerp(left: f32, right: f32, s: f32, k: u32) -> f32 {
+    return left + (right - left) * (s - f32(k));
+}
+
+fn texel_of(v: f32, res: u32) -> u32 {
+    return min(u32(max(floor(v * f32(res)), 0.0)), res - 1u);
+}
+
+// Neighbouring functions i0, i1 and weight t of i1 at coordinate v (function centres at
+// (i + 0.5) / res); without interpolation the function floor(v res) alone (eq. 6).
+fn neighbours(v: f32, res: u32, interp: bool) -> vec3<f32> {
+    if !interp {
+        let i = f32(texel_of(v, res));
+        return vec3<f32>(i, i, 0.0);
+    }
+    let s = clamp(v * f32(res) - 0.5, 0.0, f32(res - 1u));
+    let i0 = floor(s);
+    return vec3<f32>(i0, min(i0 + 1.0, f32(res - 1u)), s - i0);
+}
