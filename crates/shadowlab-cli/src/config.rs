@@ -14,8 +14,10 @@ use shadowlab_core::setup::{SceneSource, Setup};
 
 use crate::RunArgs;
 
-/// Techniques `compare` runs when neither the setup nor `-t` names any.
-pub const BASELINE: &[&str] = &["sm", "sm:pcf=3", "sm:res=2048"];
+/// Techniques `compare` runs when neither the setup nor `-t` names any: one of each family at
+/// its defaults (those that do not support the run's light type are left out).
+pub const BASELINE: &[&str] =
+    &["sm", "sm:pcf=3", "sv", "rtw", "notw", "notw-dv", "min-sm", "mdsm", "vsm", "evsm", "msm", "evsm:sd=true", "csm", "iasm"];
 
 pub struct RunConfig {
     pub scene: Scene,
@@ -86,6 +88,7 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
         (None, Some(_)) => setup.scene_source().map_err(|e| anyhow!(e))?,
         (None, None) => SceneSource::Builtin(DEFAULT_SCENE.into()),
     };
+    let defaults = args.techniques.is_empty() && setup.techniques.is_empty();
     let specs_text: Vec<String> = if !args.techniques.is_empty() {
         args.techniques.clone()
     } else if !setup.techniques.is_empty() {
@@ -120,6 +123,12 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
     let lights = if setup.lights.is_empty() { scene.lights.clone() } else { setup.lights.clone() };
     if args.light >= lights.len() {
         bail!("--light {}: the run has {} light(s)", args.light, lights.len());
+    }
+    let mut specs = specs;
+    if defaults {
+        // the default list skips what the light cannot use; named techniques are checked below
+        let light = &lights[args.light];
+        specs.retain(|s| shadowlab_gpu::techniques::resolve(s, Some(light)).is_ok());
     }
     let cfg = RunConfig {
         source: match &source {
