@@ -131,16 +131,7 @@ impl Cascaded {
             )));
         }
         let d = &gpu.device;
-        let maps = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("csm.maps"),
-            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: count as u32 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: raster::DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let maps = raster::depth_target(gpu, "csm.maps", res, res, count as u32, wgpu::TextureUsages::empty());
         let params = CsmParams {
             cascades: [CascadeU::zeroed(); MAX_CASCADES],
             cfg: [count as f32, res as f32, p.get("pcf") as f32, p.get("blend") as f32],
@@ -159,15 +150,7 @@ impl Cascaded {
         let eval_pipeline = gpu.compute_pipeline("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
         let camera_layout = binding::layout(d, "csm.camera", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
         let camera_pipeline = gpu.compute_pipeline("csm.camera", &compose(CAMERA_WGSL, false), "main", &[&camera_layout]);
-        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("csm.cmp"),
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            mag_filter: wgpu::FilterMode::Nearest,
-            min_filter: wgpu::FilterMode::Nearest,
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            ..Default::default()
-        });
+        let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {
             count,

@@ -216,20 +216,17 @@ impl MultiDepthMap {
         // the depth pass reads only light_view_proj; the rest mirrors what sm would hold
         let sm_params = SmParams { light_view_proj: params.light_view_proj, texel: params.texel, bias };
         let d = &gpu.device;
-        let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-            d.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: usage | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        };
-        let base = texture("mdsm.base", raster::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-        let nsm = texture("mdsm.nsm", wgpu::TextureFormat::Rgba32Float, wgpu::TextureUsages::STORAGE_BINDING);
+        let base = raster::depth_target(gpu, "mdsm.base", res, res, 1, wgpu::TextureUsages::empty());
+        let nsm = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mdsm.nsm"),
+            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
 
         let depth_uniform = gpu.uniform("mdsm.depth_params", &sm_params);
         let depth_layout = binding::layout(d, "mdsm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);

@@ -157,16 +157,7 @@ impl MinShadowMap {
             bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
         };
         let d = &gpu.device;
-        let map = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("min-sm.map"),
-            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: raster::DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let map = raster::depth_target(gpu, "min-sm.map", res, res, 1, wgpu::TextureUsages::empty());
         let uniform = gpu.uniform("min-sm.params", &params);
         let depth_layout = binding::layout(d, "min-sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_group = binding::group(d, "min-sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
@@ -177,15 +168,7 @@ impl MinShadowMap {
             &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
         );
         let eval_pipeline = gpu.compute_pipeline("min-sm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
-        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("min-sm.cmp"),
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            mag_filter: wgpu::FilterMode::Nearest,
-            min_filter: wgpu::FilterMode::Nearest,
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            ..Default::default()
-        });
+        let sampler = raster::comparison_sampler(gpu, "min-sm.cmp");
         let reduce = MsfReduce {
             frame_view: frame.view.as_mat4().to_cols_array_2d(),
             mode: [frame.perspective as u32, grid, RUN, 0],
