@@ -23,7 +23,7 @@ pub use params::*;
 
 use crate::reduce::{decode, MinMax};
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
+use crate::shaders::{compose, compose_depth};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
@@ -34,7 +34,7 @@ const CAMERA_WGSL: &str = include_str!("camera.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
-        ("csm/depth.wgsl", compose(DEPTH_WGSL, true)),
+        ("csm/depth.wgsl", compose_depth(DEPTH_WGSL)),
         ("csm/eval.wgsl", compose_view(EVAL_WGSL, false)),
         ("csm/camera.wgsl", compose(CAMERA_WGSL, false)),
     ]
@@ -141,7 +141,7 @@ impl Cascaded {
         let depth_layout = binding::layout(d, "csm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_uniforms: Vec<_> = (0..count).map(|_| gpu.uniform("csm.cascade", &Mat4::IDENTITY.to_cols_array_2d())).collect();
         let depth_groups = depth_uniforms.iter().map(|u| binding::group(d, "csm.depth", &depth_layout, &[u.as_entire_binding()])).collect();
-        let depth_pipeline = raster::scene_pipeline(gpu, "csm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
+        let depth_pipeline = raster::scene_pipeline(gpu, "csm.depth", &compose_depth(DEPTH_WGSL), &[&depth_layout, &scene.layout], &[]);
         let eval_layout = view_layout(
             gpu,
             "csm.eval",

@@ -7,7 +7,7 @@ use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::gpu::Iasm;
 use super::{eval_atlas_src, ATLAS_WGSL};
-use crate::shaders::compose;
+use crate::shaders::compose_depth;
 use crate::techniques::{view_layout, FrameInputs};
 use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
@@ -29,7 +29,7 @@ pub(super) fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Resul
     gpu.check_size(w, h, "iasm atlas")?;
     let texture = raster::depth_target(gpu, "iasm.atlas", w, h, 1, wgpu::TextureUsages::empty());
     let view = texture.create_view(&Default::default());
-    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose(ATLAS_WGSL, true), layouts, &[]);
+    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose_depth(ATLAS_WGSL), layouts, &[]);
     let eval_layout = view_layout(gpu, "iasm.eval_atlas", &[binding::uniform(), binding::texture_depth(), binding::storage(false)]);
     let eval = gpu.compute_pipeline("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout]);
     Ok(Atlas { texture, view, slots, pipeline, eval_layout, eval })

@@ -20,7 +20,7 @@ mod plan;
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::params::{ParamDef, BOOL};
 
-use crate::shaders::compose;
+use crate::shaders::{compose, compose_depth};
 use crate::techniques::{compose_view, TechniqueInfo};
 
 pub use gpu::Iasm;
@@ -50,11 +50,11 @@ fn probe_src() -> String {
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
         ("iasm/analysis.wgsl", analysis_src()),
-        ("iasm/render.wgsl", compose(RENDER_WGSL, true)),
+        ("iasm/render.wgsl", compose_depth(RENDER_WGSL)),
         ("iasm/eval.wgsl", eval_src()),
         ("iasm/bounds.wgsl", compose(BOUNDS_WGSL, true)),
         ("iasm/probe.wgsl", probe_src()),
-        ("iasm/atlas.wgsl", compose(ATLAS_WGSL, true)),
+        ("iasm/atlas.wgsl", compose_depth(ATLAS_WGSL)),
         ("iasm/eval_atlas.wgsl", eval_atlas_src()),
     ]
 }

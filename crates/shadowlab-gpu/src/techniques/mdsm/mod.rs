@@ -29,15 +29,6 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     vec![("mdsm/select.wgsl", compose(SELECT_WGSL, false)), ("mdsm/eval.wgsl", compose_view(EVAL_WGSL, false))]
 }
 
-/// `sm`'s depth pass (same shader, same `SmParams`), so the base map is `sm`'s map.
-fn sm_depth_wgsl() -> Result<String, GpuError> {
-    sm::shaders()
-        .into_iter()
-        .find(|(name, _)| *name == "sm/depth.wgsl")
-        .map(|(_, src)| src)
-        .ok_or_else(|| GpuError::Invalid("mdsm: sm/depth.wgsl not found".into()))
-}
-
 /// Depths per texel. Seed 003 demonstrates 2 and 3; 2 doubles the outcomes of every kernel
 /// (Table 1) for one more channel. 1 = plain `sm`; 4 fills the RGBA32F texel.
 pub const DEFAULT_N: f64 = 2.0;
@@ -231,7 +222,7 @@ impl MultiDepthMap {
         let depth_uniform = gpu.uniform("mdsm.depth_params", &sm_params);
         let depth_layout = binding::layout(d, "mdsm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_group = binding::group(d, "mdsm.depth", &depth_layout, &[depth_uniform.as_entire_binding()]);
-        let depth_pipeline = raster::scene_pipeline(gpu, "mdsm.depth", &sm_depth_wgsl()?, &[&depth_layout, &scene.layout], &[]);
+        let depth_pipeline = raster::scene_pipeline(gpu, "mdsm.depth", &sm::depth_source(), &[&depth_layout, &scene.layout], &[]);
 
         let uniform = gpu.uniform("mdsm.params", &params);
         let storage_out = wgpu::BindingType::StorageTexture {

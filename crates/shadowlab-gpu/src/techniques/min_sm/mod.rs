@@ -18,14 +18,11 @@ use shadowlab_core::params::{ParamDef, ParamValues};
 use shadowlab_core::scene::Bounds;
 
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
 use crate::techniques::sm::{self, count_image, depth_image, SmParams};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 
-const DEPTH_WGSL: &str = include_str!("../sm/depth.wgsl");
-const EVAL_WGSL: &str = include_str!("../sm/eval.wgsl");
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
 
 /// min-sm's own shader (the depth and evaluation shaders are `sm`'s files, validated there).
@@ -161,13 +158,13 @@ impl MinShadowMap {
         let uniform = gpu.uniform("min-sm.params", &params);
         let depth_layout = binding::layout(d, "min-sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_group = binding::group(d, "min-sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
-        let depth_pipeline = raster::scene_pipeline(gpu, "min-sm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
+        let depth_pipeline = raster::scene_pipeline(gpu, "min-sm.depth", &sm::depth_source(), &[&depth_layout, &scene.layout], &[]);
         let eval_layout = view_layout(
             gpu,
             "min-sm.eval",
             &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
         );
-        let eval_pipeline = gpu.compute_pipeline("min-sm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let eval_pipeline = gpu.compute_pipeline("min-sm.eval", &sm::eval_source(), "main", &[&eval_layout]);
         let sampler = raster::comparison_sampler(gpu, "min-sm.cmp");
         let reduce = MsfReduce {
             frame_view: frame.view.as_mat4().to_cols_array_2d(),

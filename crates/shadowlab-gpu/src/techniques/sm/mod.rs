@@ -10,7 +10,7 @@ use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::{ParamDef, ParamValues};
 
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
+use crate::shaders::compose_depth;
 use crate::techniques::{compose_view, view_layout, FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
@@ -19,7 +19,17 @@ const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("sm/depth.wgsl", compose(DEPTH_WGSL, true)), ("sm/eval.wgsl", compose_view(EVAL_WGSL, false))]
+    vec![("sm/depth.wgsl", depth_source()), ("sm/eval.wgsl", eval_source())]
+}
+
+/// The composed depth pass (uniform `SmParams` at group 0; mdsm and min-sm render with it too).
+pub fn depth_source() -> String {
+    compose_depth(DEPTH_WGSL)
+}
+
+/// The composed evaluation (view bindings, then `SmParams`, depth map, comparison sampler, counts).
+pub fn eval_source() -> String {
+    compose_view(EVAL_WGSL, false)
 }
 
 /// Shadow-map side in texels. The seeds evaluate 512 against 1024x1024 output.
@@ -150,13 +160,13 @@ impl ShadowMap {
         let uniform = gpu.uniform("sm.params", &params);
         let depth_layout = binding::layout(d, "sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_group = binding::group(d, "sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
-        let depth_pipeline = raster::scene_pipeline(gpu, "sm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
+        let depth_pipeline = raster::scene_pipeline(gpu, "sm.depth", &depth_source(), &[&depth_layout, &scene.layout], &[]);
         let eval_layout = view_layout(
             gpu,
             "sm.eval",
             &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
         );
-        let eval_pipeline = gpu.compute_pipeline("sm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let eval_pipeline = gpu.compute_pipeline("sm.eval", &eval_source(), "main", &[&eval_layout]);
         let sampler = raster::comparison_sampler(gpu, "sm.cmp");
         let counts = gpu.storage("sm.counts", res as u64 * res as u64 * 4);
         Ok(ShadowMap {
