@@ -46,12 +46,12 @@ pub const PAD_MARGIN_TEXELS: f64 = 1.0;
 /// `sm`'s parameters (same keys, defaults, docs and sources; the order is checked by a test),
 /// then the reduction grid.
 pub const PARAMS: &[ParamDef] = &[
-    sm::PARAMS[0], // res
-    sm::PARAMS[1], // pcf
-    sm::PARAMS[2], // bias
-    sm::PARAMS[3], // slope_bias
-    sm::PARAMS[4], // max_slope
-    sm::PARAMS[5], // normal_offset
+    sm::RES,
+    sm::PCF,
+    sm::BIAS,
+    sm::SLOPE_BIAS,
+    sm::MAX_SLOPE,
+    sm::NORMAL_OFFSET,
     ParamDef {
         key: "grid",
         default: DEFAULT_GRID,
