@@ -6,14 +6,16 @@
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
-use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::{ParamDef, ParamValues};
 
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
-use crate::techniques::{compose_view, view_layout, FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
+use crate::techniques::{compose_view, FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, raster, Gpu, GpuError};
+use crate::{Gpu, GpuError};
+
+mod pass;
+pub use pass::{DepthPass, MapPass};
 
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
@@ -134,17 +136,7 @@ pub struct SmParams {
 }
 
 pub struct ShadowMap {
-    res: u32,
-    pcf: u32,
-    params: SmParams,
-    map: wgpu::Texture,
-    counts: wgpu::Buffer,
-    uniform: wgpu::Buffer,
-    depth_pipeline: wgpu::RenderPipeline,
-    depth_group: wgpu::BindGroup,
-    eval_pipeline: wgpu::ComputePipeline,
-    eval_layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
+    pass: MapPass,
 }
 
 impl ShadowMap {
@@ -152,85 +144,23 @@ impl ShadowMap {
         let res = p.get_u32("res");
         gpu.check_size(res, res, "shadow map")?;
         let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("sm does not support point lights".into()))?;
-        let params = SmParams {
-            light_view_proj: lp.view_proj.to_cols_array_2d(),
-            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, p.get("pcf") as f32],
-            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
-        };
-        let d = &gpu.device;
-        let map = raster::depth_target(gpu, "sm.map", res, res, 1, wgpu::TextureUsages::empty());
-        let uniform = gpu.uniform("sm.params", &params);
-        let depth_layout = binding::layout(d, "sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
-        let depth_group = binding::group(d, "sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
-        let depth_pipeline = raster::scene_pipeline(gpu, "sm.depth", &depth_source(), &[&depth_layout, &scene.layout], &[]);
-        let eval_layout = view_layout(
-            gpu,
-            "sm.eval",
-            &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
-        );
-        let eval_pipeline = gpu.compute_pipeline("sm.eval", &eval_source(), "main", &[&eval_layout]);
-        let sampler = raster::comparison_sampler(gpu, "sm.cmp");
-        let counts = gpu.storage("sm.counts", res as u64 * res as u64 * 4);
-        Ok(ShadowMap {
-            res,
-            pcf: p.get_u32("pcf"),
-            params,
-            map,
-            counts,
-            uniform,
-            depth_pipeline,
-            depth_group,
-            eval_pipeline,
-            eval_layout,
-            sampler,
-        })
+        Ok(ShadowMap { pass: MapPass::new(gpu, scene, "sm", p, &lp) })
     }
 }
 
 impl Technique for ShadowMap {
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let map_view = self.map.create_view(&Default::default());
-        timer.stage(gpu, "sm.render", |enc| {
-            let mut pass = raster::begin_pass(enc, "sm.render", &[], &map_view);
-            pass.set_pipeline(&self.depth_pipeline);
-            pass.set_bind_group(0, &self.depth_group, &[]);
-            pass.set_bind_group(1, &f.scene.group, &[]);
-            pass.draw(0..f.scene.triangle_count * 3, 0..1);
-        });
+        self.pass.render(gpu, f, timer);
         Ok(())
     }
 
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let map_view = self.map.create_view(&Default::default());
-        let group = f.view_group(
-            gpu,
-            "sm.eval",
-            &self.eval_layout,
-            &[
-                self.uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&map_view),
-                wgpu::BindingResource::Sampler(&self.sampler),
-                self.counts.as_entire_binding(),
-            ],
-        );
-        timer.stage(gpu, "sm.evaluate", |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, "sm.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
-        });
+        self.pass.evaluate(gpu, f, timer);
         Ok(())
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
-        let n = (self.res * self.res) as usize;
-        let counts: Vec<u32> = gpu.read_buffer_as(&self.counts, n);
-        let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4));
-        let mut r = TechniqueReport { shadow_data_bytes: n as u64 * 4, sampling: Some(sampling_stats(&counts)), ..Default::default() };
-        r.counters.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
-        r.counters.insert("shadow_map_texels".into(), n as f64);
-        r.images.push(depth_image("shadow map (depth)", self.res, &depth));
-        r.images.push(count_image("view samples per texel", self.res, &counts));
-        let _ = self.params;
-        r
+        self.pass.report(gpu).0
     }
 }
 
