@@ -26,7 +26,12 @@ const SELECT_WGSL: &str = include_str!("select.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("mdsm/select.wgsl", compose(SELECT_WGSL, false)), ("mdsm/eval.wgsl", compose_view(EVAL_WGSL, false))]
+    vec![("mdsm/select.wgsl", compose(SELECT_WGSL, false)), ("mdsm/eval.wgsl", eval_src())]
+}
+
+/// eval.wgsl after `sm`'s bias model and sample counting (sm/bias.wgsl).
+fn eval_src() -> String {
+    compose_view(&format!("{}{EVAL_WGSL}", sm::BIAS_WGSL), false)
 }
 
 /// Depths per texel. Seed 003 demonstrates 2 and 3; 2 doubles the outcomes of every kernel
@@ -234,7 +239,7 @@ impl MultiDepthMap {
         );
         let select_pipeline = gpu.compute_pipeline("mdsm.select", &compose(SELECT_WGSL, false), "main", &[&select_layout]);
         let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
-        let eval_pipeline = gpu.compute_pipeline("mdsm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let eval_pipeline = gpu.compute_pipeline("mdsm.eval", &eval_src(), "main", &[&eval_layout]);
         let counts = gpu.storage("mdsm.counts", res as u64 * res as u64 * 4);
         Ok(MultiDepthMap { res, k, n, params, depth, nsm, counts, uniform, select_pipeline, select_group, eval_pipeline, eval_layout })
     }

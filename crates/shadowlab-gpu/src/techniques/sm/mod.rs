@@ -19,6 +19,8 @@ pub use pass::{DepthPass, MapPass};
 
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
+/// The bias model and sample counting of eval.wgsl, also composed into mdsm's evaluation.
+pub const BIAS_WGSL: &str = include_str!("bias.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![("sm/depth.wgsl", depth_source()), ("sm/eval.wgsl", eval_source())]
@@ -31,7 +33,7 @@ pub fn depth_source() -> String {
 
 /// The composed evaluation (view bindings, then `SmParams`, depth map, comparison sampler, counts).
 pub fn eval_source() -> String {
-    compose_view(EVAL_WGSL, false)
+    compose_view(&format!("{BIAS_WGSL}{EVAL_WGSL}"), false)
 }
 
 /// Shadow-map side in texels. The seeds evaluate 512 against 1024x1024 output.
