@@ -125,7 +125,7 @@ pub const PARAMS: &[ParamDef] = &[
     },
     ParamDef {
         key: "max_slope",
-        default: 4.0,
+        default: sm::MAX_SLOPE.default,
         min: 0.0,
         max: 1000.0,
         integer: false,
