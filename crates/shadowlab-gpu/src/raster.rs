@@ -72,6 +72,27 @@ pub fn begin_pass<'e>(
     })
 }
 
+/// A `w x h` render target of `format` that later passes sample, plus `extra_usage`.
+pub fn render_target(
+    gpu: &Gpu,
+    label: &str,
+    w: u32,
+    h: u32,
+    format: wgpu::TextureFormat,
+    extra_usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra_usage,
+        view_formats: &[],
+    })
+}
+
 /// A `w x h x layers` Depth32Float target of the shadow passes: render attachment, sampled
 /// (`texture_depth_2d[_array]`) and copyable for the report's pictures, plus `extra_usage`.
 pub fn depth_target(gpu: &Gpu, label: &str, w: u32, h: u32, layers: u32, extra_usage: wgpu::TextureUsages) -> wgpu::Texture {
