@@ -71,3 +71,53 @@ pub fn begin_pass<'e>(
         multiview_mask: None,
     })
 }
+
+/// A `w x h` render target of `format` that later passes sample, plus `extra_usage`.
+pub fn render_target(
+    gpu: &Gpu,
+    label: &str,
+    w: u32,
+    h: u32,
+    format: wgpu::TextureFormat,
+    extra_usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra_usage,
+        view_formats: &[],
+    })
+}
+
+/// A `w x h x layers` Depth32Float target of the shadow passes: render attachment, sampled
+/// (`texture_depth_2d[_array]`) and copyable for the report's pictures, plus `extra_usage`.
+pub fn depth_target(gpu: &Gpu, label: &str, w: u32, h: u32, layers: u32, extra_usage: wgpu::TextureUsages) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC | extra_usage,
+        view_formats: &[],
+    })
+}
+
+/// The shadow maps' comparison sampler: `LessEqual` against the reference depth, nearest
+/// texel (PCF is done with explicit taps), clamped to the edge.
+pub fn comparison_sampler(gpu: &Gpu, label: &str) -> wgpu::Sampler {
+    gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some(label),
+        compare: Some(wgpu::CompareFunction::LessEqual),
+        mag_filter: wgpu::FilterMode::Nearest,
+        min_filter: wgpu::FilterMode::Nearest,
+        address_mode_u: wgpu::AddressMode::ClampToEdge,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        ..Default::default()
+    })
+}

@@ -1,8 +1,10 @@
-//! Shader composition: every shader is `common.wgsl` + (optionally `scene.wgsl`) + its own file.
+//! Shader composition: every shader is `common.wgsl` + (optionally `scene.wgsl`, and for the
+//! depth-only shadow passes `depth.wgsl`) + its own file.
 //! [`all`] lists every composed shader so a CPU-only test validates each with naga.
 
 pub const COMMON: &str = include_str!("common.wgsl");
 pub const SCENE: &str = include_str!("scene.wgsl");
+pub const DEPTH: &str = include_str!("depth.wgsl");
 
 /// `common.wgsl`, then `scene.wgsl` if `with_scene`, then `body`.
 pub fn compose(body: &str, with_scene: bool) -> String {
@@ -12,6 +14,12 @@ pub fn compose(body: &str, with_scene: bool) -> String {
     }
     s.push_str(body);
     s
+}
+
+/// `common.wgsl`, `scene.wgsl`, `depth.wgsl` (vertex fetch and alpha cut-out of a depth-only
+/// pass from a light), then `body` (its uniform and entry points).
+pub fn compose_depth(body: &str) -> String {
+    compose(&format!("{DEPTH}{body}"), true)
 }
 
 /// (file name, composed source) of every shader the crate uses.

@@ -33,30 +33,17 @@ pub struct GBuffer {
     pub mask: wgpu::Buffer,
 }
 
-fn target(gpu: &Gpu, label: &str, w: u32, h: u32, format: F, extra: wgpu::TextureUsages) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra,
-        view_formats: &[],
-    })
-}
-
 impl GBuffer {
     pub fn new(gpu: &Gpu, w: u32, h: u32) -> GBuffer {
         let c = wgpu::TextureUsages::COPY_SRC;
         GBuffer {
             width: w,
             height: h,
-            position: target(gpu, "gbuffer.position", w, h, POSITION_FORMAT, c),
-            normal: target(gpu, "gbuffer.normal", w, h, NORMAL_FORMAT, c),
-            albedo: target(gpu, "gbuffer.albedo", w, h, ALBEDO_FORMAT, c),
-            motion: target(gpu, "gbuffer.motion", w, h, MOTION_FORMAT, c),
-            depth: target(gpu, "gbuffer.depth", w, h, raster::DEPTH_FORMAT, wgpu::TextureUsages::empty()),
+            position: raster::render_target(gpu, "gbuffer.position", w, h, POSITION_FORMAT, c),
+            normal: raster::render_target(gpu, "gbuffer.normal", w, h, NORMAL_FORMAT, c),
+            albedo: raster::render_target(gpu, "gbuffer.albedo", w, h, ALBEDO_FORMAT, c),
+            motion: raster::render_target(gpu, "gbuffer.motion", w, h, MOTION_FORMAT, c),
+            depth: raster::render_target(gpu, "gbuffer.depth", w, h, raster::DEPTH_FORMAT, wgpu::TextureUsages::empty()),
             mask: gpu.storage("gbuffer.mask", (w * h * 4) as u64),
         }
     }

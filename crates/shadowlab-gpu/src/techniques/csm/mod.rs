@@ -23,7 +23,7 @@ pub use params::*;
 
 use crate::reduce::{decode, MinMax};
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
+use crate::shaders::{compose, compose_depth};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
@@ -34,7 +34,7 @@ const CAMERA_WGSL: &str = include_str!("camera.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
-        ("csm/depth.wgsl", compose(DEPTH_WGSL, true)),
+        ("csm/depth.wgsl", compose_depth(DEPTH_WGSL)),
         ("csm/eval.wgsl", compose_view(EVAL_WGSL, false)),
         ("csm/camera.wgsl", compose(CAMERA_WGSL, false)),
     ]
@@ -131,16 +131,7 @@ impl Cascaded {
             )));
         }
         let d = &gpu.device;
-        let maps = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("csm.maps"),
-            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: count as u32 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: raster::DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let maps = raster::depth_target(gpu, "csm.maps", res, res, count as u32, wgpu::TextureUsages::empty());
         let params = CsmParams {
             cascades: [CascadeU::zeroed(); MAX_CASCADES],
             cfg: [count as f32, res as f32, p.get("pcf") as f32, p.get("blend") as f32],
@@ -150,7 +141,7 @@ impl Cascaded {
         let depth_layout = binding::layout(d, "csm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_uniforms: Vec<_> = (0..count).map(|_| gpu.uniform("csm.cascade", &Mat4::IDENTITY.to_cols_array_2d())).collect();
         let depth_groups = depth_uniforms.iter().map(|u| binding::group(d, "csm.depth", &depth_layout, &[u.as_entire_binding()])).collect();
-        let depth_pipeline = raster::scene_pipeline(gpu, "csm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
+        let depth_pipeline = raster::scene_pipeline(gpu, "csm.depth", &compose_depth(DEPTH_WGSL), &[&depth_layout, &scene.layout], &[]);
         let eval_layout = view_layout(
             gpu,
             "csm.eval",
@@ -159,15 +150,7 @@ impl Cascaded {
         let eval_pipeline = gpu.compute_pipeline("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
         let camera_layout = binding::layout(d, "csm.camera", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
         let camera_pipeline = gpu.compute_pipeline("csm.camera", &compose(CAMERA_WGSL, false), "main", &[&camera_layout]);
-        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("csm.cmp"),
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            mag_filter: wgpu::FilterMode::Nearest,
-            min_filter: wgpu::FilterMode::Nearest,
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            ..Default::default()
-        });
+        let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {
             count,

@@ -26,7 +26,7 @@ pub const DEFAULT_FIT: f64 = 0.0;
 pub const DEFAULT_BIAS: f64 = sm::DEFAULT_BIAS;
 pub const DEFAULT_NORMAL_OFFSET: f64 = sm::DEFAULT_NORMAL_OFFSET;
 /// Clamp on tan(angle to light) for the PCF kernel's receiver-plane bias (as `sm`'s max_slope).
-pub const MAX_SLOPE: f32 = 4.0;
+pub const MAX_SLOPE: f32 = sm::MAX_SLOPE.default as f32;
 
 pub const PARAMS: &[ParamDef] = &[
     ParamDef {

@@ -7,7 +7,7 @@ use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::gpu::Iasm;
 use super::{eval_atlas_src, ATLAS_WGSL};
-use crate::shaders::compose;
+use crate::shaders::compose_depth;
 use crate::techniques::{view_layout, FrameInputs};
 use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
@@ -27,18 +27,9 @@ pub(super) fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Resul
     let (w, h, slots) =
         core::atlas_layout(&THESIS_RESOLUTIONS).ok_or_else(|| GpuError::Invalid("iasm: resolution set does not fit an atlas".into()))?;
     gpu.check_size(w, h, "iasm atlas")?;
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("iasm.atlas"),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: raster::DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let texture = raster::depth_target(gpu, "iasm.atlas", w, h, 1, wgpu::TextureUsages::empty());
     let view = texture.create_view(&Default::default());
-    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose(ATLAS_WGSL, true), layouts, &[]);
+    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose_depth(ATLAS_WGSL), layouts, &[]);
     let eval_layout = view_layout(gpu, "iasm.eval_atlas", &[binding::uniform(), binding::texture_depth(), binding::storage(false)]);
     let eval = gpu.compute_pipeline("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout]);
     Ok(Atlas { texture, view, slots, pipeline, eval_layout, eval })

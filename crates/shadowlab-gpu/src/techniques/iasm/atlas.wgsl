@@ -9,25 +9,14 @@ struct TileParams {
 
 @group(0) @binding(0) var<uniform> tp: TileParams;
 
-struct VsOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) uv: vec2<f32>,
-    @location(1) @interpolate(flat) material: u32,
-}
-
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
-    let v = vertices[vi];
-    var o: VsOut;
-    o.clip = tp.view_proj * vec4<f32>(v.pos, 1.0);
-    o.uv = v.uv;
-    o.material = v.material;
-    return o;
+fn vs_main(@builtin(vertex_index) vi: u32) -> DepthVsOut {
+    return depth_vertex(vi, tp.view_proj);
 }
 
 @fragment
-fn fs_main(in: VsOut) {
-    if cut_out(materials[in.material], in.uv) {
+fn fs_main(in: DepthVsOut) {
+    if depth_cut_out(in) {
         discard;
     }
 }

@@ -13,7 +13,7 @@ use super::chunks::chunk_bounds;
 use super::plan::{Plan, TileStats};
 use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, RENDER_WGSL};
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
+use crate::shaders::compose_depth;
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
@@ -345,7 +345,7 @@ impl Technique for Iasm {
 }
 
 fn render_pipeline(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
-    let module = gpu.shader("iasm.render", &compose(RENDER_WGSL, true));
+    let module = gpu.shader("iasm.render", &compose_depth(RENDER_WGSL));
     let layout = gpu.pipeline_layout("iasm.render", layouts);
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("iasm.render"),

@@ -20,8 +20,8 @@ mod plan;
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::params::{ParamDef, BOOL};
 
-use crate::shaders::compose;
-use crate::techniques::{compose_view, TechniqueInfo};
+use crate::shaders::{compose, compose_depth};
+use crate::techniques::{compose_view, sm, TechniqueInfo};
 
 pub use gpu::Iasm;
 
@@ -50,11 +50,11 @@ fn probe_src() -> String {
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
         ("iasm/analysis.wgsl", analysis_src()),
-        ("iasm/render.wgsl", compose(RENDER_WGSL, true)),
+        ("iasm/render.wgsl", compose_depth(RENDER_WGSL)),
         ("iasm/eval.wgsl", eval_src()),
         ("iasm/bounds.wgsl", compose(BOUNDS_WGSL, true)),
         ("iasm/probe.wgsl", probe_src()),
-        ("iasm/atlas.wgsl", compose(ATLAS_WGSL, true)),
+        ("iasm/atlas.wgsl", compose_depth(ATLAS_WGSL)),
         ("iasm/eval_atlas.wgsl", eval_atlas_src()),
     ]
 }
@@ -72,10 +72,10 @@ pub const DEFAULT_K: f64 = 0.0;
 /// Too small: geometry ahead falls outside (lit); too large: coarse tiles.
 pub const DEFAULT_SIZE: f64 = 0.0;
 /// Constant bias in texels of the tile (as `sm`); 0.5 from `sm`'s sweep.
-pub const DEFAULT_BIAS: f64 = 0.5;
+pub const DEFAULT_BIAS: f64 = sm::DEFAULT_BIAS;
 /// Normal offset in texels of the tile (as `sm`); 0.5 from `sm`'s sweep; low: acne at grazing
 /// light, high: shifted shadows.
-pub const DEFAULT_NORMAL_OFFSET: f64 = 0.5;
+pub const DEFAULT_NORMAL_OFFSET: f64 = sm::DEFAULT_NORMAL_OFFSET;
 /// Where the tiles' depth lives: 0 = buffer (the thesis's linear storage buffer, exactly the
 /// set's 6,860,800 bytes, fragments write by atomic max: no early depth test), 1 = atlas (the
 /// same tiles in a 2048 x 1024 Depth32Float atlas, 8,388,608 bytes, hardware depth test). The

@@ -46,26 +46,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let ires = i32(res);
 
     // sampling statistics: the texel this view sample lands in
-    let m0 = to_map(p);
-    if all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
-        let t = vec2<u32>(m0.xy * res);
-        atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
-    }
+    count_sample(to_map(p), res);
 
-    // world size of one texel at p
-    var texel = md.texel.x;
-    if md.texel.y > 0.5 {
-        texel = md.texel.x * max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
-    }
-    let cos_t = clamp(dot(nrm, l), 1e-4, 1.0);
-    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, md.bias.w);
+    // `sm`'s bias (bias.wgsl), the kernel's and the search region's reach added
     let kw = i32(md.texel.w);
     let half = f32(kw - 1) * 0.5;
     var reach = half;
     if md.sel.w == 1u {
         reach += f32(md.sel.y - 1u) * 0.5;
     }
-    let q = p + nrm * (md.bias.z * texel) + l * ((md.bias.x + (md.bias.y + reach) * tan_t) * texel);
+    let q = biased_point(p, nrm, l, texel_at(md.texel, p), md.bias, reach);
     let m = to_map(q);
     if any(m.xy < vec2<f32>(0.0)) || any(m.xy > vec2<f32>(1.0)) || m.z > 1.0 {
         visibility[i] = 1.0;

@@ -17,25 +17,21 @@ use shadowlab_core::params::{ParamDef, ParamValues, BOOL};
 
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
-use crate::techniques::sm::{self, count_image, depth_image, SmParams};
+use crate::techniques::sm::{self, count_image, depth_image, DepthPass, SmParams};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, raster, Gpu, GpuError};
+use crate::{binding, Gpu, GpuError};
 
 const SELECT_WGSL: &str = include_str!("select.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("mdsm/select.wgsl", compose(SELECT_WGSL, false)), ("mdsm/eval.wgsl", compose_view(EVAL_WGSL, false))]
+    vec![("mdsm/select.wgsl", compose(SELECT_WGSL, false)), ("mdsm/eval.wgsl", eval_src())]
 }
 
-/// `sm`'s depth pass (same shader, same `SmParams`), so the base map is `sm`'s map.
-fn sm_depth_wgsl() -> Result<String, GpuError> {
-    sm::shaders()
-        .into_iter()
-        .find(|(name, _)| *name == "sm/depth.wgsl")
-        .map(|(_, src)| src)
-        .ok_or_else(|| GpuError::Invalid("mdsm: sm/depth.wgsl not found".into()))
+/// eval.wgsl after `sm`'s bias model and sample counting (sm/bias.wgsl).
+fn eval_src() -> String {
+    compose_view(&format!("{}{EVAL_WGSL}", sm::BIAS_WGSL), false)
 }
 
 /// Depths per texel. Seed 003 demonstrates 2 and 3; 2 doubles the outcomes of every kernel
@@ -129,7 +125,7 @@ pub const PARAMS: &[ParamDef] = &[
     },
     ParamDef {
         key: "max_slope",
-        default: 4.0,
+        default: sm::MAX_SLOPE.default,
         min: 0.0,
         max: 1000.0,
         integer: false,
@@ -178,12 +174,11 @@ pub struct MultiDepthMap {
     k: u32,
     n: u32,
     params: MdsmParams,
-    base: wgpu::Texture,
+    /// `sm`'s depth pass: the base map.
+    depth: DepthPass,
     nsm: wgpu::Texture,
     counts: wgpu::Buffer,
     uniform: wgpu::Buffer,
-    depth_pipeline: wgpu::RenderPipeline,
-    depth_group: wgpu::BindGroup,
     select_pipeline: wgpu::ComputePipeline,
     select_group: wgpu::BindGroup,
     eval_pipeline: wgpu::ComputePipeline,
@@ -205,36 +200,27 @@ impl MultiDepthMap {
         Select::from_index(strategy).ok_or_else(|| GpuError::Invalid(format!("mdsm: select index {strategy} unknown")))?;
         let lp =
             lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("mdsm does not support point lights".into()))?;
-        let bias = [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32];
         let region = if n > 1 { qw } else { 1 };
+        // the depth pass reads only light_view_proj; the rest mirrors what sm would hold
+        let sm_params = SmParams::new(&lp, res, kw as f32, p);
         let params = MdsmParams {
-            light_view_proj: lp.view_proj.to_cols_array_2d(),
-            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, kw as f32],
-            bias,
+            light_view_proj: sm_params.light_view_proj,
+            texel: sm_params.texel,
+            bias: sm_params.bias,
             sel: [n, region, strategy, (p.get_bool("region_bias") && n > 1) as u32],
         };
-        // the depth pass reads only light_view_proj; the rest mirrors what sm would hold
-        let sm_params = SmParams { light_view_proj: params.light_view_proj, texel: params.texel, bias };
         let d = &gpu.device;
-        let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-            d.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: usage | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        };
-        let base = texture("mdsm.base", raster::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-        let nsm = texture("mdsm.nsm", wgpu::TextureFormat::Rgba32Float, wgpu::TextureUsages::STORAGE_BINDING);
-
-        let depth_uniform = gpu.uniform("mdsm.depth_params", &sm_params);
-        let depth_layout = binding::layout(d, "mdsm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
-        let depth_group = binding::group(d, "mdsm.depth", &depth_layout, &[depth_uniform.as_entire_binding()]);
-        let depth_pipeline = raster::scene_pipeline(gpu, "mdsm.depth", &sm_depth_wgsl()?, &[&depth_layout, &scene.layout], &[]);
+        let depth = DepthPass::new(gpu, scene, "mdsm", res, &sm_params);
+        let nsm = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mdsm.nsm"),
+            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
 
         let uniform = gpu.uniform("mdsm.params", &params);
         let storage_out = wgpu::BindingType::StorageTexture {
@@ -244,33 +230,18 @@ impl MultiDepthMap {
         };
         let select_layout =
             binding::layout(d, "mdsm.select", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::texture_depth(), storage_out]);
-        let (base_view, nsm_view) = (base.create_view(&Default::default()), nsm.create_view(&Default::default()));
+        let (depth_view, nsm_view) = (depth.map.create_view(&Default::default()), nsm.create_view(&Default::default()));
         let select_group = binding::group(
             d,
             "mdsm.select",
             &select_layout,
-            &[uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&base_view), wgpu::BindingResource::TextureView(&nsm_view)],
+            &[uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&depth_view), wgpu::BindingResource::TextureView(&nsm_view)],
         );
         let select_pipeline = gpu.compute_pipeline("mdsm.select", &compose(SELECT_WGSL, false), "main", &[&select_layout]);
         let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
-        let eval_pipeline = gpu.compute_pipeline("mdsm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let eval_pipeline = gpu.compute_pipeline("mdsm.eval", &eval_src(), "main", &[&eval_layout]);
         let counts = gpu.storage("mdsm.counts", res as u64 * res as u64 * 4);
-        Ok(MultiDepthMap {
-            res,
-            k,
-            n,
-            params,
-            base,
-            nsm,
-            counts,
-            uniform,
-            depth_pipeline,
-            depth_group,
-            select_pipeline,
-            select_group,
-            eval_pipeline,
-            eval_layout,
-        })
+        Ok(MultiDepthMap { res, k, n, params, depth, nsm, counts, uniform, select_pipeline, select_group, eval_pipeline, eval_layout })
     }
 
     /// The uniform as uploaded (projection, bias, selection settings).
@@ -280,7 +251,7 @@ impl MultiDepthMap {
 
     /// Reads back the base depth map (row-major, `res x res`).
     pub fn read_base(&self, gpu: &Gpu) -> Vec<f32> {
-        bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.base, 4))
+        self.depth.read(gpu)
     }
 
     /// Reads back the n-SM: per texel Z1 >= ... >= Zn, unused channels repeating Zn.
@@ -291,14 +262,7 @@ impl MultiDepthMap {
 
 impl Technique for MultiDepthMap {
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let base_view = self.base.create_view(&Default::default());
-        timer.stage(gpu, "mdsm.render", |enc| {
-            let mut pass = raster::begin_pass(enc, "mdsm.render", &[], &base_view);
-            pass.set_pipeline(&self.depth_pipeline);
-            pass.set_bind_group(0, &self.depth_group, &[]);
-            pass.set_bind_group(1, &f.scene.group, &[]);
-            pass.draw(0..f.scene.triangle_count * 3, 0..1);
-        });
+        self.depth.render(gpu, f, timer);
         timer.stage(gpu, "mdsm.select", |enc| {
             gpu.dispatch_2d(enc, "mdsm.select", &self.select_pipeline, &[&self.select_group], self.res, self.res)
         });

@@ -13,19 +13,15 @@ use bytemuck::Zeroable;
 use shadowlab_core::calipers::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace::{self, LightProjection};
-use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::{ParamDef, ParamValues};
 use shadowlab_core::scene::Bounds;
 
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
-use crate::techniques::sm::{self, count_image, depth_image, SmParams};
+use crate::techniques::sm::{self, MapPass};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, raster, Gpu, GpuError};
+use crate::{binding, Gpu, GpuError};
 
-const DEPTH_WGSL: &str = include_str!("../sm/depth.wgsl");
-const EVAL_WGSL: &str = include_str!("../sm/eval.wgsl");
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
 
 /// min-sm's own shader (the depth and evaluation shaders are `sm`'s files, validated there).
@@ -49,12 +45,12 @@ pub const PAD_MARGIN_TEXELS: f64 = 1.0;
 /// `sm`'s parameters (same keys, defaults, docs and sources; the order is checked by a test),
 /// then the reduction grid.
 pub const PARAMS: &[ParamDef] = &[
-    sm::PARAMS[0], // res
-    sm::PARAMS[1], // pcf
-    sm::PARAMS[2], // bias
-    sm::PARAMS[3], // slope_bias
-    sm::PARAMS[4], // max_slope
-    sm::PARAMS[5], // normal_offset
+    sm::RES,
+    sm::PCF,
+    sm::BIAS,
+    sm::SLOPE_BIAS,
+    sm::MAX_SLOPE,
+    sm::NORMAL_OFFSET,
     ParamDef {
         key: "grid",
         default: DEFAULT_GRID,
@@ -108,8 +104,9 @@ pub struct MsfReduce {
 }
 
 pub struct MinShadowMap {
+    /// `sm`'s depth pass and evaluation, pointed at the fitted rectangle every frame.
+    pass: MapPass,
     res: u32,
-    pcf: u32,
     grid: u32,
     shape: RectFit,
     one_pass: bool,
@@ -122,19 +119,10 @@ pub struct MinShadowMap {
     /// `sm`'s scene-fitted projection: used when no sample is evaluated, and for comparisons.
     scene_fit: LightProjection,
     pad_texels: f64,
-    params: SmParams,
     last: Option<MinFrustum>,
     /// CPU fit time of every frame so far (ms).
     fit_ms: Vec<f64>,
     last_count: u64,
-    map: wgpu::Texture,
-    counts: wgpu::Buffer,
-    uniform: wgpu::Buffer,
-    depth_pipeline: wgpu::RenderPipeline,
-    depth_group: wgpu::BindGroup,
-    eval_pipeline: wgpu::ComputePipeline,
-    eval_layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
     reduce_uniform: wgpu::Buffer,
     reduce_layout: wgpu::BindGroupLayout,
     bounds_pipeline: wgpu::ComputePipeline,
@@ -151,41 +139,8 @@ impl MinShadowMap {
         let scene_fit = lightspace::fit(light, &scene.bounds, res).ok_or_else(no_point)?;
         let frame = frustum::light_frame(light, &scene.bounds).ok_or_else(no_point)?;
         let (pcf, grid) = (p.get_u32("pcf"), p.get_u32("grid"));
-        let params = SmParams {
-            light_view_proj: scene_fit.view_proj.to_cols_array_2d(),
-            texel: [scene_fit.texel, scene_fit.perspective as u32 as f32, res as f32, pcf as f32],
-            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
-        };
+        let pass = MapPass::new(gpu, scene, "min-sm", p, &scene_fit);
         let d = &gpu.device;
-        let map = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("min-sm.map"),
-            size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: raster::DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let uniform = gpu.uniform("min-sm.params", &params);
-        let depth_layout = binding::layout(d, "min-sm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
-        let depth_group = binding::group(d, "min-sm.depth", &depth_layout, &[uniform.as_entire_binding()]);
-        let depth_pipeline = raster::scene_pipeline(gpu, "min-sm.depth", &compose(DEPTH_WGSL, true), &[&depth_layout, &scene.layout], &[]);
-        let eval_layout = view_layout(
-            gpu,
-            "min-sm.eval",
-            &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
-        );
-        let eval_pipeline = gpu.compute_pipeline("min-sm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
-        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("min-sm.cmp"),
-            compare: Some(wgpu::CompareFunction::LessEqual),
-            mag_filter: wgpu::FilterMode::Nearest,
-            min_filter: wgpu::FilterMode::Nearest,
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            ..Default::default()
-        });
         let reduce = MsfReduce {
             frame_view: frame.view.as_mat4().to_cols_array_2d(),
             mode: [frame.perspective as u32, grid, RUN, 0],
@@ -206,8 +161,8 @@ impl MinShadowMap {
         });
         let pad_texels = p.get("normal_offset") + (pcf as f64 - 1.0) * 0.5 + PAD_MARGIN_TEXELS;
         Ok(MinShadowMap {
+            pass,
             res,
-            pcf,
             grid,
             shape: if p.get_u32("fit") == 1 { RectFit::Side } else { RectFit::Area },
             one_pass: p.get_bool("one_pass"),
@@ -218,18 +173,9 @@ impl MinShadowMap {
             frame,
             scene_fit,
             pad_texels,
-            params,
             last: None,
             fit_ms: Vec::new(),
             last_count: 0,
-            map,
-            counts: gpu.storage("min-sm.counts", res as u64 * res as u64 * 4),
-            uniform,
-            depth_pipeline,
-            depth_group,
-            eval_pipeline,
-            eval_layout,
-            sampler,
             reduce_uniform,
             reduce_layout,
             bounds_pipeline,
@@ -292,57 +238,27 @@ impl Technique for MinShadowMap {
             Some(m) => (m.view_proj_f32(), m.texel as f32, m.perspective),
             None => (self.scene_fit.view_proj, self.scene_fit.texel, self.scene_fit.perspective),
         };
-        self.params.light_view_proj = vp.to_cols_array_2d();
-        self.params.texel[0] = texel;
-        self.params.texel[1] = persp as u32 as f32;
         let fit_ms = t1.elapsed().as_secs_f64() * 1e3;
         self.fit_ms.push(fit_ms);
         timer.add("min-sm.fit", fit_ms);
-        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        self.pass.set_projection(gpu, vp, texel, persp);
         Ok(())
     }
 
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let map_view = self.map.create_view(&Default::default());
-        timer.stage(gpu, "min-sm.render", |enc| {
-            let mut pass = raster::begin_pass(enc, "min-sm.render", &[], &map_view);
-            pass.set_pipeline(&self.depth_pipeline);
-            pass.set_bind_group(0, &self.depth_group, &[]);
-            pass.set_bind_group(1, &f.scene.group, &[]);
-            pass.draw(0..f.scene.triangle_count * 3, 0..1);
-        });
+        self.pass.render(gpu, f, timer);
         Ok(())
     }
 
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let map_view = self.map.create_view(&Default::default());
-        let group = f.view_group(
-            gpu,
-            "min-sm.eval",
-            &self.eval_layout,
-            &[
-                self.uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&map_view),
-                wgpu::BindingResource::Sampler(&self.sampler),
-                self.counts.as_entire_binding(),
-            ],
-        );
-        timer.stage(gpu, "min-sm.evaluate", |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, "min-sm.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
-        });
+        self.pass.evaluate(gpu, f, timer);
         Ok(())
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
-        let n = (self.res * self.res) as usize;
-        let counts: Vec<u32> = gpu.read_buffer_as(&self.counts, n);
-        let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4));
-        let mut r = TechniqueReport { shadow_data_bytes: n as u64 * 4, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+        let (mut r, counts) = self.pass.report(gpu);
         let in_map: u64 = counts.iter().map(|&c| c as u64).sum();
         let c = &mut r.counters;
-        c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
-        c.insert("shadow_map_texels".into(), n as f64);
         c.insert("view_samples".into(), self.last_count as f64);
         c.insert("samples_in_map".into(), in_map as f64);
         c.insert("samples_outside_map".into(), self.last_count.saturating_sub(in_map) as f64);
@@ -359,8 +275,6 @@ impl Technique for MinShadowMap {
             c.insert("texel_vs_sm".into(), m.texel / self.scene_fit.texel as f64);
             c.insert("rect_aspect".into(), m.padded.half.max_element() / m.padded.half.min_element().max(1e-30));
         }
-        r.images.push(depth_image("shadow map (depth)", self.res, &depth));
-        r.images.push(count_image("view samples per texel", self.res, &counts));
         r
     }
 }

@@ -33,24 +33,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let res = sm.texel.z;
 
     // sampling statistics: the texel this view sample lands in
-    let m0 = to_map(p);
-    if all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
-        let t = vec2<u32>(m0.xy * res);
-        atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
-    }
+    count_sample(to_map(p), res);
 
-    // world size of one texel at p
-    var texel = sm.texel.x;
-    if sm.texel.y > 0.5 {
-        texel = sm.texel.x * max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
-    }
-    let cos_t = clamp(dot(n, l), 1e-4, 1.0);
-    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, sm.bias.w);
-    // PCF taps up to `half` texels away see a sloped receiver `half * tan` texels deeper:
-    // that much slope bias is added for the kernel (receiver-plane bias, Isidoro 2006).
+    // the PCF kernel reaches `half` texels from the sample (bias.wgsl)
     let k = i32(sm.texel.w);
     let half = f32(k - 1) * 0.5;
-    let q = p + n * (sm.bias.z * texel) + l * ((sm.bias.x + (sm.bias.y + half) * tan_t) * texel);
+    let q = biased_point(p, n, l, texel_at(sm.texel, p), sm.bias, half);
     let m = to_map(q);
     if any(m.xy < vec2<f32>(0.0)) || any(m.xy > vec2<f32>(1.0)) || m.z > 1.0 {
         visibility[i] = 1.0;

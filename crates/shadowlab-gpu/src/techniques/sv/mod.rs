@@ -23,7 +23,7 @@ use shadowlab_core::params::{ParamDef, ParamValues};
 use crate::scene_gpu::GpuScene;
 use crate::techniques::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
-use crate::{binding, Gpu, GpuError};
+use crate::{binding, raster, Gpu, GpuError};
 use pipelines::{dispatch_1d, Pipelines, LIT_FORMAT};
 
 pub use pipelines::shaders;
@@ -167,20 +167,8 @@ impl ShadowVolumes {
 
     fn targets(&mut self, gpu: &Gpu, w: u32, h: u32) -> &Targets {
         if self.targets.as_ref().is_none_or(|t| (t.width, t.height) != (w, h)) {
-            let tex = |label, format| {
-                gpu.device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                })
-            };
-            let depth = tex("sv.depth_stencil", self.depth_format);
-            let lit = tex("sv.lit", LIT_FORMAT);
+            let depth = raster::render_target(gpu, "sv.depth_stencil", w, h, self.depth_format, wgpu::TextureUsages::empty());
+            let lit = raster::render_target(gpu, "sv.lit", w, h, LIT_FORMAT, wgpu::TextureUsages::empty());
             self.targets = Some(Targets { width: w, height: h, depth, lit });
         }
         self.targets.as_ref().unwrap()
