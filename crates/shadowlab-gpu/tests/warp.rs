@@ -8,8 +8,8 @@ use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::warp;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::prefix_sum::{PrefixSum, ScanParams};
-use shadowlab_gpu::techniques::warp::{Variant, Warped};
 use shadowlab_gpu::techniques;
+use shadowlab_gpu::techniques::warp::{Variant, Warped};
 use shadowlab_gpu::timing::StageTimer;
 use wgpu::BufferUsages;
 

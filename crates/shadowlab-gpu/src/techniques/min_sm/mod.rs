@@ -264,7 +264,7 @@ impl Technique for MinShadowMap {
         c.insert("samples_outside_map".into(), self.last_count.saturating_sub(in_map) as f64);
         // median and max over the frames run so far (a single frame can be preempted)
         c.insert("cpu_fit_ms".into(), crate::timing::median(&self.fit_ms));
-        c.insert("cpu_fit_ms_max".into(), self.fit_ms.iter().copied().fold(0.0, f64::max));
+        c.insert("cpu_fit_max_ms".into(), self.fit_ms.iter().copied().fold(0.0, f64::max));
         c.insert("readback_bytes".into(), self.red.size() as f64);
         c.insert("fallback_scene_fit".into(), self.last.is_none() as u32 as f64);
         c.insert("reduce_passes".into(), self.last_passes as f64);
