@@ -80,7 +80,7 @@ fn memory_and_split_counters_are_exact() {
     assert!((used - 1.0).abs() < 1e-9, "every evaluated pixel used one cascade: {used}");
     assert_eq!(run.report.images.iter().filter(|i| i.name.ends_with("depth")).count(), 3);
 
-    // untightened: the camera read back from the frame uniform gives near and far exactly
+    // untightened: the camera's own near and far bound the splits
     let run = lab.run(&v, &spec("csm:cascades=4,res=512,tighten=false"), 1).unwrap();
     let c = &run.report.counters;
     assert_eq!(run.report.shadow_data_bytes, 4 * 512 * 512 * 4);

@@ -5,16 +5,16 @@
 //! texel-snapped; optionally only the depth range present in the G-buffer is split.
 //! Stored depth: orthographic (linear), 0 = near the light.
 //!
-//! Per frame: `prepare` copies the camera out of the frame uniform and reduces the G-buffer's
-//! linear depth to [min, max] on the GPU, reads both back (one device sync, timed as
-//! `csm.readback`) and fits the boxes on the CPU (`shadowlab_core::cascades`); `render` draws
+//! Per frame: `prepare` (with `tighten`) reduces the G-buffer's linear depth to [min, max] on
+//! the GPU and reads it back (one device sync, timed as `csm.readback`), then fits the boxes to
+//! the view's camera on the CPU (`shadowlab_core::cascades`); `render` draws
 //! the scene once per cascade; `evaluate` picks the cascade per pixel by view depth.
 
 mod params;
 mod report;
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 use shadowlab_core::cascades::{self, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
@@ -23,21 +23,16 @@ pub use params::*;
 
 use crate::reduce::{decode, MinMax};
 use crate::scene_gpu::GpuScene;
-use crate::shaders::{compose, compose_depth};
+use crate::shaders::compose_depth;
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
-const CAMERA_WGSL: &str = include_str!("camera.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![
-        ("csm/depth.wgsl", compose_depth(DEPTH_WGSL)),
-        ("csm/eval.wgsl", compose_view(EVAL_WGSL, false)),
-        ("csm/camera.wgsl", compose(CAMERA_WGSL, false)),
-    ]
+    vec![("csm/depth.wgsl", compose_depth(DEPTH_WGSL)), ("csm/eval.wgsl", compose_view(EVAL_WGSL, false))]
 }
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -71,9 +66,8 @@ pub struct CsmParams {
     pub bias: [f32; 4],
 }
 
-/// Bytes of the probe buffer the CPU reads each frame: camera (5 vec4) + min/max words.
-const PROBE_CAMERA: u64 = 80;
-const PROBE_BYTES: u64 = PROBE_CAMERA + 8;
+/// Bytes of the probe buffer the CPU reads each frame with `tighten`: the min/max words.
+const PROBE_BYTES: u64 = 8;
 
 pub struct Cascaded {
     count: usize,
@@ -99,8 +93,6 @@ pub struct Cascaded {
     eval_pipeline: wgpu::ComputePipeline,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
-    camera_pipeline: wgpu::ComputePipeline,
-    camera_layout: wgpu::BindGroupLayout,
     reduce: MinMax,
     probe: wgpu::Buffer,
 }
@@ -148,8 +140,6 @@ impl Cascaded {
             &[binding::uniform(), texture_depth_array(), binding::comparison_sampler(), binding::storage(false), binding::storage(false)],
         );
         let eval_pipeline = gpu.compute_pipeline("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
-        let camera_layout = binding::layout(d, "csm.camera", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
-        let camera_pipeline = gpu.compute_pipeline("csm.camera", &compose(CAMERA_WGSL, false), "main", &[&camera_layout]);
         let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {
@@ -175,8 +165,6 @@ impl Cascaded {
             eval_pipeline,
             eval_layout,
             sampler,
-            camera_pipeline,
-            camera_layout,
             reduce: MinMax::new(gpu, "csm.reduce", 3),
             probe: gpu.storage("csm.probe", PROBE_BYTES),
         })
@@ -198,38 +186,24 @@ impl Cascaded {
 }
 
 impl Technique for Cascaded {
-    /// Camera copy + depth reduction on the GPU, one readback, the fit on the CPU.
+    /// Depth reduction on the GPU and one readback (with `tighten`), the fit on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let group =
-            binding::group(&gpu.device, "csm.camera", &self.camera_layout, &[f.frame.as_entire_binding(), self.probe.as_entire_binding()]);
-        timer.stage(gpu, "csm.analyze", |enc| {
-            enc.clear_buffer(&self.probe, 0, None);
-            {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("csm.camera"), timestamp_writes: None });
-                pass.set_pipeline(&self.camera_pipeline);
-                pass.set_bind_group(0, &group, &[]);
-                pass.dispatch_workgroups(1, 1, 1);
-            }
-            if self.tighten {
+        self.depth_range = None;
+        if self.tighten {
+            timer.stage(gpu, "csm.analyze", |enc| {
                 self.reduce.record(gpu, enc, "csm.reduce", &f.gbuffer.position, &f.gbuffer.mask);
-                enc.copy_buffer_to_buffer(&self.reduce.result, 0, &self.probe, PROBE_CAMERA, 8);
-            }
-        });
-        let t0 = std::time::Instant::now();
-        let words: Vec<u32> = gpu.read_buffer_as(&self.probe, (PROBE_BYTES / 4) as usize);
-        timer.add("csm.readback", t0.elapsed().as_secs_f64() * 1e3);
+                enc.copy_buffer_to_buffer(&self.reduce.result, 0, &self.probe, 0, PROBE_BYTES);
+            });
+            let t0 = std::time::Instant::now();
+            let words: Vec<u32> = gpu.read_buffer_as(&self.probe, 2);
+            timer.add("csm.readback", t0.elapsed().as_secs_f64() * 1e3);
+            self.depth_range = decode([words[0], words[1]]);
+        }
 
         let t0 = std::time::Instant::now();
-        let v: Vec<f32> = words[..20].iter().map(|w| f32::from_bits(*w)).collect();
-        let view_proj = Mat4::from_cols(
-            Vec4::from_slice(&v[0..4]),
-            Vec4::from_slice(&v[4..8]),
-            Vec4::from_slice(&v[8..12]),
-            Vec4::from_slice(&v[12..16]),
-        );
-        let frustum = ViewFrustum::from_view_proj(view_proj, Vec3::from_slice(&v[16..19]))
+        let view_proj = f.camera.view_proj(f.gbuffer.width, f.gbuffer.height);
+        let frustum = ViewFrustum::from_view_proj(view_proj, f.camera.position)
             .ok_or_else(|| GpuError::Invalid("csm: the view's projection is not a perspective frustum".into()))?;
-        self.depth_range = if self.tighten { decode([words[20], words[21]]) } else { None };
         let (near, far) = cascades::depth_range(frustum.near, frustum.far, self.depth_range);
         let splits = if self.manual.is_empty() {
             cascades::practical_splits(near, far, self.count, self.lambda)
