@@ -2,6 +2,15 @@
 // cropped to the desired view and moved by the warp textures; depth stays the base projection's
 // post-projective depth (0 = near the light). With subdivision on, the vertices come from the
 // pieces of subdiv.wgsl.
+//
+// `exact_depth` (wp.flags.z): the rasteriser interpolates depth linearly between warped
+// vertices, which is wrong inside a piece by up to the subdivision threshold. The stored depth
+// d = clip_to_map(base_clip(p)).z of a point p on a plane is an affine function of its base
+// (cropped, unwarped) map coordinates u, for orthographic and perspective (spot) projections
+// alike: a projective map sends planes to planes. So the vertex stage passes the plane
+// d = dot(g, u) + c of the piece's triangle (flat) and the unwarped u (screen-linear, a first
+// guess); depth_exact.wgsl inverts the warp at the fragment by Newton steps and writes the
+// plane's depth there.
 
 @group(0) @binding(10) var<storage, read> pieces: array<vec4<u32>>;
 
@@ -9,6 +18,17 @@ struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
     @location(1) @interpolate(flat) material: u32,
+    // exact depth: the unwarped cropped map coordinate (initial guess of the inversion)
+    @location(2) @interpolate(linear) u: vec2<f32>,
+    // exact depth: plane gradient (x, y) and offset (z); w = 1 when valid
+    @location(3) @interpolate(flat) plane: vec4<f32>,
+    // exact depth: the piece corners' depth range (the exact depth is clamped to it)
+    @location(4) @interpolate(flat) zrange: vec2<f32>,
+}
+
+fn bary_pos(tri: u32, b: vec2<f32>) -> vec3<f32> {
+    let v0 = vertices[3u * tri].pos;
+    return v0 + (vertices[3u * tri + 1u].pos - v0) * b.x + (vertices[3u * tri + 2u].pos - v0) * b.y;
 }
 
 // Corner c of a subdivision piece (triangle, three unorm16x2 barycentrics; subdiv.wgsl).
@@ -23,24 +43,66 @@ fn piece_vertex(p: vec4<u32>, c: u32) -> Vertex {
     return v;
 }
 
+// Plane d = dot(g, u) + c through three points (u, d); w = 0 when the triangle is seen edge-on
+// from the light (its projected edges nearly parallel: depth undefined) or a point is behind it.
+fn depth_plane(a: array<vec4<f32>, 3>, r: vec4<f32>) -> vec4<f32> {
+    if min(min(a[0].w, a[1].w), a[2].w) <= 1e-7 {
+        return vec4<f32>(0.0);
+    }
+    let m0 = clip_to_map(a[0]);
+    let m1 = clip_to_map(a[1]);
+    let m2 = clip_to_map(a[2]);
+    let u0 = to_dv(m0.xy, r);
+    let e1 = to_dv(m1.xy, r) - u0;
+    let e2 = to_dv(m2.xy, r) - u0;
+    let det = e1.x * e2.y - e1.y * e2.x;
+    if det * det <= EDGE_ON * dot(e1, e1) * dot(e2, e2) || det == 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let d1 = m1.z - m0.z;
+    let d2 = m2.z - m0.z;
+    let g = vec2<f32>(d1 * e2.y - d2 * e1.y, e1.x * d2 - e2.x * d1) / det;
+    return vec4<f32>(g, m0.z - dot(g, u0), 1.0);
+}
+
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     var v: Vertex;
+    var piece = vec4<u32>(vi / 3u, 0u, 0xffffu, 0xffff0000u);
     if wp.imp.w > 0.0 {
-        v = piece_vertex(pieces[vi / 3u], vi % 3u);
+        piece = pieces[vi / 3u];
+        v = piece_vertex(piece, vi % 3u);
     } else {
         v = vertices[vi];
     }
+    let r = dv_rect();
     var o: VsOut;
-    o.clip = warped_clip(v.pos, dv_rect());
+    o.clip = warped_clip(v.pos, r);
     o.uv = v.uv;
     o.material = v.material;
+    o.u = vec2<f32>(0.0);
+    o.plane = vec4<f32>(0.0);
+    o.zrange = vec2<f32>(0.0, 1.0);
+    if wp.flags.z != 0u {
+        let a = base_clip(wp, v.pos);
+        o.u = to_dv(clip_to_map(a).xy, r);
+        // the whole triangle's plane (better conditioned than a small piece's), else the piece's
+        let t = piece.x;
+        var plane = depth_plane(array<vec4<f32>, 3>(base_clip(wp, vertices[3u * t].pos), base_clip(wp, vertices[3u * t + 1u].pos),
+            base_clip(wp, vertices[3u * t + 2u].pos)), r);
+        let pc = array<vec4<f32>, 3>(base_clip(wp, bary_pos(t, unpack2x16unorm(piece.y))), base_clip(wp, bary_pos(t, unpack2x16unorm(piece.z))),
+            base_clip(wp, bary_pos(t, unpack2x16unorm(piece.w))));
+        if plane.w == 0.0 {
+            plane = depth_plane(pc, r);
+        }
+        o.plane = plane;
+        if plane.w != 0.0 {
+            let z = vec3<f32>(clip_to_map(pc[0]).z, clip_to_map(pc[1]).z, clip_to_map(pc[2]).z);
+            o.zrange = vec2<f32>(min(min(z.x, z.y), z.z), max(max(z.x, z.y), z.z));
+        }
+    }
     return o;
 }
 
-@fragment
-fn fs_main(in: VsOut) {
-    if cut_out(materials[in.material], in.uv) {
-        discard;
-    }
-}
+// sin^2 of the angle between the projected edges below which a triangle counts as edge-on.
+const EDGE_ON: f32 = 1e-6;

@@ -35,14 +35,18 @@ const PARAMS_WGSL: &str = include_str!("params.wgsl");
 const LOOKUP_WGSL: &str = include_str!("lookup.wgsl");
 const ANALYZE_WGSL: &str = include_str!("analyze.wgsl");
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
+const DEPTH_PLAIN_WGSL: &str = include_str!("depth_plain.wgsl");
+const DEPTH_EXACT_WGSL: &str = include_str!("depth_exact.wgsl");
 const SUBDIV_WGSL: &str = include_str!("subdiv.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 
 fn analyze_src() -> String {
     compose_view(&format!("{PARAMS_WGSL}{ANALYZE_WGSL}"), false)
 }
-fn depth_src() -> String {
-    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{DEPTH_WGSL}"), true)
+/// The depth pass; `exact`: the fragment stage writes the plane's depth at the inverted warp.
+fn depth_src(exact: bool) -> String {
+    let fs = if exact { DEPTH_EXACT_WGSL } else { DEPTH_PLAIN_WGSL };
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{DEPTH_WGSL}{fs}"), true)
 }
 fn subdiv_src() -> String {
     compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{SUBDIV_WGSL}"), true)
@@ -54,7 +58,8 @@ fn eval_src() -> String {
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
         ("warp/analyze.wgsl", analyze_src()),
-        ("warp/depth.wgsl", depth_src()),
+        ("warp/depth.wgsl", depth_src(false)),
+        ("warp/depth_exact.wgsl", depth_src(true)),
         ("warp/subdiv.wgsl", subdiv_src()),
         ("warp/eval.wgsl", eval_src()),
     ]
@@ -192,6 +197,7 @@ impl Warped {
             return Err(GpuError::Invalid(format!("{name}: window {window} must be below res {res}")));
         }
         let subdiv = opt("subdiv", 0.0) as f32;
+        let exact = opt("exact_depth", 0.0) != 0.0 && variant != Variant::Dv;
         let tris = scene.triangle_count;
         let limit = gpu.limits.max_storage_buffer_binding_size / 16;
         let on = subdiv > 0.0 && variant != Variant::Dv;
@@ -204,7 +210,7 @@ impl Warped {
             cfg: [p.get("dv_margin") as f32, 1.0 + opt("close_cracks", 0.0) as f32, (variant != Variant::Dv) as u32 as f32, window as f32],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
             ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
-            flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), 0, 0],
+            flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, 0],
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;
@@ -259,9 +265,9 @@ impl Warped {
         let analyze = entries.iter().map(|&e| (e, gpu.compute_pipeline(&format!("{name}.{e}"), &src, e, &[&analyze_layout]))).collect();
         let look = [(6, binding::uniform()), (7, ro), (8, tex), (9, tex)];
         let lookup_layout =
-            layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX, &[look[0], look[1], look[2], look[3], (10, ro)]);
+            layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX_FRAGMENT, &[look[0], look[1], look[2], look[3], (10, ro)]);
         let depth_pipeline =
-            raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(), &[&lookup_layout, &scene.layout], &[]);
+            raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(exact), &[&lookup_layout, &scene.layout], &[]);
         let split_layout = layout_at(
             gpu,
             &format!("{name}.subdivide"),

@@ -16,11 +16,13 @@ pub const DEFAULT_NOTW_BLUR: f64 = 8.0;
 /// NoTW uniform floor (fraction of the mean count per texel); 0 = as the seeds. Courtyard:
 /// 0.5 -> 2.9 % wrong, 2 -> 2.0 % (bias 0.5); too high: CV and used texels drift to plain sm's.
 pub const DEFAULT_MIX: f64 = 2.0;
-/// NoTW constant bias (warped texels): rasterised depth between subdivided vertices is off by
-/// up to the subdivision threshold. 512x512 views, crack-free subdivision: courtyard sun
-/// 1 -> 1.78 %, 1.5 -> 1.43, 2 -> 1.25, 3 -> 1.06; conference sun 1 -> 0.37, 1.5 -> 0.48,
-/// 2 -> 0.65, 3 -> 1.19 (leaks). 2 is the best sum.
-pub const DEFAULT_NOTW_BIAS: f64 = 2.0;
+/// NoTW constant bias (warped texels), for the default exact depth. 1024x1024 output, 512 map,
+/// six setups (docs/bench/warp.md): bias 0.5 / 1 / 1.5 / 2 sum to 9.66 / 9.22 / 9.17 / 9.39 %
+/// wrong; 1.5 beats the interpolated depth at bias 2 on all six. Low: acne on surfaces
+/// grazing the light (courtyard spot 1.92 % at 0.5), high: leaks (conference sun 0.24 % at
+/// 0.5, 0.63 at 2). With `exact_depth=false` the interpolated depth is off by up to the
+/// subdivision threshold and 2 is better (courtyard sun 1 -> 1.78 %, 2 -> 1.25, 512 view).
+pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
 /// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
 /// texels); 0 = off. Courtyard 512 view: off -> 70 % wrong (rtw and notw: the floor is two
 /// triangles); rtw 1 -> 0.58 % with 24 k pieces (crack-free subdivision); notw 2 -> 1.25 %
@@ -130,8 +132,11 @@ const W_DV: ParamDef = p(
 const W_EYE: ParamDef =
     p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
 const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
-const NOTW_BIASP: ParamDef =
-    ParamDef { default: DEFAULT_NOTW_BIAS, source: "shadowlab sweep 1/1.5/2/3 on courtyard and conference (docs/bench/warp.md)", ..BIAS };
+const NOTW_BIASP: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_BIAS,
+    source: "shadowlab sweep 0.5/1/1.5/2 with exact depth on six setups (docs/bench/warp.md)",
+    ..BIAS
+};
 const SUBDIV: ParamDef = p(
     "subdiv",
     DEFAULT_SUBDIV,
@@ -174,6 +179,28 @@ pub const CLOSE_CRACKS: ParamDef = ParamDef {
     choices: shadowlab_core::params::BOOL,
 };
 
+/// Exact depth per fragment (warp inverted by Newton steps, the triangle's plane evaluated);
+/// 0 = the rasterised depth interpolated between warped vertices. See `EXACT_DEPTH`. RTW: off;
+/// its smooth warp bends little at subdiv 1, so exact depth changes wrong pixels by <= 0.01
+/// points on five of six setups (sponza sun 1.18 -> 1.06 %) for 1.3-1.8x the time.
+pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
+/// NoTW: on. Fewer wrong pixels on all six setups (with bias 1.5: e.g. sponza spot 3.47 ->
+/// 3.22 %, conference sun 0.64 -> 0.46) for ~1.5x the depth-pass time (no early depth test,
+/// 9 warp lookups per fragment).
+pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 1.0;
+pub const EXACT_DEPTH: ParamDef = ParamDef {
+    key: "exact_depth",
+    default: DEFAULT_EXACT_DEPTH,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "write the exact depth per fragment: invert the warp at the fragment (3 Newton steps, 9 warp lookups) and evaluate the triangle's depth plane there; false = depth interpolated between warped vertices (off by up to the subdivision bend); disables early depth test",
+    source: "shadowlab experiment (docs/bench/warp.md)",
+    choices: shadowlab_core::params::BOOL,
+};
+
+const NOTW_EXACT: ParamDef = ParamDef { default: DEFAULT_NOTW_EXACT_DEPTH, ..EXACT_DEPTH };
+
 pub const NOTW_PARAMS: &[ParamDef] = &[
     RES,
     WINDOW,
@@ -183,6 +210,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     NOTW_SUBDIV,
     SUBDIV_LEVELS,
     CLOSE_CRACKS,
+    NOTW_EXACT,
     PCF,
     NOTW_BIASP,
     SLOPE,
@@ -190,6 +218,21 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     NORMAL_OFFSET,
     DV_MARGIN,
 ];
-pub const RTW_PARAMS: &[ParamDef] =
-    &[RES, W_DV, W_EYE, BLUR, INTERP, SUBDIV, SUBDIV_LEVELS, CLOSE_CRACKS, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const RTW_PARAMS: &[ParamDef] = &[
+    RES,
+    W_DV,
+    W_EYE,
+    BLUR,
+    INTERP,
+    SUBDIV,
+    SUBDIV_LEVELS,
+    CLOSE_CRACKS,
+    EXACT_DEPTH,
+    PCF,
+    BIAS,
+    SLOPE,
+    MAX_SLOPE,
+    NORMAL_OFFSET,
+    DV_MARGIN,
+];
 pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];

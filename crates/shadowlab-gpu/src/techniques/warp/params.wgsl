@@ -22,7 +22,7 @@ struct WarpParams {
     ints: vec4<u32>,
     // x: 1 = offsets interpolated linearly between neighbouring functions (continuous warp),
     // 0 = eq. 6 as printed (function floor(y w) / floor(x' w)); y: NoTW uniform floor `mix`
-    // (f32 bits)
+    // (f32 bits); z: 1 = exact depth per fragment (depth_exact.wgsl)
     flags: vec4<u32>,
 }
 
