@@ -182,11 +182,11 @@ pub const CLOSE_CRACKS: ParamDef = ParamDef {
 /// Exact depth per fragment (warp inverted by Newton steps, the triangle's plane evaluated);
 /// 0 = the rasterised depth interpolated between warped vertices. See `EXACT_DEPTH`. RTW: off;
 /// its smooth warp bends little at subdiv 1, so exact depth changes wrong pixels by <= 0.01
-/// points on five of six setups (sponza sun 1.18 -> 1.06 %) for 1.3-1.8x the time.
+/// points on five of six setups (sponza sun 1.18 -> 1.06 %) for 1.1-1.7x the total time.
 pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
 /// NoTW: on. Fewer wrong pixels on all six setups (with bias 1.5: e.g. sponza spot 3.47 ->
-/// 3.22 %, conference sun 0.64 -> 0.46) for ~1.5x the depth-pass time (no early depth test,
-/// 9 warp lookups per fragment).
+/// 3.22 %, conference sun 0.64 -> 0.46) for 2.8-4.8x the depth-pass time, 1.1-1.8x the total
+/// (no early depth test, 9 warp evaluations per fragment). Too slow? `exact_depth=false,bias=2`.
 pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 1.0;
 pub const EXACT_DEPTH: ParamDef = ParamDef {
     key: "exact_depth",
