@@ -30,6 +30,10 @@ pub struct GpuScene {
     pub layout: wgpu::BindGroupLayout,
     pub group: wgpu::BindGroup,
     pub triangle_count: u32,
+    /// Triangles `dynamic_first..triangle_count` are dynamic (moved by the scene's animations,
+    /// rewritten every frame); `0..dynamic_first` are static. Equal to `triangle_count` for a
+    /// scene without moving objects.
+    pub dynamic_first: u32,
     pub bounds: Bounds,
     pub eps: f32,
     pub bvh_bytes: usize,
@@ -99,6 +103,7 @@ impl GpuScene {
             layout,
             group,
             triangle_count: scene.triangle_count() as u32,
+            dynamic_first: scene.triangle_count() as u32,
             bounds: scene.bounds(),
             eps: scene.ray_epsilon(),
             bvh_bytes: bvh.bytes(),

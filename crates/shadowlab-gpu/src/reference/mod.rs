@@ -9,10 +9,18 @@ use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, Techn
 use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
+/// The shadow-ray library (`occluded`, `sample_shadowed`): needs `scene.wgsl` and the view
+/// inputs of `view.wgsl` (the light uniform). Techniques that trace rays compose it in front of
+/// their own body: `compose_view(&format!("{TRACE_WGSL}{body}"), true)`.
+pub const TRACE_WGSL: &str = include_str!("trace.wgsl");
 const RT_WGSL: &str = include_str!("rt.wgsl");
 
+fn rt_src() -> String {
+    compose_view(&format!("{TRACE_WGSL}{RT_WGSL}"), true)
+}
+
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("rt.wgsl", compose_view(RT_WGSL, true))]
+    vec![("rt.wgsl", rt_src())]
 }
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -36,7 +44,7 @@ pub struct RayTraced {
 impl RayTraced {
     pub fn new(gpu: &Gpu, scene: &GpuScene) -> RayTraced {
         let layout = view_layout(gpu, "rt", &[binding::storage(false)]);
-        let pipeline = gpu.compute_pipeline("rt", &compose_view(RT_WGSL, true), "main", &[&layout, &scene.layout]);
+        let pipeline = gpu.compute_pipeline("rt", &rt_src(), "main", &[&layout, &scene.layout]);
         RayTraced { pipeline, layout, rays: gpu.storage("rt.rays", 4), bvh_bytes: scene.bvh_bytes }
     }
 }

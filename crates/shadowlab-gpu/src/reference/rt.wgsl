@@ -1,92 +1,7 @@
-// `rt`: exact hard-shadow visibility for every evaluated G-buffer sample. One shadow ray per
-// pixel through the BVH, any-hit with early exit, alpha cut-outs honoured. Mirrors
-// shadowlab-core/src/bvh.rs (`shadow_ray`, `intersect_triangle`, `occluded`).
+// `rt`: exact hard-shadow visibility for every evaluated G-buffer sample, one shadow ray per
+// pixel through `trace.wgsl`.
 
 @group(0) @binding(6) var<storage, read_write> rays: atomic<u32>;
-
-const MAX_DEPTH: u32 = 64u;
-
-fn safe_inv(x: f32) -> f32 {
-    if abs(x) < 1e-20 {
-        return select(-1e20, 1e20, x >= 0.0);
-    }
-    return 1.0 / x;
-}
-
-fn hits_box(n: BvhNode, o: vec3<f32>, inv: vec3<f32>, tmax: f32) -> bool {
-    let t0 = (n.min - o) * inv;
-    let t1 = (n.max - o) * inv;
-    let lo = min(t0, t1);
-    let hi = max(t0, t1);
-    let tn = max(max(max(lo.x, lo.y), lo.z), 0.0);
-    let tf = min(min(min(hi.x, hi.y), hi.z), tmax);
-    return tn <= tf;
-}
-
-// Returns (hit, u, v) as vec3 with x = 1 on a hit.
-fn intersect(o: vec3<f32>, d: vec3<f32>, tmax: f32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
-    let e1 = b - a;
-    let e2 = c - a;
-    let p = cross(d, e2);
-    let det = dot(e1, p);
-    if abs(det) < 1e-12 {
-        return vec3<f32>(0.0);
-    }
-    let inv = 1.0 / det;
-    let s = o - a;
-    let u = dot(s, p) * inv;
-    if u < 0.0 || u > 1.0 {
-        return vec3<f32>(0.0);
-    }
-    let q = cross(s, e1);
-    let v = dot(d, q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return vec3<f32>(0.0);
-    }
-    let t = dot(e2, q) * inv;
-    if t > 0.0 && t < tmax {
-        return vec3<f32>(1.0, u, v);
-    }
-    return vec3<f32>(0.0);
-}
-
-fn passes_cutout(prim: u32, u: f32, v: f32) -> bool {
-    let v0 = vertices[3u * prim];
-    let m = materials[v0.material];
-    if (m.flags & MAT_MASKED) == 0u {
-        return false;
-    }
-    let uv = v0.uv * (1.0 - u - v) + vertices[3u * prim + 1u].uv * u + vertices[3u * prim + 2u].uv * v;
-    return cut_out(m, uv);
-}
-
-fn occluded(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
-    let inv = vec3<f32>(safe_inv(d.x), safe_inv(d.y), safe_inv(d.z));
-    var stack: array<u32, MAX_DEPTH>;
-    var sp = 1u;
-    stack[0] = 0u;
-    while sp > 0u {
-        sp -= 1u;
-        let n = bvh_nodes[stack[sp]];
-        if !hits_box(n, o, inv, tmax) {
-            continue;
-        }
-        if n.prim_count == 0u {
-            stack[sp] = n.first_index;
-            stack[sp + 1u] = n.first_index + 1u;
-            sp += 2u;
-            continue;
-        }
-        for (var k = 0u; k < n.prim_count; k++) {
-            let prim = prim_indices[n.first_index + k];
-            let h = intersect(o, d, tmax, vertices[3u * prim].pos, vertices[3u * prim + 1u].pos, vertices[3u * prim + 2u].pos);
-            if h.x > 0.0 && !passes_cutout(prim, h.y, h.z) {
-                return true;
-            }
-        }
-    }
-    return false;
-}
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -94,14 +9,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    let o = s.p + s.n * light.eps;
-    var d = -light.direction.xyz;
-    var tmax = 1e30;
-    if light.kind != LIGHT_DIRECTIONAL {
-        let to = light.position.xyz - o;
-        tmax = length(to);
-        d = to / tmax;
-    }
     atomicAdd(&rays, 1u);
-    visibility[s.i] = select(1.0, 0.0, occluded(o, d, tmax));
+    visibility[s.i] = select(1.0, 0.0, sample_shadowed(s.p, s.n));
 }
