@@ -2,6 +2,7 @@
 //! lights, the BVH and its CPU traversal (the reference's cross-check), metrics, technique
 //! parameters, and the CPU halves of techniques.
 
+pub mod anim;
 pub mod builtin;
 pub mod bvh;
 pub mod calipers;

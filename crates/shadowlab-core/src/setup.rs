@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use crate::anim::AnimationSpec;
 use crate::camera::{default_far, default_fov, default_near, Camera, CameraKey};
 use crate::light::Light;
 use crate::loaders::{SceneTransform, UpAxis};
@@ -22,6 +23,9 @@ pub struct Setup {
     pub output: OutputSection,
     #[serde(default)]
     pub techniques: Vec<TechniqueEntry>,
+    /// `[[animations]]`: moving objects (see `anim.rs`), added to a built-in scene's own.
+    #[serde(default)]
+    pub animations: Vec<AnimationSpec>,
 }
 
 /// `[camera]`: the lens and pose of frame 0, and an optional `[[camera.path]]` of keyframes
@@ -160,6 +164,9 @@ impl Setup {
         for l in &self.lights {
             l.validate()?;
         }
+        for (i, a) in self.animations.iter().enumerate() {
+            a.validate().map_err(|e| format!("animations[{i}]: {e}"))?;
+        }
         Ok(())
     }
 
@@ -231,6 +238,26 @@ spec = "sm:res=512,pcf=3"
         let bad = text.replace("target = [1, 1, -1]", "target = [1, 1, 0]");
         assert!(Setup::parse(&bad).unwrap().validate().unwrap_err().contains("camera.path[1]"));
         assert!(Setup::parse(&text.replace("[[camera.path]]\nposition = [0", "[[camera.path]]\nfov = 3\nposition = [0")).is_err());
+    }
+    #[test]
+    fn animations_parse_and_are_checked() {
+        let text = "[scene]\nbuiltin = 'planebox'\n\
+                    [[animations]]\nname = 'box'\nmaterials = ['box']\ninside = [[-1, 0, -1], [1, 2, 1]]\n\
+                    motion = { type = 'translate', offset = [2, 0, 0], period = 32 }\n\
+                    [[animations]]\nname = 'fan'\ninside = [[-9, 0, -9], [9, 9, 9]]\n\
+                    [animations.motion]\ntype = 'sway'\npivot = [0, 3, 0]\naxis = [0, 0, 1]\namplitude_deg = 10\nperiod = 40\n";
+        let s = Setup::parse(text).unwrap();
+        s.validate().unwrap();
+        assert_eq!(s.animations.len(), 2);
+        assert_eq!(s.animations[0].motion, crate::anim::Motion::Translate { offset: Vec3::new(2.0, 0.0, 0.0), period: 32.0 });
+        assert_eq!(s.animations[1].inside.unwrap()[1], Vec3::splat(9.0));
+        let e = Setup::parse(&text.replace("period = 40", "period = 0")).unwrap().validate().unwrap_err();
+        assert!(e.contains("animations[1]") && e.contains("period"), "{e}");
+        assert!(Setup::parse(&text.replace("amplitude_deg", "amplitude")).is_err(), "unknown motion keys are errors");
+        assert!(Setup::parse(&text.replace("type = 'sway'", "type = 'wobble'")).is_err());
+        assert!(Setup::parse(&text.replace("materials = ['box']", "material = 'box'")).is_err());
+        let none = text.replace("materials = ['box']\ninside = [[-1, 0, -1], [1, 2, 1]]\n", "");
+        assert!(Setup::parse(&none).unwrap().validate().unwrap_err().contains("select triangles"));
     }
     #[test]
     fn scene_paths_fall_back_to_the_scenes_directory() {

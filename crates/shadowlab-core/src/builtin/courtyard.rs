@@ -141,7 +141,35 @@ pub fn build() -> Scene {
             CameraKey { position: Vec3::new(13.6 - 1.5 * t, 1.7 + 0.03 * (t * 2.1).sin(), 1.0 - 0.4 * t), target: cam.target }
         })
         .collect();
-    b.finish("courtyard", cam, vec![Light::Directional { direction: sun_direction() }], path)
+    let mut s = b.finish("courtyard", cam, vec![Light::Directional { direction: sun_direction() }], path);
+    crate::anim::apply(&mut s, &animations()).expect("courtyard animations select their banners");
+    s
+}
+
+/// Moving objects (time in frames): every banner swings about its rod (the x axis through the
+/// rod), 6 to 9 degrees, with periods of 40 to 61 frames so that they do not move in step.
+pub fn animations() -> Vec<crate::anim::AnimationSpec> {
+    use crate::anim::{AnimationSpec, Motion};
+    let mut v = Vec::new();
+    for (i, s) in [-1.0f32, 1.0].into_iter().enumerate() {
+        for k in (0..8).filter(|k| k % 2 == 1) {
+            let cx = -HALF_LEN + (k as f32 + 0.5) * SIDE_BAY;
+            let z = s * (COURT_Z - 0.45);
+            let j = (4 * i as u32 + k) as f32;
+            v.push(AnimationSpec {
+                name: format!("banner {}{k}", if s < 0.0 { "north " } else { "south " }),
+                materials: vec!["banner red".into(), "banner blue".into()],
+                inside: Some([Vec3::new(cx - 0.8, 6.0, z - 0.2), Vec3::new(cx + 0.8, 9.5, z + 0.2)]),
+                motion: Motion::Sway {
+                    pivot: Vec3::new(cx, 9.45, z),
+                    axis: Vec3::X,
+                    amplitude_deg: 6.0 + 0.25 * j,
+                    period: 40.0 + 3.0 * j,
+                },
+            });
+        }
+    }
+    v
 }
 
 /// One storey of arcade in local coordinates: `bays` arches along +x from x = 0, centred on z = 0.

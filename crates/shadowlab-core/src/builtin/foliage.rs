@@ -100,6 +100,19 @@ pub fn build() -> Scene {
         }
     }
 
+    // A hand cart with a thin flag pole, crossing between the lamp and the wall (animated below).
+    let cart = b.material(Material::solid("cart", [0.70, 0.20, 0.12]));
+    let (c0, c1) = CART;
+    b.cuboid(c0 + Vec3::Y * 0.35, c1, cart);
+    for x in [c0.x + 0.25, c1.x - 0.25] {
+        for z in [c0.z, c1.z] {
+            b.cylinder(Vec3::new(x, 0.3, z), Vec3::new(x, 0.3, z + if z == c0.z { -0.06 } else { 0.06 }), 0.3, 12, cart);
+        }
+    }
+    let pole = Vec3::new(c1.x - 0.1, c1.y, (c0.z + c1.z) / 2.0);
+    b.cylinder(pole, pole + Vec3::Y * 2.2, 0.015, 8, cart);
+    b.cuboid(pole + Vec3::new(0.0, 1.7, -0.005), pole + Vec3::new(0.7, 2.2, 0.005), cart);
+
     // Trees (the two near the wall throw leaf shadows on it).
     for (k, &(x, z)) in TREES.iter().enumerate() {
         tree(&mut b, Vec3::new(x, 0.0, z), 10_000 + 2_000 * k as u32, bark, leaves);
@@ -107,7 +120,37 @@ pub fn build() -> Scene {
 
     let cam = Camera::new(Vec3::new(1.5, 1.7, 16.0), Vec3::new(0.5, 2.5, WALL_Z), 55.0, 0.1, 100.0);
     let path = (0..4).map(|i| CameraKey { position: cam.position + Vec3::new(-0.7, 0.0, -0.4) * i as f32, target: cam.target }).collect();
-    b.finish("foliage", cam, vec![Light::Directional { direction: sun_direction() }], path)
+    let mut s = b.finish("foliage", cam, vec![Light::Directional { direction: sun_direction() }], path);
+    crate::anim::apply(&mut s, &animations()).expect("foliage animations select their objects");
+    s
+}
+
+/// The hand cart's body at t = 0 (min, max corners); it crosses by `CART_TRAVEL` and back.
+pub const CART: (Vec3, Vec3) = (Vec3::new(4.2, 0.0, -6.9), Vec3::new(5.8, 1.1, -6.1));
+pub const CART_TRAVEL: Vec3 = Vec3::new(-9.0, 0.0, 0.0);
+
+/// Moving objects (time in frames): the cart crossing in front of the wall and back (64 frames),
+/// the two sagging cables swaying about their chords, the dangling one about its top.
+pub fn animations() -> Vec<crate::anim::AnimationSpec> {
+    use crate::anim::{AnimationSpec, Motion};
+    let cab = cables();
+    let cable_sway = |name: &str, inside: [Vec3; 2], pivot: Vec3, axis: Vec3, amplitude_deg: f32, period: f32| AnimationSpec {
+        name: name.into(),
+        materials: vec!["cable".into()],
+        inside: Some(inside),
+        motion: Motion::Sway { pivot, axis, amplitude_deg, period },
+    };
+    vec![
+        AnimationSpec {
+            name: "cart".into(),
+            materials: vec!["cart".into()],
+            inside: None,
+            motion: Motion::Translate { offset: CART_TRAVEL, period: 64.0 },
+        },
+        cable_sway("west cable", [Vec3::new(-8.0, 0.0, -9.0), Vec3::new(0.95, 6.0, -4.0)], cab[0].0, cab[0].1 - cab[0].0, 9.0, 40.0),
+        cable_sway("east cable", [Vec3::new(1.05, 0.0, -9.0), Vec3::new(9.0, 6.0, -5.1)], cab[1].0, cab[1].1 - cab[1].0, 7.0, 52.0),
+        cable_sway("dangling cable", [Vec3::new(1.7, 3.0, -5.1), Vec3::new(2.0, 5.1, -4.9)], cab[2].0, Vec3::Z, 14.0, 30.0),
+    ]
 }
 
 /// A tree at `foot`: trunk, four branches and `CARDS_PER_TREE` leaf cards in an ellipsoidal

@@ -140,6 +140,7 @@ impl MeshBuilder {
             lights,
             camera_path,
             transform: Mat4::IDENTITY,
+            animations: Vec::new(),
             report,
         }
     }

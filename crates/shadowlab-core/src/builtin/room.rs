@@ -126,7 +126,21 @@ pub fn build() -> Scene {
         Light::Spot { position: SPOT_POSITION, direction: (table_top - SPOT_POSITION).normalize(), cone_deg: 38.0 },
         Light::Point { position: POINT_POSITION },
     ];
-    b.finish("room", cam, lights, path)
+    let mut s = b.finish("room", cam, lights, path);
+    crate::anim::apply(&mut s, &animations()).expect("room animations select their objects");
+    s
+}
+
+/// Moving object (time in frames): the chair at the +x end of the table is pulled out by 0.5 m
+/// and pushed back every 48 frames (seat, back and thin legs move under both lights).
+pub fn animations() -> Vec<crate::anim::AnimationSpec> {
+    use crate::anim::{AnimationSpec, Motion};
+    vec![AnimationSpec {
+        name: "end chair".into(),
+        materials: vec!["chair beech".into(), "chair legs".into()],
+        inside: Some([Vec3::new(TABLE_HALF.x + 0.02, -0.1, -0.6), Vec3::new(TABLE_HALF.x + 1.0, 1.2, 0.6)]),
+        motion: Motion::Translate { offset: Vec3::new(0.5, 0.0, 0.0), period: 48.0 },
+    }]
 }
 
 /// A chair centred on the origin, facing -z (the table side): seat, four thin round legs and a

@@ -186,6 +186,7 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
         lights: Vec::new(),
         camera_path: Vec::new(),
         transform: Mat4::IDENTITY,
+        animations: Vec::new(),
         report: LoadReport { warnings, ..report },
     })
 }

@@ -1,0 +1,264 @@
+//! Moving objects ("animations"): rigid motions of selected triangles over time.
+//!
+//! Time unit: **frames**. `t` is the frame index of a `compare --frames N` sequence (frame `k` is at
+//! `t = start + k`, `start` = `--time`, default 0); periods are in frames. Every motion is the
+//! identity at `t = 0`, so `Scene::vertices` always holds the pose at `t = 0` and a scene without
+//! animations, or any scene at `t = 0`, is exactly the geometry that was loaded.
+//!
+//! Selection happens once, on load ([`apply`]): the selected triangles are moved to the end of
+//! `Scene::vertices`, each animation's triangles contiguous, so that the dynamic triangles form
+//! the range `dynamic_first..triangle_count` that the GPU rewrites every frame (and the range
+//! `GpuScene::dynamic_first` promises to techniques that keep a static and a dynamic shadow map).
+//! Static triangles keep their relative order.
+
+use std::f32::consts::TAU;
+
+use glam::{Mat4, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::scene::{Scene, Vertex};
+
+/// A rigid motion as a function of time in frames; `transform(0)` is the identity.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub enum Motion {
+    /// Back and forth along a segment: displacement `offset * (1 - cos(2 pi t / period)) / 2`
+    /// (at rest at t = 0, at `offset` at half the period, smooth turns at both ends).
+    Translate { offset: Vec3, period: f32 },
+    /// Swinging about the line through `pivot` along `axis`: angle `amplitude_deg * sin(2 pi t / period)`
+    /// (right-handed about `axis`). Wires, banners, pendulums.
+    Sway { pivot: Vec3, axis: Vec3, amplitude_deg: f32, period: f32 },
+    /// Full turns about the line through `center` along `axis`: angle `2 pi t / period`
+    /// (negative period: the other way round). Fans, carousels.
+    Orbit { center: Vec3, axis: Vec3, period: f32 },
+}
+
+/// Rotation by `angle` (radians) about the line through `p` along unit `axis`.
+fn rotation_about(p: Vec3, axis: Vec3, angle: f32) -> Mat4 {
+    Mat4::from_translation(p) * Mat4::from_axis_angle(axis, angle) * Mat4::from_translation(-p)
+}
+
+impl Motion {
+    /// The object's transform at time `t` (frames), applied to its pose at t = 0.
+    pub fn transform(&self, t: f32) -> Mat4 {
+        match *self {
+            Motion::Translate { offset, period } => {
+                let s = 0.5 * (1.0 - (TAU * t / period).cos());
+                Mat4::from_translation(offset * s)
+            }
+            Motion::Sway { pivot, axis, amplitude_deg, period } => {
+                rotation_about(pivot, axis.normalize(), amplitude_deg.to_radians() * (TAU * t / period).sin())
+            }
+            Motion::Orbit { center, axis, period } => rotation_about(center, axis.normalize(), TAU * t / period),
+        }
+    }
+
+    /// Bad periods, axes and amplitudes are errors (never NaN geometry later).
+    pub fn validate(&self) -> Result<(), String> {
+        let (period, finite) = match *self {
+            Motion::Translate { offset, period } => (period, offset.is_finite()),
+            Motion::Sway { pivot, axis, amplitude_deg, period } => {
+                if axis.length() < 1e-6 {
+                    return Err("sway axis must be non-zero".into());
+                }
+                if !(amplitude_deg.is_finite() && amplitude_deg.abs() <= 180.0) {
+                    return Err(format!("sway amplitude_deg {amplitude_deg} must be in [-180, 180]"));
+                }
+                (period, pivot.is_finite() && axis.is_finite())
+            }
+            Motion::Orbit { center, axis, period } => {
+                if axis.length() < 1e-6 {
+                    return Err("orbit axis must be non-zero".into());
+                }
+                (period, center.is_finite() && axis.is_finite())
+            }
+        };
+        let ok_period = match self {
+            Motion::Orbit { .. } => period.is_finite() && period.abs() >= 1e-3,
+            _ => period.is_finite() && period >= 1e-3,
+        };
+        if !ok_period {
+            return Err(format!("period {period} must be a finite number of frames > 0 (orbit: != 0)"));
+        }
+        if !finite {
+            return Err("motion vectors must be finite".into());
+        }
+        Ok(())
+    }
+
+    /// Largest rotation (radians) between two times `period / samples` apart (0 for translations).
+    fn max_angle_step(&self, samples: usize) -> f32 {
+        let phase_step = TAU / samples as f32;
+        match *self {
+            Motion::Translate { .. } => 0.0,
+            // d/dphase (A sin phase) <= A
+            Motion::Sway { amplitude_deg, .. } => amplitude_deg.abs().to_radians() * phase_step,
+            Motion::Orbit { .. } => phase_step,
+        }
+    }
+
+    /// One full period in frames.
+    pub fn period(&self) -> f32 {
+        match *self {
+            Motion::Translate { period, .. } | Motion::Sway { period, .. } | Motion::Orbit { period, .. } => period.abs(),
+        }
+    }
+}
+
+/// One `[[animations]]` entry of a setup (or of a built-in scene): which triangles move, and how.
+/// A triangle is selected when its material is one of `materials` (if given) and its centroid
+/// lies inside `inside = [[min], [max]]` (if given); at least one of the two is required.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnimationSpec {
+    pub name: String,
+    #[serde(default)]
+    pub materials: Vec<String>,
+    #[serde(default)]
+    pub inside: Option<[Vec3; 2]>,
+    pub motion: Motion,
+}
+
+impl AnimationSpec {
+    /// Checks what can be checked without the scene.
+    pub fn validate(&self) -> Result<(), String> {
+        let who = format!("animation '{}'", self.name);
+        if self.name.trim().is_empty() {
+            return Err("an animation needs a non-empty `name`".into());
+        }
+        if self.materials.is_empty() && self.inside.is_none() {
+            return Err(format!("{who}: select triangles with `materials` and/or `inside`"));
+        }
+        if let Some([lo, hi]) = self.inside {
+            if !(lo.is_finite() && hi.is_finite() && lo.cmple(hi).all()) {
+                return Err(format!("{who}: `inside` needs finite [min, max] with min <= max"));
+            }
+        }
+        self.motion.validate().map_err(|e| format!("{who}: {e}"))
+    }
+}
+
+/// An animation resolved against a scene: triangles `first..first + count` move with `motion`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Animation {
+    pub name: String,
+    pub first: usize,
+    pub count: usize,
+    pub motion: Motion,
+}
+
+/// Selects the triangles of `specs`, moves them to the end of `scene.vertices` (after the
+/// scene's existing animations) and records them in `scene.animations`. Errors: invalid spec,
+/// unknown material, empty selection, duplicate name, or a triangle selected twice.
+pub fn apply(scene: &mut Scene, specs: &[AnimationSpec]) -> Result<(), String> {
+    if specs.is_empty() {
+        return Ok(());
+    }
+    let n = scene.triangle_count();
+    // owner[i] = index into `all` of the animation moving triangle i
+    let mut owner: Vec<Option<usize>> = vec![None; n];
+    let mut all: Vec<(String, Motion)> = Vec::new();
+    for a in &scene.animations {
+        owner[a.first..a.first + a.count].iter_mut().for_each(|o| *o = Some(all.len()));
+        all.push((a.name.clone(), a.motion));
+    }
+    for spec in specs {
+        spec.validate()?;
+        let who = format!("animation '{}'", spec.name);
+        if all.iter().any(|(name, _)| *name == spec.name) {
+            return Err(format!("{who}: the name is used twice"));
+        }
+        let mut mats = Vec::new();
+        for m in &spec.materials {
+            let found: Vec<u32> = (0..scene.materials.len() as u32).filter(|&i| scene.materials[i as usize].name == *m).collect();
+            if found.is_empty() {
+                let mut names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+                names.sort();
+                names.dedup();
+                let shown = names.iter().take(40).copied().collect::<Vec<_>>().join("', '");
+                return Err(format!("{who}: unknown material '{m}' (the scene has '{shown}')"));
+            }
+            mats.extend(found);
+        }
+        let id = all.len();
+        let mut selected = 0usize;
+        for (i, o) in owner.iter_mut().enumerate() {
+            let v = &scene.vertices[3 * i..3 * i + 3];
+            if !mats.is_empty() && !mats.contains(&v[0].material) {
+                continue;
+            }
+            if let Some([lo, hi]) = spec.inside {
+                let c = (Vec3::from(v[0].pos) + Vec3::from(v[1].pos) + Vec3::from(v[2].pos)) / 3.0;
+                if !(c.cmpge(lo).all() && c.cmple(hi).all()) {
+                    continue;
+                }
+            }
+            if let Some(other) = *o {
+                return Err(format!("{who}: triangle {i} is already moved by animation '{}'", all[other].0));
+            }
+            *o = Some(id);
+            selected += 1;
+        }
+        if selected == 0 {
+            return Err(format!("{who}: selects no triangles (check `materials` and `inside`)"));
+        }
+        all.push((spec.name.clone(), spec.motion));
+    }
+    let mut order: Vec<usize> = (0..n).filter(|&i| owner[i].is_none()).collect();
+    let mut animations = Vec::new();
+    for (id, (name, motion)) in all.into_iter().enumerate() {
+        let first = order.len();
+        order.extend((0..n).filter(|&i| owner[i] == Some(id)));
+        animations.push(Animation { name, first, count: order.len() - first, motion });
+    }
+    let old = std::mem::take(&mut scene.vertices);
+    scene.vertices = order.iter().flat_map(|&i| old[3 * i..3 * i + 3].iter().copied()).collect();
+    scene.animations = animations;
+    Ok(())
+}
+
+/// `v` moved by the rigid transform `m` (position and face normal; a rotation keeps the
+/// normal's length, so it is not renormalised and the identity returns `v` bit for bit).
+pub fn move_vertex(v: &Vertex, m: &Mat4) -> Vertex {
+    if *m == Mat4::IDENTITY {
+        return *v;
+    }
+    let pos = m.transform_point3(Vec3::from(v.pos));
+    let normal = m.transform_vector3(Vec3::from(v.normal));
+    Vertex { pos: pos.into(), normal: normal.into(), ..*v }
+}
+
+/// Conservative world bounds of the triangles `anim` moves over all time: positions sampled
+/// over the period, padded by the largest sagitta of the arcs between samples (rotations).
+pub fn swept_bounds(scene: &Scene, anim: &Animation) -> crate::scene::Bounds {
+    const SAMPLES: usize = 64;
+    let mut b = crate::scene::Bounds::EMPTY;
+    let verts = &scene.vertices[3 * anim.first..3 * (anim.first + anim.count)];
+    let mut max_radius = 0f32;
+    let pivot = match anim.motion {
+        Motion::Sway { pivot, axis, .. } => Some((pivot, axis.normalize())),
+        Motion::Orbit { center, axis, .. } => Some((center, axis.normalize())),
+        Motion::Translate { .. } => None,
+    };
+    for k in 0..=SAMPLES {
+        let m = anim.motion.transform(anim.motion.period() * k as f32 / SAMPLES as f32);
+        for v in verts {
+            b.grow(m.transform_point3(Vec3::from(v.pos)));
+        }
+    }
+    if let Some((p, axis)) = pivot {
+        for v in verts {
+            let d = Vec3::from(v.pos) - p;
+            max_radius = max_radius.max((d - axis * d.dot(axis)).length());
+        }
+        let step = anim.motion.max_angle_step(SAMPLES);
+        let pad = max_radius * (1.0 - (step * 0.5).cos()) + 1e-6;
+        b.min -= Vec3::splat(pad);
+        b.max += Vec3::splat(pad);
+    }
+    b
+}
+
+#[cfg(test)]
+#[path = "anim_tests.rs"]
+mod tests;
