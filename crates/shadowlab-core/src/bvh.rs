@@ -33,14 +33,23 @@ pub struct Bvh {
 }
 
 impl Bvh {
+    /// BVH over every triangle of `scene` (as stored: moving objects at t = 0).
     pub fn build(scene: &Scene) -> Result<Bvh, String> {
+        Bvh::build_range(scene, 0..scene.triangle_count())
+    }
+
+    /// BVH over triangles `range` of `scene`; primitive indices are scene triangle indices.
+    pub fn build_range(scene: &Scene, range: std::ops::Range<usize>) -> Result<Bvh, String> {
+        let first = range.start as u32;
+        let tris: Vec<[Vec3; 3]> = range.map(|i| scene.triangle(i)).collect();
+        Bvh::from_triangles(&tris, first)
+    }
+
+    /// BVH over `tris`; triangle `k` gets primitive index `first + k`.
+    pub fn from_triangles(tris: &[[Vec3; 3]], first: u32) -> Result<Bvh, String> {
         let t0 = std::time::Instant::now();
-        let tris: Vec<Triangle> = (0..scene.triangle_count())
-            .map(|i| {
-                let [a, b, c] = scene.triangle(i);
-                Triangle { v0: Vec3A::from(a), v1: Vec3A::from(b), v2: Vec3A::from(c) }
-            })
-            .collect();
+        let tris: Vec<Triangle> =
+            tris.iter().map(|[a, b, c]| Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) }).collect();
         if tris.is_empty() {
             return Err("scene has no triangles".into());
         }
@@ -60,7 +69,34 @@ impl Bvh {
         if depth >= MAX_DEPTH {
             return Err(format!("BVH depth {depth} exceeds the traversal stack ({MAX_DEPTH})"));
         }
-        Ok(Bvh { nodes, prim_indices: b.primitive_indices, depth, build_ms: t0.elapsed().as_secs_f64() * 1e3 })
+        let prim_indices = b.primitive_indices.iter().map(|i| i + first).collect();
+        Ok(Bvh { nodes, prim_indices, depth, build_ms: t0.elapsed().as_secs_f64() * 1e3 })
+    }
+
+    /// The nodes as they read when stored at `node_base` in a node array whose primitive
+    /// indices are stored at `prim_base` (children and leaf ranges shifted; the GPU keeps the
+    /// static and the dynamic BVH in one buffer each).
+    pub fn relocated_nodes(&self, node_base: u32, prim_base: u32) -> Vec<BvhNode> {
+        self.nodes
+            .iter()
+            .map(|n| BvhNode { first_index: n.first_index + if n.prim_count == 0 { node_base } else { prim_base }, ..*n })
+            .collect()
+    }
+
+    /// Placeholder static tree of a scene where everything moves (`GpuScene` never traverses it:
+    /// the static tree is skipped when `dynamic_first == 0`). Not for the CPU traversal.
+    pub fn empty() -> Bvh {
+        Bvh {
+            nodes: vec![BvhNode { min: [f32::MAX; 3], max: [f32::MIN; 3], prim_count: 1, first_index: 0 }],
+            prim_indices: vec![],
+            depth: 1,
+            build_ms: 0.0,
+        }
+    }
+
+    /// Most nodes a binary BVH over `triangles` can have (every leaf holds at least one).
+    pub fn max_nodes(triangles: usize) -> usize {
+        (2 * triangles).saturating_sub(1).max(1)
     }
 
     pub fn bytes(&self) -> usize {
@@ -156,12 +192,19 @@ fn passes_cutout(scene: &Scene, prim: usize, u: f32, v: f32) -> bool {
 
 /// Any-hit occlusion test with early exit, honouring alpha cut-outs.
 pub fn occluded(bvh: &Bvh, scene: &Scene, r: &ShadowRay) -> bool {
+    occluded_from(&bvh.nodes, &bvh.prim_indices, 0, scene, r)
+}
+
+/// [`occluded`] over node/primitive arrays from the node `root` (the GPU's layout: static and
+/// dynamic trees in one array, see [`Bvh::relocated_nodes`]).
+pub fn occluded_from(nodes: &[BvhNode], prims: &[u32], root: u32, scene: &Scene, r: &ShadowRay) -> bool {
     let inv = safe_inverse(r.dir);
     let mut stack = [0u32; MAX_DEPTH];
+    stack[0] = root;
     let mut sp = 1;
     while sp > 0 {
         sp -= 1;
-        let n = &bvh.nodes[stack[sp] as usize];
+        let n = &nodes[stack[sp] as usize];
         if !hits_box(n, r.origin, inv, r.tmax) {
             continue;
         }
@@ -172,7 +215,7 @@ pub fn occluded(bvh: &Bvh, scene: &Scene, r: &ShadowRay) -> bool {
             continue;
         }
         for k in 0..n.prim_count {
-            let prim = bvh.prim_indices[(n.first_index + k) as usize] as usize;
+            let prim = prims[(n.first_index + k) as usize] as usize;
             let [a, b, c] = scene.triangle(prim);
             if let Some((_, u, v)) = intersect_triangle(r, a, b, c) {
                 if !passes_cutout(scene, prim, u, v) {
@@ -234,6 +277,37 @@ mod tests {
         let pl = Light::Point { position: Vec3::new(0.0, 0.5, 3.0) };
         assert!(occluded(&bvh, &s, &shadow_ray(&pl, Vec3::new(0.0, 0.1, -1.0), Vec3::Y, eps)));
         assert!(!occluded(&bvh, &s, &shadow_ray(&pl, Vec3::new(0.0, 0.2, 2.0), Vec3::Y, eps)));
+    }
+
+    #[test]
+    fn static_and_dynamic_trees_in_one_array_see_everything() {
+        // courtyard's banners are dynamic: a static tree over the rest and a relocated dynamic
+        // tree behind it in the same arrays answer exactly like one tree over the whole scene
+        let s = builtin("courtyard").unwrap();
+        let (d, n) = (s.dynamic_first(), s.triangle_count());
+        assert!(d < n);
+        let full = Bvh::build(&s).unwrap();
+        let st = Bvh::build_range(&s, 0..d).unwrap();
+        let dy = Bvh::build_range(&s, d..n).unwrap();
+        assert!(dy.nodes.len() <= Bvh::max_nodes(n - d) && dy.prim_indices.len() == n - d);
+        assert!(dy.prim_indices.iter().all(|&p| (d as u32..n as u32).contains(&p)));
+        let root = st.nodes.len() as u32;
+        let mut nodes = st.nodes.clone();
+        nodes.extend(dy.relocated_nodes(root, st.prim_indices.len() as u32));
+        let prims: Vec<u32> = st.prim_indices.iter().chain(&dy.prim_indices).copied().collect();
+        let b = s.bounds();
+        let l = s.lights[0];
+        let (mut hits, mut dyn_hits) = (0, 0);
+        for i in 0..2000u32 {
+            let h = |k: u32| crate::builtin::hash01(i * 7 + k);
+            let p = b.min + (b.max - b.min) * Vec3::new(h(1), h(2) * 0.7, h(3));
+            let r = shadow_ray(&l, p, Vec3::Y, 1e-4);
+            let two = occluded_from(&nodes, &prims, 0, &s, &r) || occluded_from(&nodes, &prims, root, &s, &r);
+            assert_eq!(two, occluded(&full, &s, &r), "ray {i}");
+            hits += two as u32;
+            dyn_hits += occluded_from(&nodes, &prims, root, &s, &r) as u32;
+        }
+        assert!(hits > 100 && dyn_hits > 0, "{hits} occluded, {dyn_hits} by banners");
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The lab: one scene on the GPU, views prepared once (G-buffer, mask, reference), techniques
 //! run against them. The CLI and the integration tests both drive this.
 
+use std::cell::Cell;
 use std::collections::BTreeMap;
 
 use shadowlab_core::bvh::Bvh;
@@ -20,16 +21,25 @@ use crate::{Gpu, GpuError};
 pub struct Lab<'a> {
     pub gpu: &'a Gpu,
     pub scene: &'a Scene,
+    /// BVH over the whole scene as stored (moving objects at t = 0): the CPU cross-checks'.
+    /// For another time use `Bvh::build(&scene.at_time(t))`.
     pub bvh: Bvh,
     pub gscene: GpuScene,
     gbuffer_pass: GBufferPass,
     shade_pass: ShadePass,
+    /// Animation time of the GPU scene now: (t, previous t), in frames.
+    time: Cell<(f32, f32)>,
+    /// Wall time of the last `set_time` that moved something (ms).
+    animate_ms: Cell<f64>,
 }
 
 /// One view of the scene for one light, with its G-buffer read back.
 pub struct View {
     pub camera: Camera,
     pub prev_camera: Camera,
+    /// Animation time of this view and of its motion vectors' previous frame (frames).
+    pub time: f32,
+    pub prev_time: f32,
     pub light: Light,
     pub width: u32,
     pub height: u32,
@@ -92,14 +102,40 @@ pub struct Run {
 impl<'a> Lab<'a> {
     pub fn new(gpu: &'a Gpu, scene: &'a Scene) -> Result<Lab<'a>, GpuError> {
         let bvh = Bvh::build(scene).map_err(GpuError::Invalid)?;
-        let gscene = GpuScene::new(gpu, scene, &bvh)?;
+        let d = scene.dynamic_first();
+        let gscene = if d == scene.triangle_count() {
+            GpuScene::new(gpu, scene, &bvh)?
+        } else {
+            let static_bvh = if d == 0 { Bvh::empty() } else { Bvh::build_range(scene, 0..d).map_err(GpuError::Invalid)? };
+            GpuScene::new(gpu, scene, &static_bvh)?
+        };
         let gbuffer_pass = GBufferPass::new(gpu, &gscene);
         let shade_pass = ShadePass::new(gpu);
         gpu.take_error()?;
-        Ok(Lab { gpu, scene, bvh, gscene, gbuffer_pass, shade_pass })
+        Ok(Lab { gpu, scene, bvh, gscene, gbuffer_pass, shade_pass, time: Cell::new((0.0, 0.0)), animate_ms: Cell::new(0.0) })
     }
 
-    /// Renders the G-buffer and the mask for `light`, and reads them back.
+    /// Moves the scene's moving objects to time `t` (frames), with motion vectors against
+    /// `prev_t`; the following views are rendered at that time (see [`View::time`]). Cheap when
+    /// nothing moves or the time is unchanged. Starts at (0, 0).
+    pub fn set_time(&self, t: f32, prev_t: f32) -> Result<(), GpuError> {
+        if self.time.get() == (t, prev_t) && t.is_finite() {
+            return Ok(());
+        }
+        let t0 = std::time::Instant::now();
+        self.gscene.set_time(self.gpu, self.scene, t, prev_t)?;
+        self.animate_ms.set(t0.elapsed().as_secs_f64() * 1e3);
+        self.time.set((t, prev_t));
+        Ok(())
+    }
+
+    /// The current animation time (t, previous t).
+    pub fn time(&self) -> (f32, f32) {
+        self.time.get()
+    }
+
+    /// Renders the G-buffer and the mask for `light` at the current animation time
+    /// ([`Lab::set_time`]), and reads them back.
     pub fn view(&self, camera: &Camera, prev: &Camera, light: &Light, width: u32, height: u32) -> Result<View, GpuError> {
         let gpu = self.gpu;
         gpu.check_size(width, height, "output size")?;
@@ -117,9 +153,17 @@ impl<'a> Lab<'a> {
         let mask: Vec<u32> = gpu.read_buffer_as(&g.mask, g.pixels());
         let visibility = gpu.storage("visibility", g.pixels() as u64 * 4);
         let color = ShadePass::output(gpu, &g);
+        let (time, prev_time) = self.time.get();
+        let mut stages_ms = timer.medians();
+        if self.gscene.is_animated() {
+            // CPU transform + dynamic BVH rebuild + upload of the last `set_time`
+            stages_ms.insert("scene.animate".into(), self.animate_ms.get());
+        }
         Ok(View {
             camera: *camera,
             prev_camera: *prev,
+            time,
+            prev_time,
             light: *light,
             width,
             height,
@@ -131,7 +175,7 @@ impl<'a> Lab<'a> {
             position,
             normal,
             mask,
-            stages_ms: timer.medians(),
+            stages_ms,
         })
     }
 
@@ -171,8 +215,10 @@ impl<'a> Lab<'a> {
 
     /// Runs `inst` on `view`: once untimed when `warm_up`, then `repeat` times timed (at least
     /// once); then shades and reads back its visibility and report.
+    /// The scene is moved to the view's time first if it was moved elsewhere since.
     pub fn step(&self, view: &View, inst: &mut Instance, warm_up: bool, repeat: usize) -> Result<Run, GpuError> {
         let gpu = self.gpu;
+        self.set_time(view.time, view.prev_time)?;
         let inputs = view.inputs(&self.gscene);
         let tech = inst.tech.as_mut();
         if warm_up {

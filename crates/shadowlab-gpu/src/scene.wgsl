@@ -1,5 +1,15 @@
 // Scene data, bind group 1 (scene_gpu.rs): triangles as vertex triples, materials, packed
-// RGBA8 texels of all textures, and the BVH.
+// RGBA8 texels of all textures, and the BVH. Triangles `scene_info.dynamic_first..` move
+// (rewritten every frame); their previous-frame positions are `dynamic_prev`; the BVH arrays
+// hold the static tree (root 0, absent when dynamic_first == 0) and then the dynamic tree
+// (root `scene_info.dynamic_root`, absent when dynamic_first == triangle_count).
+
+struct SceneInfo {
+    triangle_count: u32,
+    dynamic_first: u32,
+    dynamic_root: u32,
+    _pad: u32,
+}
 
 struct BvhNode {
     min: vec3<f32>,
@@ -13,6 +23,17 @@ struct BvhNode {
 @group(1) @binding(2) var<storage, read> texels: array<u32>;
 @group(1) @binding(3) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(1) @binding(4) var<storage, read> prim_indices: array<u32>;
+@group(1) @binding(5) var<uniform> scene_info: SceneInfo;
+@group(1) @binding(6) var<storage, read> dynamic_prev: array<vec4<f32>>;
+
+// World position of vertex `vi` in the previous frame (moving objects; others stand still).
+fn previous_position(vi: u32) -> vec3<f32> {
+    let first = 3u * scene_info.dynamic_first;
+    if vi >= first {
+        return dynamic_prev[vi - first].xyz;
+    }
+    return vertices[vi].pos;
+}
 
 // Base colour times texture (RGBA, linear).
 fn material_color(m: Material, uv: vec2<f32>) -> vec4<f32> {

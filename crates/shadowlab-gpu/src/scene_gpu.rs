@@ -1,8 +1,17 @@
 //! The scene on the GPU: vertex triples, materials, packed texels and the BVH, as one bind
 //! group (group 1 of every pass, `scene.wgsl`).
+//!
+//! Moving objects: triangles `dynamic_first..triangle_count` are rewritten by [`GpuScene::set_time`]
+//! (one `write_buffer` of the dynamic vertex range), their positions at the previous frame go to
+//! `dynamic_prev` (the G-buffer's motion vectors), and a second BVH over the dynamic triangles
+//! only is rebuilt on the CPU (obvhs) and written behind the static one in the same node and
+//! index buffers (fixed capacity: the dynamic triangle count never changes). `occluded()` in
+//! `reference/trace.wgsl` traverses the static tree from node 0, then the dynamic one from
+//! `scene_info.dynamic_root`. Without moving objects nothing of this exists or runs.
 
 use bytemuck::{Pod, Zeroable};
-use shadowlab_core::bvh::Bvh;
+use glam::Vec3;
+use shadowlab_core::bvh::{Bvh, BvhNode};
 use shadowlab_core::scene::{Bounds, Scene};
 use wgpu::BufferUsages;
 
@@ -21,6 +30,19 @@ pub struct GpuMaterial {
     pub _pad: [u32; 3],
 }
 
+/// WGSL `SceneInfo` (16 bytes): where the dynamic part starts.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SceneInfo {
+    pub triangle_count: u32,
+    /// First dynamic triangle (== triangle_count without moving objects); also the number of
+    /// static triangles: the static tree (root node 0) exists when it is > 0.
+    pub dynamic_first: u32,
+    /// Node index of the dynamic tree's root (== the static tree's node count).
+    pub dynamic_root: u32,
+    pub _pad: u32,
+}
+
 pub const MAT_TEXTURED: u32 = 1;
 pub const MAT_MASKED: u32 = 2;
 pub const MAT_DOUBLE_SIDED: u32 = 4;
@@ -36,12 +58,33 @@ pub struct GpuScene {
     pub dynamic_first: u32,
     pub bounds: Bounds,
     pub eps: f32,
+    /// BVH bytes on the GPU: static tree plus the dynamic tree's fixed capacity.
     pub bvh_bytes: usize,
     pub texel_bytes: usize,
+    /// `SceneInfo` uniform (binding 5).
+    pub info: SceneInfo,
+    nodes: wgpu::Buffer,
+    prims: wgpu::Buffer,
+    /// Previous-frame positions of the dynamic vertices (binding 6; one vec4 each).
+    prev: wgpu::Buffer,
+    static_prims: u32,
+    dynamic_node_capacity: usize,
 }
 
 impl GpuScene {
+    /// Uploads `scene` with `bvh` as the static tree: a BVH over triangles
+    /// `0..scene.dynamic_first()` (`Bvh::build_range`; `Bvh::build` when nothing moves). Moving
+    /// objects start at t = 0.
     pub fn new(gpu: &Gpu, scene: &Scene, bvh: &Bvh) -> Result<GpuScene, GpuError> {
+        let dynamic_first = scene.dynamic_first();
+        let tri_count = scene.triangle_count();
+        let dyn_tris = tri_count - dynamic_first;
+        if bvh.prim_indices.len() != dynamic_first || bvh.prim_indices.iter().any(|&p| p as usize >= dynamic_first) {
+            return Err(GpuError::Invalid(format!(
+                "GpuScene::new needs the static BVH over triangles 0..{dynamic_first} (got one over {} triangles)",
+                bvh.prim_indices.len()
+            )));
+        }
         let mut texels: Vec<u32> = Vec::new();
         let mut offsets = Vec::new();
         for t in &scene.textures {
@@ -73,7 +116,9 @@ impl GpuScene {
             .collect();
         let max = gpu.limits.max_storage_buffer_binding_size as usize;
         let vbytes = std::mem::size_of_val(scene.vertices.as_slice());
-        for (what, bytes) in [("vertex data", vbytes), ("texture data", texels.len() * 4), ("BVH", bvh.nodes.len() * 32)] {
+        let dynamic_node_capacity = if dyn_tris > 0 { Bvh::max_nodes(dyn_tris) } else { 0 };
+        let node_count = bvh.nodes.len() + dynamic_node_capacity;
+        for (what, bytes) in [("vertex data", vbytes), ("texture data", texels.len() * 4), ("BVH", node_count * 32)] {
             if bytes > max {
                 return Err(GpuError::Invalid(format!("scene {what} is {bytes} bytes, over this device's storage binding limit of {max}")));
             }
@@ -82,10 +127,25 @@ impl GpuScene {
         let vertices = gpu.buffer_init("scene.vertices", bytemuck::cast_slice(&scene.vertices), st | BufferUsages::VERTEX);
         let mats = gpu.buffer_init("scene.materials", bytemuck::cast_slice(&materials), st);
         let tex = gpu.buffer_init("scene.texels", bytemuck::cast_slice(&texels), st);
-        let nodes = gpu.buffer_init("scene.bvh_nodes", bytemuck::cast_slice(&bvh.nodes), st);
-        let prims = gpu.buffer_init("scene.prim_indices", bytemuck::cast_slice(&bvh.prim_indices), st);
+        // static tree first, then room for the dynamic one (written by `set_time`)
+        let mut all_nodes = bvh.nodes.clone();
+        all_nodes.resize(node_count, BvhNode::default());
+        let mut all_prims = bvh.prim_indices.clone();
+        all_prims.resize(bvh.prim_indices.len() + dyn_tris, 0);
+        let nodes = gpu.buffer_init("scene.bvh_nodes", bytemuck::cast_slice(&all_nodes), st);
+        let prims = gpu.buffer_init("scene.prim_indices", bytemuck::cast_slice(&all_prims), st);
+        let info = SceneInfo {
+            triangle_count: tri_count as u32,
+            dynamic_first: dynamic_first as u32,
+            dynamic_root: bvh.nodes.len() as u32,
+            _pad: 0,
+        };
+        let info_buf = gpu.uniform("scene.info", &info);
+        let prev = gpu.storage("scene.dynamic_prev", (dyn_tris * 3 * 16).max(16) as u64);
         let vis = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let layout = binding::layout(&gpu.device, "scene", vis, &[binding::storage(true); 5]);
+        let mut types = [binding::storage(true); 7];
+        types[5] = binding::uniform();
+        let layout = binding::layout(&gpu.device, "scene", vis, &types);
         let group = binding::group(
             &gpu.device,
             "scene",
@@ -96,18 +156,67 @@ impl GpuScene {
                 tex.as_entire_binding(),
                 nodes.as_entire_binding(),
                 prims.as_entire_binding(),
+                info_buf.as_entire_binding(),
+                prev.as_entire_binding(),
             ],
         );
-        Ok(GpuScene {
+        let g = GpuScene {
             vertices,
             layout,
             group,
-            triangle_count: scene.triangle_count() as u32,
-            dynamic_first: scene.triangle_count() as u32,
-            bounds: scene.bounds(),
+            triangle_count: tri_count as u32,
+            dynamic_first: dynamic_first as u32,
+            bounds: scene.swept_bounds(),
             eps: scene.ray_epsilon(),
-            bvh_bytes: bvh.bytes(),
+            bvh_bytes: bvh.bytes() + dynamic_node_capacity * std::mem::size_of::<BvhNode>() + dyn_tris * 4,
             texel_bytes: texels.len() * 4,
-        })
+            info,
+            nodes,
+            prims,
+            prev,
+            static_prims: bvh.prim_indices.len() as u32,
+            dynamic_node_capacity,
+        };
+        g.set_time(gpu, scene, 0.0, 0.0)?;
+        Ok(g)
+    }
+
+    /// Whether the scene has moving objects.
+    pub fn is_animated(&self) -> bool {
+        self.dynamic_first < self.triangle_count
+    }
+
+    /// Moves the dynamic triangles to time `t` (frames) with their previous positions at
+    /// `prev_t` (motion vectors), and rebuilds and uploads the dynamic BVH. Queue writes only:
+    /// they take effect with the next submission. Nothing happens without moving objects.
+    pub fn set_time(&self, gpu: &Gpu, scene: &Scene, t: f32, prev_t: f32) -> Result<(), GpuError> {
+        if !self.is_animated() {
+            return Ok(());
+        }
+        if scene.dynamic_first() != self.dynamic_first as usize || scene.triangle_count() != self.triangle_count as usize {
+            return Err(GpuError::Invalid("GpuScene::set_time: not the scene this GpuScene was made from".into()));
+        }
+        if !(t.is_finite() && prev_t.is_finite()) {
+            return Err(GpuError::Invalid(format!("animation time must be finite (t = {t}, previous {prev_t})")));
+        }
+        let moved = scene.animated_vertices(t);
+        let prev: Vec<[f32; 4]> = scene.animated_vertices(prev_t).iter().map(|v| Vec3::from(v.pos).extend(1.0).into()).collect();
+        let tris: Vec<[Vec3; 3]> = moved.chunks_exact(3).map(|v| [v[0].pos.into(), v[1].pos.into(), v[2].pos.into()]).collect();
+        let dynamic = Bvh::from_triangles(&tris, self.dynamic_first).map_err(GpuError::Invalid)?;
+        if dynamic.nodes.len() > self.dynamic_node_capacity {
+            return Err(GpuError::Invalid(format!(
+                "dynamic BVH has {} nodes, over its capacity of {}",
+                dynamic.nodes.len(),
+                self.dynamic_node_capacity
+            )));
+        }
+        let node_size = std::mem::size_of::<BvhNode>() as u64;
+        let q = &gpu.queue;
+        q.write_buffer(&self.vertices, self.dynamic_first as u64 * 3 * 48, bytemuck::cast_slice(&moved));
+        q.write_buffer(&self.prev, 0, bytemuck::cast_slice(&prev));
+        let nodes = dynamic.relocated_nodes(self.info.dynamic_root, self.static_prims);
+        q.write_buffer(&self.nodes, self.info.dynamic_root as u64 * node_size, bytemuck::cast_slice(&nodes));
+        q.write_buffer(&self.prims, self.static_prims as u64 * 4, bytemuck::cast_slice(&dynamic.prim_indices));
+        Ok(())
     }
 }

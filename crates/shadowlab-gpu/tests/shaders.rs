@@ -284,3 +284,22 @@ fn warp_struct_layouts_match_rust() {
         ],
     );
 }
+
+#[test]
+fn scene_info_layout_matches_wgsl() {
+    use shadowlab_gpu::scene_gpu::SceneInfo;
+    let all = shadowlab_gpu::shaders::all();
+    for name in ["rt.wgsl", "gbuffer.wgsl"] {
+        let src = &all.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("{name} not composed")).1;
+        check(
+            &parse(name, src),
+            "SceneInfo",
+            size_of::<SceneInfo>(),
+            &[
+                ("triangle_count", offset_of!(SceneInfo, triangle_count)),
+                ("dynamic_first", offset_of!(SceneInfo, dynamic_first)),
+                ("dynamic_root", offset_of!(SceneInfo, dynamic_root)),
+            ],
+        );
+    }
+}

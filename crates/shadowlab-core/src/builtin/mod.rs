@@ -9,6 +9,9 @@ mod room;
 
 use glam::{Mat4, Vec2, Vec3};
 
+/// The foliage hand cart at t = 0 (body corners) and its travel (tests follow it).
+pub use foliage::{CART as FOLIAGE_CART, CART_TRAVEL as FOLIAGE_CART_TRAVEL};
+
 use crate::camera::{Camera, CameraKey};
 use crate::light::Light;
 use crate::scene::{LoadReport, Material, Scene, Texture, TriangleSink};

@@ -1,5 +1,7 @@
 // G-buffer pass: world position + linear view depth, geometric normal facing the camera,
-// albedo, motion vector (pixels, current minus previous). Alpha-tested texels are discarded.
+// albedo, motion vector (pixels, current minus previous: camera motion and, for moving objects,
+// the surface point's own motion, from its previous-frame position `previous_position`).
+// Alpha-tested texels are discarded.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 
@@ -8,6 +10,7 @@ struct VsOut {
     @location(0) world: vec3<f32>,
     @location(1) uv: vec2<f32>,
     @location(2) @interpolate(flat) tri: u32,
+    @location(3) prev_world: vec3<f32>,
 }
 
 @vertex
@@ -18,6 +21,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     o.world = v.pos;
     o.uv = v.uv;
     o.tri = vi / 3u;
+    o.prev_world = previous_position(vi);
     return o;
 }
 
@@ -40,7 +44,7 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> GOut {
         n = -n;
     }
     let cur = frame.view_proj * vec4<f32>(in.world, 1.0);
-    let prev = frame.prev_view_proj * vec4<f32>(in.world, 1.0);
+    let prev = frame.prev_view_proj * vec4<f32>(in.prev_world, 1.0);
     let size = vec2<f32>(frame.size);
     let motion = (cur.xy / cur.w - prev.xy / prev.w) * vec2<f32>(0.5, -0.5) * size;
     var o: GOut;

@@ -1,6 +1,8 @@
 // Shadow-ray library shared by `rt` and every technique that traces rays (leak tracing,
 // hybrid classifiers): any-hit traversal of the scene BVH with early exit, alpha cut-outs
-// honoured. Needs `scene.wgsl` and the light uniform. Mirrors shadowlab-core/src/bvh.rs
+// honoured. Two trees: the static one (root 0) and the dynamic one over the moving objects
+// (root `scene_info.dynamic_root`, rebuilt every frame); `occluded` sees both,
+// `occluded_static` / `occluded_dynamic` one each. Needs `scene.wgsl` and the light uniform. Mirrors shadowlab-core/src/bvh.rs
 // (`shadow_ray`, `intersect_triangle`, `occluded`).
 
 const MAX_DEPTH: u32 = 64u;
@@ -59,11 +61,12 @@ fn passes_cutout(prim: u32, u: f32, v: f32) -> bool {
     return cut_out(m, uv);
 }
 
-fn occluded(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
+// Any-hit traversal of the tree rooted at node `root`.
+fn occluded_tree(root: u32, o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
     let inv = vec3<f32>(safe_inv(d.x), safe_inv(d.y), safe_inv(d.z));
     var stack: array<u32, MAX_DEPTH>;
     var sp = 1u;
-    stack[0] = 0u;
+    stack[0] = root;
     while sp > 0u {
         sp -= 1u;
         let n = bvh_nodes[stack[sp]];
@@ -85,6 +88,20 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
         }
     }
     return false;
+}
+
+// Blocked by static geometry (triangles 0..dynamic_first).
+fn occluded_static(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
+    return scene_info.dynamic_first > 0u && occluded_tree(0u, o, d, tmax);
+}
+
+// Blocked by moving objects (triangles dynamic_first..triangle_count, where they are this frame).
+fn occluded_dynamic(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
+    return scene_info.dynamic_first < scene_info.triangle_count && occluded_tree(scene_info.dynamic_root, o, d, tmax);
+}
+
+fn occluded(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
+    return occluded_static(o, d, tmax) || occluded_dynamic(o, d, tmax);
 }
 
 // True where the light is blocked for a surface point `p` with geometric normal `n` (the ray
