@@ -61,7 +61,8 @@ pub fn bench(setups: &[PathBuf], size: &str, frames: usize, out: Option<&Path>) 
     for (name, setup) in &jobs {
         eprintln!("bench: {name}");
         let t0 = Instant::now();
-        let scene = load_scene(&setup.scene_source().map_err(|e| anyhow!(e))?, &setup.transform())?;
+        let mut scene = load_scene(&setup.scene_source().map_err(|e| anyhow!(e))?, &setup.transform())?;
+        shadowlab_core::anim::apply(&mut scene, &setup.animations).map_err(|e| anyhow!("{name}: [[animations]]: {e}"))?;
         let load_ms = t0.elapsed().as_secs_f64() * 1e3;
         let camera = setup.camera.as_ref().map(|c| c.camera()).unwrap_or(scene.camera);
         let light = setup.lights.first().copied().unwrap_or(scene.lights[0]);

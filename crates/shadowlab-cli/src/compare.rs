@@ -29,6 +29,7 @@ pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
     anyhow::ensure!(cfg.specs.len() == 1, "render takes one technique (got {}); use compare for several", cfg.specs.len());
     let gpu = Gpu::new()?;
     let lab = Lab::new(&gpu, &cfg.scene)?;
+    lab.set_time(cfg.time, cfg.time)?;
     let view = lab.view(&cfg.camera, &cfg.camera, cfg.light(), cfg.width, cfg.height)?;
     let run = lab.run(&view, &cfg.specs[0], args.repeat)?;
     let tmp = out.with_extension("partial.png");
@@ -120,7 +121,8 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         "adapter": gpu.adapter_summary(),
         "timer": gpu.timer_name(),
         "repeat": args.repeat,
-        "bvh": {"nodes": lab.bvh.nodes.len(), "bytes": lab.bvh.bytes(), "bytes_per_triangle": lab.bvh.bytes() as f64 / cfg.scene.triangle_count() as f64, "depth": lab.bvh.depth, "build_ms": lab.bvh.build_ms},
+        "animation": animation_json(&cfg, &lab),
+        "bvh": {"gpu_bytes": lab.gscene.bvh_bytes, "nodes": lab.bvh.nodes.len(), "bytes": lab.bvh.bytes(), "bytes_per_triangle": lab.bvh.bytes() as f64 / cfg.scene.triangle_count() as f64, "depth": lab.bvh.depth, "build_ms": lab.bvh.build_ms},
         "gbuffer_stages_ms": view.stages_ms,
         "frames": frames,
         "cameras": path.cameras,
@@ -153,6 +155,18 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         println!("report: {} ({:.1} s)", final_dir.join("index.html").display(), t_start.elapsed().as_secs_f64());
     }
     Ok(())
+}
+
+/// Moving objects: how many triangles move (0 = a still scene), which, how, and the times.
+fn animation_json(cfg: &RunConfig, lab: &Lab) -> serde_json::Value {
+    let s = &cfg.scene;
+    json!({
+        "dynamic_triangles": s.triangle_count() - s.dynamic_first(),
+        "dynamic_first": lab.gscene.dynamic_first,
+        "time_unit": "frames",
+        "start_time": cfg.time,
+        "animations": s.animations.iter().map(|a| json!({"name": a.name, "triangles": a.count, "motion": a.motion})).collect::<Vec<_>>(),
+    })
 }
 
 /// The reference's time: its median over frames 1.. (or its single frame's median).

@@ -31,6 +31,8 @@ pub struct RunConfig {
     pub width: u32,
     pub height: u32,
     pub specs: Vec<TechniqueSpec>,
+    /// Animation time of frame 0 (`--time`, frames).
+    pub time: f32,
 }
 
 impl RunConfig {
@@ -112,7 +114,11 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
     if width == 0 || height == 0 {
         bail!("output size {width}x{height}: width and height must be at least 1");
     }
-    let scene = load_scene(&source, &setup.transform()).with_context(|| "loading the scene")?;
+    if !args.time.is_finite() {
+        bail!("--time {}: must be a finite number of frames", args.time);
+    }
+    let mut scene = load_scene(&source, &setup.transform()).with_context(|| "loading the scene")?;
+    shadowlab_core::anim::apply(&mut scene, &setup.animations).map_err(|e| anyhow!("[[animations]]: {e}"))?;
     for w in &scene.report.warnings {
         eprintln!("warning: {w}");
     }
@@ -143,6 +149,7 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
         width,
         height,
         specs,
+        time: args.time,
     };
     for s in &cfg.specs {
         shadowlab_gpu::techniques::resolve(s, Some(cfg.light()))?;

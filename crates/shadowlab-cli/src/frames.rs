@@ -6,6 +6,7 @@
 //! frames in order, once each (techniques with history, such as temporal masks or delayed
 //! analysis, see a real sequence); times are medians over frames 1.. (frame 0 is the warm-up),
 //! quality figures are means over all frames, flicker is the mean over consecutive pairs.
+//! Moving objects move with the frames: frame k is at animation time `--time` + k (frames).
 
 use std::collections::BTreeMap;
 
@@ -44,6 +45,8 @@ pub struct FrameRecord {
 #[derive(Clone, Debug, Serialize)]
 pub struct ReferenceFrame {
     pub frame: usize,
+    /// Animation time of the frame (frames; `--time` + frame).
+    pub time: f32,
     pub evaluated_pixels: u64,
     pub edge_pixels: u64,
     pub rays_traced: Option<f64>,
@@ -84,6 +87,9 @@ pub fn run(lab: &Lab, cfg: &RunConfig, frames: usize, repeat: usize, pb: &Progre
     let mut last = None;
     for (f, cam) in cameras.iter().enumerate() {
         let prev_cam = if f == 0 { cam } else { &cameras[f - 1] };
+        // moving objects: frame f at time + f; frame 0's motion vectors are zero like its camera's
+        let t = cfg.time + f as f32;
+        lab.set_time(t, if f == 0 { t } else { t - 1.0 })?;
         pb.set_message(format!("frame {}/{frames}: G-buffer", f + 1));
         let view = lab.view(cam, prev_cam, light, cfg.width, cfg.height)?;
         pb.set_message(format!("frame {}/{frames}: rt (reference)", f + 1));
@@ -92,6 +98,7 @@ pub fn run(lab: &Lab, cfg: &RunConfig, frames: usize, repeat: usize, pb: &Progre
         let evaluated = view.mask.iter().filter(|m| **m != 0).count() as u64;
         reference.push(ReferenceFrame {
             frame: f,
+            time: t,
             evaluated_pixels: evaluated,
             edge_pixels: edges,
             rays_traced: rt.report.counters.get("rays_traced").copied(),

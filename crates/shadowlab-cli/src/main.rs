@@ -45,6 +45,10 @@ pub struct RunArgs {
     /// the camera holds still where there is none). 1 = the single view of frame 0
     #[arg(long, default_value_t = 1)]
     pub frames: usize,
+    /// Animation time of frame 0, in frames (moving objects: frame k of `--frames` is at
+    /// time + k; a single view is at this time)
+    #[arg(long, default_value_t = 0.0)]
+    pub time: f32,
     /// No progress bar or summary
     #[arg(long, short)]
     pub quiet: bool,

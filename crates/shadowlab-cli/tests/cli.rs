@@ -253,3 +253,50 @@ fn techniques_and_scenes_list_the_registries() {
         assert!(s.contains(needle), "scenes output lacks '{needle}'");
     }
 }
+
+#[test]
+fn moving_objects_move_with_the_frames_and_bad_animations_are_clear_errors() {
+    let setup_dir = tmp("anim-setup");
+    std::fs::create_dir_all(&setup_dir).unwrap();
+    let bad = setup_dir.join("bad.toml");
+    std::fs::write(&bad, "[scene]\nbuiltin = 'planebox'\n[[animations]]\nname = 'x'\nmaterials = ['nope']\nmotion = { type = 'orbit', center = [0, 0, 0], axis = [0, 1, 0], period = 10 }\n").unwrap();
+    let out = tmp("anim");
+    let o = out.to_str().unwrap();
+    assert_clean_error(&run(&["compare", "-q", "--setup", bad.to_str().unwrap(), "--out", o]), "unknown material 'nope'");
+    assert_clean_error(&run(&["compare", "-q", "--scene", "planebox", "--time", "NaN", "--out", o]), "--time");
+    assert!(!out.exists());
+    if skip_gpu() {
+        return;
+    }
+    let good = setup_dir.join("good.toml");
+    std::fs::write(&good, "[scene]\nbuiltin = 'planebox'\n[[animations]]\nname = 'box'\nmaterials = ['box']\nmotion = { type = 'translate', offset = [2, 0, 0], period = 4 }\n").unwrap();
+    let r = run(&[
+        "compare",
+        "-q",
+        "--setup",
+        good.to_str().unwrap(),
+        "--size",
+        "96x96",
+        "--frames",
+        "3",
+        "--time",
+        "1",
+        "-t",
+        "sm",
+        "--out",
+        o,
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["animation"]["dynamic_triangles"], 12, "the box's 12 triangles move");
+    assert_eq!(m["animation"]["animations"][0]["name"], "box");
+    let times: Vec<f64> = m["reference"]["frames"].as_array().unwrap().iter().map(|f| f["time"].as_f64().unwrap()).collect();
+    assert_eq!(times, [1.0, 2.0, 3.0]);
+    let _ = std::fs::remove_dir_all(&out);
+    let r = run(&["compare", "-q", "--scene", "planebox", "--size", "64x64", "-t", "sm", "--out", o]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(m["animation"]["dynamic_triangles"], 0, "planebox stands still");
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&setup_dir);
+}
