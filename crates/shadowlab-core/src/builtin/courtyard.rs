@@ -8,6 +8,7 @@
 //! comes from the far end towards the viewer, where a plain shadow map is worst off. Shadows in
 //! view: the far arcade's arches stretched ~3x along the floor, the -z upper arcade, balustrade
 //! and banners as long streaks across the court, the fountain, and the -z building's long edge.
+//! Moving objects ([`animations`]): the banners swing about their rods.
 
 use std::f32::consts::PI;
 

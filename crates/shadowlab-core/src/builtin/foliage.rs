@@ -5,6 +5,9 @@
 //!
 //! The sun (37 degrees up) hits the wall at about 45 degrees, so the lamp, cable and leaf shadows
 //! land on the wall the camera looks at; the fence wires' shadows lie on the ground.
+//!
+//! Moving objects ([`animations`], time in frames): a hand cart with a thin flag pole crosses
+//! between the lamp and the wall, and the cables sway, so their shadows move across the wall.
 
 use glam::{Vec2, Vec3};
 

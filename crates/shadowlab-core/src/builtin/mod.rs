@@ -26,17 +26,17 @@ pub struct BuiltinScene {
 pub const BUILTIN_SCENES: &[BuiltinScene] = &[
     BuiltinScene {
         name: "courtyard",
-        summary: "Sponza-like atrium: two storeys of columns and arches, thin banners, grazing sun (perspective aliasing)",
+        summary: "Sponza-like atrium: two storeys of columns and arches, thin banners swinging on their rods, grazing sun (perspective aliasing)",
         build: courtyard::build,
     },
     BuiltinScene {
         name: "room",
-        summary: "closed interior: table, 12 chairs with thin legs, shelves; spot light (light 0) and point light (light 1)",
+        summary: "closed interior: table, 12 chairs with thin legs (one slides in and out), shelves; spot light (light 0) and point light (light 1)",
         build: room::build,
     },
     BuiltinScene {
         name: "foliage",
-        summary: "alpha-tested leaf cards, a wire fence, a street lamp with thin wires before a wall (light leaks); sun",
+        summary: "alpha-tested leaf cards, a wire fence, a street lamp with swaying thin wires before a wall, a crossing hand cart (light leaks); sun",
         build: foliage::build,
     },
     BuiltinScene {

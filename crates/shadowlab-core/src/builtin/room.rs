@@ -5,6 +5,7 @@
 //! a point light hanging above the table below the ceiling (omnidirectional shadows: cube or
 //! dual-paraboloid maps, NoTW for point lights). The camera stands in the front-right corner and
 //! looks at the table with the point light inside the view, so its shadows surround the viewer.
+//! Moving object ([`animations`]): the chair at the +x end of the table slides out and back.
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
