@@ -162,3 +162,71 @@ fn still_scenes_have_no_dynamic_part_and_ignore_time() {
     assert!(motion.iter().all(|m| *m == [0.0, 0.0]), "nothing moves");
     assert!(!v7.stages_ms.contains_key("scene.animate"));
 }
+
+/// Per sample: bit 0 = `occluded_static`, bit 1 = `occluded_dynamic` (the ray of `sample_shadowed`).
+const SPLIT_WGSL: &str = r#"
+@group(0) @binding(6) var<storage, read_write> hits: array<u32>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let o = s.p + s.n * light.eps;
+    var d = -light.direction.xyz;
+    var tmax = 1e30;
+    if light.kind != LIGHT_DIRECTIONAL {
+        let to = light.position.xyz - o;
+        tmax = length(to);
+        d = to / tmax;
+    }
+    hits[s.i] = select(0u, 1u, occluded_static(o, d, tmax)) | select(0u, 2u, occluded_dynamic(o, d, tmax));
+}
+"#;
+
+#[test]
+fn occluded_static_and_occluded_dynamic_each_see_their_part() {
+    use shadowlab_core::bvh::{occluded_from, shadow_ray};
+    use shadowlab_gpu::reference::TRACE_WGSL;
+    use shadowlab_gpu::techniques::{compose_view, view_layout};
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("foliage").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let t = 16.0;
+    lab.set_time(t, t).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let layout = view_layout(&gpu, "split", &[shadowlab_gpu::binding::storage(false)]);
+    let pipeline =
+        gpu.compute_pipeline("split", &compose_view(&format!("{TRACE_WGSL}{SPLIT_WGSL}"), true), "main", &[&layout, &lab.gscene.layout]);
+    let hits = gpu.storage("split.hits", 256 * 256 * 4);
+    let inputs = v.inputs(&lab.gscene);
+    let group = inputs.view_group(&gpu, "split", &layout, &[hits.as_entire_binding()]);
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    gpu.dispatch_2d(&mut enc, "split", &pipeline, &[&group, &lab.gscene.group], 256, 256);
+    gpu.queue.submit([enc.finish()]);
+    gpu.take_error().unwrap();
+    let got: Vec<u32> = gpu.read_buffer_as(&hits, 256 * 256);
+    // CPU: the moved scene, one tree per part
+    let moved = scene.at_time(t);
+    let d = moved.dynamic_first();
+    let st = Bvh::build_range(&moved, 0..d).unwrap();
+    let dy = Bvh::build_range(&moved, d..moved.triangle_count()).unwrap();
+    let light = scene.lights[0];
+    let (mut n, mut wrong, mut by_dynamic) = (0, 0, 0);
+    for i in 0..got.len() {
+        if v.mask[i] == 0 {
+            continue;
+        }
+        let p = Vec3::from_slice(&v.position[i][..3]);
+        let nn = Vec3::from_slice(&v.normal[i][..3]);
+        let r = shadow_ray(&light, p, nn, lab.gscene.eps);
+        let s = occluded_from(&st.nodes, &st.prim_indices, 0, &moved, &r) as u32;
+        let dd = occluded_from(&dy.nodes, &dy.prim_indices, 0, &moved, &r) as u32;
+        n += 1;
+        wrong += (got[i] != s | (dd << 1)) as u32;
+        by_dynamic += dd;
+    }
+    assert!(n > 10_000 && by_dynamic > 50, "{n} samples, {by_dynamic} shadowed by moving objects");
+    assert!(wrong * 10_000 <= n, "{wrong} of {n} samples disagree with the CPU per tree");
+}
