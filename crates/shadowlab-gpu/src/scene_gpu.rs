@@ -212,7 +212,8 @@ impl GpuScene {
         }
         let node_size = std::mem::size_of::<BvhNode>() as u64;
         let q = &gpu.queue;
-        q.write_buffer(&self.vertices, self.dynamic_first as u64 * 3 * 48, bytemuck::cast_slice(&moved));
+        let vertex_size = std::mem::size_of::<shadowlab_core::scene::Vertex>() as u64;
+        q.write_buffer(&self.vertices, self.dynamic_first as u64 * 3 * vertex_size, bytemuck::cast_slice(&moved));
         q.write_buffer(&self.prev, 0, bytemuck::cast_slice(&prev));
         let nodes = dynamic.relocated_nodes(self.info.dynamic_root, self.static_prims);
         q.write_buffer(&self.nodes, self.info.dynamic_root as u64 * node_size, bytemuck::cast_slice(&nodes));

@@ -47,5 +47,11 @@ mod tests {
         assert!(h.contains("res=512<") || h.contains("res=512,") || h.contains("res=512 "), "parameters print as whole numbers");
         assert!(h.contains("<td>9</td>"), "fetches print as whole numbers");
         assert!(!h.contains("http://") && !h.contains("https://"), "report must work offline");
+        assert!(!h.contains("moving"), "a still scene says nothing about moving objects");
+        let mut moving = m.clone();
+        moving["animation"] =
+            serde_json::json!({"dynamic_triangles": 12, "start_time": 0.0, "animations": [{"name": "cart"}, {"name": "cable"}]});
+        let h = super::html(&moving).unwrap();
+        assert!(h.contains("12 moving: cart, cable"), "moving objects are named in the header");
     }
 }
