@@ -214,7 +214,7 @@ fn occluded_static_and_occluded_dynamic_each_see_their_part() {
     let dy = Bvh::build_range(&moved, d..moved.triangle_count()).unwrap();
     let light = scene.lights[0];
     let (mut n, mut wrong, mut by_dynamic) = (0, 0, 0);
-    for i in 0..got.len() {
+    for (i, &g) in got.iter().enumerate() {
         if v.mask[i] == 0 {
             continue;
         }
@@ -224,7 +224,7 @@ fn occluded_static_and_occluded_dynamic_each_see_their_part() {
         let s = occluded_from(&st.nodes, &st.prim_indices, 0, &moved, &r) as u32;
         let dd = occluded_from(&dy.nodes, &dy.prim_indices, 0, &moved, &r) as u32;
         n += 1;
-        wrong += (got[i] != s | (dd << 1)) as u32;
+        wrong += (g != s | (dd << 1)) as u32;
         by_dynamic += dd;
     }
     assert!(n > 10_000 && by_dynamic > 50, "{n} samples, {by_dynamic} shadowed by moving objects");
