@@ -190,3 +190,36 @@ fn builtin_animations_move_at_t_not_at_zero() {
         assert_eq!(s.dynamic_first(), s.triangle_count(), "{name} stays still");
     }
 }
+
+#[test]
+fn loaded_files_select_by_material_name_and_box() {
+    use crate::loaders::{load, SceneTransform};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    // OBJ: `usemtl` names; the unit squares sit at x = 0, 2, 4, ...; scaled by 2 on load, so the
+    // box is in scene coordinates after the transform
+    let xf = SceneTransform { scale: 2.0, ..Default::default() };
+    let mut s = load(&dir.join("quad.obj"), &xf).unwrap();
+    let n = s.triangle_count();
+    let solid = s.materials.iter().position(|m| m.name == "solid").unwrap() as u32;
+    let count = |s: &Scene, m: u32| (0..s.triangle_count()).filter(|&i| s.vertices[3 * i].material == m).count();
+    let solids = count(&s, solid);
+    apply(
+        &mut s,
+        &[
+            spec("solid squares", &["solid"], None),
+            spec("first leaves", &["leaves"], Some([Vec3::new(3.9, -1.0, -1.0), Vec3::new(6.1, 3.0, 1.0)])),
+        ],
+    )
+    .unwrap();
+    assert_eq!(s.triangle_count(), n);
+    assert_eq!(s.animations[0].count, solids);
+    assert_eq!(s.animations[1].count, 2, "the 'leaves' square at x = 2 (4..6 after scaling)");
+    assert!(s.vertices[3 * s.animations[0].first..3 * (s.animations[0].first + solids)].iter().all(|v| v.material == solid));
+    // glTF: material names as written (unnamed ones are `material<i>`)
+    let mut g = load(&dir.join("nested.gltf"), &SceneTransform::default()).unwrap();
+    let cut = g.materials.iter().position(|m| m.name == "cutout").unwrap() as u32;
+    let cuts = count(&g, cut);
+    assert!(cuts > 0);
+    apply(&mut g, &[spec("cut", &["cutout"], None)]).unwrap();
+    assert_eq!(g.triangle_count() - g.dynamic_first(), cuts);
+}
