@@ -6,6 +6,7 @@ pub mod builtin;
 pub mod bvh;
 pub mod calipers;
 pub mod camera;
+pub mod cube;
 pub mod cascades;
 pub mod edges;
 pub mod iasm;
