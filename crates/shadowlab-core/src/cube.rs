@@ -13,6 +13,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::camera::perspective;
+use crate::scene::Vertex;
 
 /// One cube face: the axis it looks along and its right / up vectors (right-handed: u x v = -n
 /// as in a right-handed camera looking along -z).
@@ -101,6 +102,50 @@ pub fn face_view_proj(light: Vec3, f: usize, near: f32, far: f32) -> Mat4 {
 /// face's plane at depth dot(d, n) is 2 dot(d, n) wide): the unit of the bias on every face.
 pub fn texel_size(f: usize, d: Vec3, res: u32) -> f32 {
     2.0 * d.dot(FACES[f].n) / res as f32
+}
+
+/// Clips a triangle to face `f`'s frustum from `light`: in front of the plane at distance
+/// `near` along the axis, and inside the square of half-width `tan_half` (1 = exactly 90
+/// degrees; a little more keeps clipped edges outside the map). The part inside comes back as
+/// a fan of triangles (none when the triangle misses the frustum); positions and texture
+/// coordinates are interpolated, normal and material kept. Warped maps need this: their
+/// per-vertex warp is undefined for vertices behind the light (w <= 0), which every big wall
+/// of a room around a point light has.
+pub fn clip_to_face(tri: &[Vertex; 3], light: Vec3, f: usize, near: f32, tan_half: f32) -> Vec<[Vertex; 3]> {
+    let fc = &FACES[f];
+    let planes = [fc.n * tan_half - fc.u, fc.n * tan_half + fc.u, fc.n * tan_half - fc.v, fc.n * tan_half + fc.v];
+    let dist = |k: usize, v: &Vertex| {
+        let d = Vec3::from(v.pos) - light;
+        if k == 4 {
+            d.dot(fc.n) - near
+        } else {
+            d.dot(planes[k])
+        }
+    };
+    let mut poly: Vec<Vertex> = tri.to_vec();
+    for k in 0..5 {
+        let mut out = Vec::with_capacity(poly.len() + 1);
+        for i in 0..poly.len() {
+            let (a, b) = (&poly[i], &poly[(i + 1) % poly.len()]);
+            let (da, db) = (dist(k, a), dist(k, b));
+            if da >= 0.0 {
+                out.push(*a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                let t = da / (da - db);
+                let lerp = |x: &[f32], y: &[f32], i: usize| x[i] + (y[i] - x[i]) * t;
+                let mut v = *a;
+                v.pos = std::array::from_fn(|i| lerp(&a.pos, &b.pos, i));
+                v.uv = std::array::from_fn(|i| lerp(&a.uv, &b.uv, i));
+                out.push(v);
+            }
+        }
+        poly = out;
+        if poly.len() < 3 {
+            return Vec::new();
+        }
+    }
+    (1..poly.len() - 1).map(|i| [poly[0], poly[i], poly[i + 1]]).collect()
 }
 
 #[cfg(test)]
@@ -227,5 +272,53 @@ mod tests {
         let d = Vec3::new(2.0, 2.0, 0.5);
         assert_eq!(texel_size(0, d, 512), texel_size(2, d, 512));
         assert_eq!(texel_size(0, Vec3::new(3.0, 0.0, 0.0), 300), 0.02);
+    }
+
+    fn vert(p: [f32; 3], uv: [f32; 2]) -> Vertex {
+        Vertex { pos: p, uv, material: 7, ..Default::default() }
+    }
+
+    fn area(t: &[Vertex; 3]) -> f32 {
+        let p = t.map(|v| Vec3::from(v.pos));
+        (p[1] - p[0]).cross(p[2] - p[0]).length() * 0.5
+    }
+
+    #[test]
+    fn clipping_by_hand() {
+        let l = Vec3::ZERO;
+        // inside +x's frustum: unchanged
+        let t = [vert([2.0, 0.0, 0.0], [0.0, 0.0]), vert([2.0, 1.0, 0.0], [1.0, 0.0]), vert([2.0, 0.0, 1.0], [0.0, 1.0])];
+        assert_eq!(clip_to_face(&t, l, 0, 0.01, 1.0), vec![t]);
+        // behind the light (for +x) or outside a side plane: nothing
+        let back = t.map(|mut v| {
+            v.pos[0] = -2.0;
+            v
+        });
+        assert!(clip_to_face(&back, l, 0, 0.01, 1.0).is_empty());
+        assert!(clip_to_face(&t, l, 2, 0.01, 1.0).is_empty());
+        // a wall x = 1 from y = -5..5, z = -5..5 (two triangles) clipped to +x: the square
+        // |y|, |z| <= 1 (area 4), texture coordinates interpolated linearly in position
+        let q = [[1.0, -5.0, -5.0], [1.0, 5.0, -5.0], [1.0, 5.0, 5.0], [1.0, -5.0, 5.0]];
+        let v = |i: usize| vert(q[i], [(q[i][1] + 5.0) / 10.0, (q[i][2] + 5.0) / 10.0]);
+        let mut total = 0.0;
+        for tri in [[v(0), v(1), v(2)], [v(0), v(2), v(3)]] {
+            for c in clip_to_face(&tri, l, 0, 0.01, 1.0) {
+                total += area(&c);
+                for p in c {
+                    assert!(p.pos[1].abs() <= 1.0 + 1e-5 && p.pos[2].abs() <= 1.0 + 1e-5, "{:?}", p.pos);
+                    assert!((p.uv[0] - (p.pos[1] + 5.0) / 10.0).abs() < 1e-5 && (p.uv[1] - (p.pos[2] + 5.0) / 10.0).abs() < 1e-5);
+                    assert_eq!(p.material, 7);
+                }
+            }
+        }
+        assert!((total - 4.0).abs() < 1e-4, "{total}");
+        // a floor triangle under the light crossing behind it (y = -1, x from -3 to 3): the +x
+        // part keeps x >= near and |z| <= x, |y| = 1 <= x
+        let floor = [vert([-3.0, -1.0, -3.0], [0.0; 2]), vert([3.0, -1.0, -3.0], [0.0; 2]), vert([0.0, -1.0, 3.0], [0.0; 2])];
+        let c = clip_to_face(&floor, l, 0, 0.01, 1.0);
+        assert!(!c.is_empty());
+        for p in c.iter().flatten() {
+            assert!(p.pos[0] >= 1.0 - 1e-5 && p.pos[2].abs() <= p.pos[0] + 1e-5, "{:?}", p.pos);
+        }
     }
 }

@@ -10,6 +10,7 @@
 //!   (a spot light along the face axis) handled by `warp::Warped` with the face's view samples
 //!   only (its own desired view, count map and warps: 8 w^2 bytes per face).
 
+mod clip;
 mod notw;
 pub use notw::CubeNotw;
 
@@ -43,7 +44,12 @@ fn split_src() -> String {
 }
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("cube/depth.wgsl", depth_src()), ("cube/eval.wgsl", eval_src()), ("cube/split.wgsl", split_src())]
+    vec![
+        ("cube/depth.wgsl", depth_src()),
+        ("cube/eval.wgsl", eval_src()),
+        ("cube/split.wgsl", split_src()),
+        ("cube/scene_copy.wgsl", clip::scene_copy_src()),
+    ]
 }
 
 /// sm's parameters apply unchanged: `res` is per face (the seeds' 512), the bias is in texels of
@@ -221,10 +227,9 @@ impl Technique for CubeMap {
     }
 
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let view = self.map.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let view = self
+            .map
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
         let group = f.view_group(
             gpu,
             "cube.evaluate",

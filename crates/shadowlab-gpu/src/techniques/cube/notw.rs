@@ -13,7 +13,7 @@ use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::ParamValues;
 
-use super::{point_position, split_src};
+use super::{clip, point_position, split_src};
 use crate::frame::LightUniform;
 use crate::gbuffer::GBuffer;
 use crate::scene_gpu::GpuScene;
@@ -27,6 +27,8 @@ const FACE_IMAGES: &[&str] = &["count map before warping", "count map after warp
 
 struct Face {
     warped: Warped,
+    /// The scene's triangles clipped to this face (clip.rs).
+    scene: GpuScene,
     light: Light,
     light_buf: wgpu::Buffer,
     sel: wgpu::Buffer,
@@ -50,14 +52,23 @@ pub struct CubeNotw {
 impl CubeNotw {
     pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<CubeNotw, GpuError> {
         let position = point_position("cube-notw", light)?;
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "cube face")?;
+        // near plane of lightspace::fit's spot frustum; clip a little in front of it and a few
+        // texels outside the map's square (fit adds one texel of margin)
+        let far = scene.bounds.corners().iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
+        let near = (far * 1e-3).max(1e-4);
+        let scenes = clip::face_scenes(gpu, scene, position, 2.0 * near, 1.0 + 8.0 / res as f32);
         let faces = FACES
             .iter()
+            .zip(scenes)
             .enumerate()
-            .map(|(f, fc)| {
+            .map(|(f, (fc, face_scene))| {
                 // one face = a spot light along the axis whose fitted frustum is the face's square
                 let light = Light::Spot { position, direction: fc.n, cone_deg: 45.0 };
                 Ok(Face {
-                    warped: Warped::new(gpu, scene, p, &light, Variant::Notw)?,
+                    warped: Warped::new(gpu, &face_scene, p, &light, Variant::Notw)?,
+                    scene: face_scene,
                     light,
                     light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
                     sel: gpu.uniform(&format!("cube-notw.face{f}"), &[f as u32, 0, 0, 0]),
@@ -71,7 +82,7 @@ impl CubeNotw {
         let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw, rw, rw]);
         let src = split_src();
         Ok(CubeNotw {
-            res: p.get_u32("res"),
+            res,
             faces,
             face_samples: gpu.storage("cube-notw.face_samples", 6 * 4),
             split: gpu.compute_pipeline("cube-notw.split", &src, "split", &[&layout]),
@@ -125,7 +136,7 @@ impl CubeNotw {
             };
             let vis = face.vis.clone().expect("sized in prepare");
             let fi = FrameInputs {
-                scene: f.scene,
+                scene: &face.scene,
                 gbuffer: &gbuffer,
                 light: face.light,
                 camera: f.camera,
@@ -192,6 +203,7 @@ impl Technique for CubeNotw {
         for (i, face) in self.faces.iter_mut().enumerate() {
             let name = FACES[i].name;
             r.counters.insert(format!("view_samples_face_{name}"), face.samples as f64);
+            r.counters.insert(format!("clipped_triangles_face_{name}"), face.scene.triangle_count as f64);
             if face.samples == 0 {
                 // not rendered this frame: no samples, nothing to report but its memory
                 after.extend(std::iter::repeat_n(0, n));
