@@ -108,6 +108,7 @@ pub struct CubeParams {
 /// A point light's cube shadow map: six layers of one Depth32Float array texture.
 pub struct CubeMap {
     res: u32,
+    far: f32,
     pcf: u32,
     map: wgpu::Texture,
     face_groups: Vec<wgpu::BindGroup>,
@@ -154,6 +155,7 @@ impl CubeMap {
         let eval_pipeline = gpu.compute_pipeline("cube.evaluate", &eval_src(), "main", &[&eval_layout]);
         Ok(CubeMap {
             res,
+            far,
             pcf,
             map,
             face_groups,
@@ -163,6 +165,11 @@ impl CubeMap {
             eval_layout,
             eval_pipeline,
         })
+    }
+
+    /// The distance stored as depth 1 (the faces hold distance / far).
+    pub fn far(&self) -> f32 {
+        self.far
     }
 
     /// The six faces (+x, -x, +y, -y, +z, -z), each `res x res` row-major: distance / far.
