@@ -68,6 +68,40 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create: |gpu, scene, p, light| Ok(Box::new(CubeMap::new(gpu, scene, p, light)?)),
 };
 
+const W: &[ParamDef] = crate::techniques::warp::NOTW_PARAMS;
+
+/// cube-notw's smoothing window (rows/columns averaged). notw's 16 bends shadow edges in the
+/// room (512 x 512 view, 256 per face: 1.04 % wrong at 16, 0.65 at 128, subdiv 2); too high
+/// and the warp tends to RTW's rectilinear one.
+pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
+/// cube-notw's subdivision threshold (warped texels). Room, same view: 2 -> 1.04 %, 1 -> 0.70,
+/// 0.5 -> 0.60 (with window 128: 0.59 / 0.57); lower costs more pieces (capacity on big scenes).
+pub const DEFAULT_NOTW_SUBDIV: f64 = 1.0;
+
+const fn with_default(p: ParamDef, default: f64, source: &'static str) -> ParamDef {
+    ParamDef { default, source, ..p }
+}
+
+/// notw's parameters (same keys, order, ranges and docs), with the window and subdivision
+/// defaults measured for cube faces (tests/cube.rs checks the keys against notw's).
+pub const NOTW_PARAMS: &[ParamDef] = &[
+    W[0],
+    with_default(W[1], DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/cube.md)"),
+    W[2],
+    W[3],
+    W[4],
+    with_default(W[5], DEFAULT_NOTW_SUBDIV, "shadowlab measurement on room's point light (docs/bench/cube.md)"),
+    W[6],
+    W[7],
+    W[8],
+    W[9],
+    W[10],
+    W[11],
+    W[12],
+    W[13],
+    W[14],
+];
+
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "cube-notw",
     summary: "NoTW per cube face: each face's view samples get their own desired view, count map and row/column warps",
@@ -75,7 +109,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     quality: "spreads the view samples over each face; faces with few samples gain little",
     source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
     lights: &["point"],
-    params: crate::techniques::warp::NOTW_PARAMS,
+    params: NOTW_PARAMS,
     create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
 };
 
