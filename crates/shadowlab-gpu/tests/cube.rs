@@ -128,12 +128,13 @@ fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {
 }
 
 /// NoTW per face on the room's point light (256 x 256 view, 128 per face: the seeds' ratio of
-/// 2 view pixels per texel along each axis). Asserts what NoTW does (more texels used, a more
-/// even count per texel than `cube`), the per-face bookkeeping, and a quality bound with a
-/// margin over today's result (1.1-1.5 % wrong; before the per-face clipping it was ~10 %).
-/// It does not beat `cube` on wrong pixels (docs/bench/cube.md).
+/// 2 view pixels per texel along each axis; window 64 as res 128 allows). Asserts what NoTW
+/// does (more texels used, a more even count per texel than `cube`), fewer wrong pixels than
+/// `cube` (measured 1.15 % vs 1.28 %) with a bound of 1.5 % (before the per-face clipping it was
+/// ~10 %), and the per-face bookkeeping. At 1024 / 512 it does not beat `cube` on this scene
+/// (docs/bench/cube.md).
 #[test]
-fn cube_notw_spreads_the_samples_of_every_face_on_the_room() {
+fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_texel() {
     let Some(gpu) = gpu() else { return };
     let scene = builtin("room").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
@@ -143,7 +144,7 @@ fn cube_notw_spreads_the_samples_of_every_face_on_the_room() {
     let notw = lab.run(&v, &spec("cube-notw:res=128,window=64"), 1).unwrap();
     let wrong = 100.0 - agreement(&notw.visibility, &rt.visibility, &v.mask);
     let cube_wrong = 100.0 - agreement(&cube.visibility, &rt.visibility, &v.mask);
-    if wrong > 3.0 {
+    if wrong > 1.5 || wrong >= cube_wrong {
         panic!("cube-notw {wrong:.3}% wrong on room (cube {cube_wrong:.3}%); {}", save_images("cube-notw-room", &v, &notw, &rt));
     }
     let (s, c) = (notw.report.sampling.unwrap(), cube.report.sampling.unwrap());
