@@ -2,17 +2,32 @@
 // looks along n with a 90 degree square frustum; a direction d hits its plane at n + s u + t v;
 // map coordinates x = (s + 1) / 2, y = (1 - t) / 2. Faces: +x, -x, +y, -y, +z, -z.
 
-// Rows n, u, v of face f.
+// Columns n, u, v of face f (a switch: a per-invocation array indexed at run time is slow on
+// lavapipe).
 fn cube_basis(f: u32) -> mat3x3<f32> {
-    var b = array<mat3x3<f32>, 6>(
-        mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(0.0, 1.0, 0.0)),
-        mat3x3<f32>(vec3<f32>(-1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, -1.0), vec3<f32>(0.0, 1.0, 0.0)),
-        mat3x3<f32>(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, 1.0)),
-        mat3x3<f32>(vec3<f32>(0.0, -1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, -1.0)),
-        mat3x3<f32>(vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(-1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0)),
-        mat3x3<f32>(vec3<f32>(0.0, 0.0, -1.0), vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0)),
-    );
-    return b[f];
+    let x = vec3<f32>(1.0, 0.0, 0.0);
+    let y = vec3<f32>(0.0, 1.0, 0.0);
+    let z = vec3<f32>(0.0, 0.0, 1.0);
+    switch f {
+        case 0u: {
+            return mat3x3<f32>(x, z, y);
+        }
+        case 1u: {
+            return mat3x3<f32>(-x, -z, y);
+        }
+        case 2u: {
+            return mat3x3<f32>(y, x, z);
+        }
+        case 3u: {
+            return mat3x3<f32>(-y, x, -z);
+        }
+        case 4u: {
+            return mat3x3<f32>(z, -x, y);
+        }
+        default: {
+            return mat3x3<f32>(-z, x, y);
+        }
+    }
 }
 
 // The face of direction d: largest |component|, ties x before y before z.
