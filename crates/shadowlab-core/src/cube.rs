@@ -160,9 +160,9 @@ mod tests {
             assert!(fc.u.dot(fc.n) == 0.0 && fc.v.dot(fc.n) == 0.0);
         }
         // the six axes are all different
-        for a in 0..6 {
-            for b in 0..6 {
-                assert_eq!(FACES[a].n == FACES[b].n, a == b);
+        for (a, fa) in FACES.iter().enumerate() {
+            for (b, fb) in FACES.iter().enumerate() {
+                assert_eq!(fa.n == fb.n, a == b);
             }
         }
     }
