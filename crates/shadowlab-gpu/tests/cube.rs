@@ -54,6 +54,12 @@ fn cube_rejects_other_lights() {
         assert!(matches!((info.create)(&gpu, &lab.gscene, &p, &light), Err(GpuError::Invalid(_))));
         assert!(techniques::resolve(&spec("cube-notw"), Some(&light)).is_err());
     }
+    // cube-notw's default window (128) needs res above it: a clear error, not a panic
+    let (info, p) = techniques::resolve(&spec("cube-notw:res=64"), Some(&scene.lights[ROOM_POINT])).unwrap();
+    match (info.create)(&gpu, &lab.gscene, &p, &scene.lights[ROOM_POINT]) {
+        Err(GpuError::Invalid(m)) => assert!(m.contains("window"), "{m}"),
+        _ => panic!("cube-notw:res=64 with window 128 accepted"),
+    }
 }
 
 /// The GPU's lookup follows the CPU rules of `shadowlab_core::cube` on every pixel, in

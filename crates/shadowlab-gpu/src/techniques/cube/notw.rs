@@ -54,6 +54,10 @@ impl CubeNotw {
         let position = point_position("cube-notw", light)?;
         let res = p.get_u32("res");
         gpu.check_size(res, res, "cube face")?;
+        let window = p.get("window");
+        if window >= res as f64 {
+            return Err(GpuError::Invalid(format!("cube-notw: window {window} must be below res {res} (e.g. window={})", res / 2)));
+        }
         // near plane of lightspace::fit's spot frustum; clip a little in front of it and a few
         // texels outside the map's square (fit adds one texel of margin)
         let far = scene.bounds.corners().iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
