@@ -8,6 +8,7 @@ pub mod bvh;
 pub mod calipers;
 pub mod camera;
 pub mod cascades;
+pub mod cube;
 pub mod edges;
 pub mod iasm;
 pub mod light;

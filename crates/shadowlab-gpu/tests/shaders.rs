@@ -303,3 +303,22 @@ fn scene_info_layout_matches_wgsl() {
         );
     }
 }
+
+#[test]
+fn cube_layouts_match_wgsl() {
+    use shadowlab_gpu::techniques::cube::{CubeFace, CubeParams};
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap_or_else(|| panic!("{n} not composed")).1);
+    check(
+        &get("cube/depth.wgsl"),
+        "CubeFace",
+        size_of::<CubeFace>(),
+        &[("light", offset_of!(CubeFace, light)), ("face", offset_of!(CubeFace, face))],
+    );
+    check(
+        &get("cube/eval.wgsl"),
+        "CubeParams",
+        size_of::<CubeParams>(),
+        &[("cfg", offset_of!(CubeParams, cfg)), ("bias", offset_of!(CubeParams, bias))],
+    );
+}

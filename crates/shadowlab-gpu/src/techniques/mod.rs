@@ -2,6 +2,7 @@
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
 pub mod csm;
+pub mod cube;
 pub mod filtered;
 pub mod iasm;
 pub mod mdsm;
@@ -152,6 +153,8 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &filtered::MSM_INFO,
     &csm::INFO,
     &iasm::INFO,
+    &cube::INFO,
+    &cube::NOTW_INFO,
 ];
 
 /// Every technique's composed WGSL, for the naga validation test.
@@ -165,6 +168,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(filtered::shaders());
     v.extend(min_sm::shaders());
     v.extend(warp::shaders());
+    v.extend(cube::shaders());
     v
 }
 

@@ -68,6 +68,11 @@ impl Warped {
         gpu.read_buffer_as(&self.work, 2 * n)[..n].to_vec()
     }
 
+    /// The count map of the last evaluation, through the final warp (cube-notw merges the faces').
+    pub fn read_counts_after(&self, gpu: &Gpu) -> Vec<u32> {
+        gpu.read_buffer_as(&self.counts, (self.res * self.res) as usize)
+    }
+
     /// The count map rebuilt through the row warps (`notw`).
     pub fn read_counts_rows(&self, gpu: &Gpu) -> Vec<u32> {
         let n = (self.res * self.res) as usize;

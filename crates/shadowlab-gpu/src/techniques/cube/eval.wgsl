@@ -1,0 +1,55 @@
+// Cube shadow map evaluation: the sample is offset by sm's bias model (bias.wgsl) in world
+// units of one face texel at the sample (2 dot(d, n) / res, continuous across the seams), its
+// distance to the light compared with an NxN kernel of nearest-texel taps. Each tap's position
+// is turned back into a direction and read on the face that direction falls on, so a kernel
+// that crosses a face edge samples the neighbour face (seamless). Counts the view samples per
+// texel of the six faces.
+
+struct CubeParams {
+    // xyz: light position, w: far
+    light: vec4<f32>,
+    // x: resolution per face, y: pcf kernel width
+    cfg: vec4<f32>,
+    // x: constant bias, y: slope-scaled bias, z: normal offset (texels), w: max slope
+    bias: vec4<f32>,
+}
+
+@group(0) @binding(6) var<uniform> cube: CubeParams;
+@group(0) @binding(7) var faces: texture_depth_2d_array;
+@group(0) @binding(8) var<storage, read_write> counts: array<atomic<u32>>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let res = cube.cfg.x;
+    let ires = i32(res);
+    let l = to_light(light, s.p);
+
+    // sampling statistics: the texel of the unbiased sample
+    let d0 = s.p - cube.light.xyz;
+    let f0 = cube_face(d0);
+    let t0 = clamp(vec2<i32>(floor(cube_project(f0, d0) * res)), vec2<i32>(0), vec2<i32>(ires - 1));
+    atomicAdd(&counts[(f0 * u32(ires) + u32(t0.y)) * u32(ires) + u32(t0.x)], 1u);
+
+    let k = i32(cube.cfg.y);
+    let half = f32(k - 1) * 0.5;
+    let texel = 2.0 * dot(d0, cube_basis(f0)[0]) / res;
+    let q = biased_point(s.p, s.n, l, texel, cube.bias, half);
+    let d = q - cube.light.xyz;
+    let f = cube_face(d);
+    let m = cube_project(f, d);
+    let dist = length(d) / cube.light.w;
+    var lit = 0.0;
+    for (var y = 0; y < k; y++) {
+        for (var x = 0; x < k; x++) {
+            let dir = cube_direction(f, m + (vec2<f32>(f32(x), f32(y)) - half) / res);
+            let g = cube_face(dir);
+            let t = clamp(vec2<i32>(floor(cube_project(g, dir) * res)), vec2<i32>(0), vec2<i32>(ires - 1));
+            lit += select(0.0, 1.0, dist <= textureLoad(faces, t, i32(g), 0));
+        }
+    }
+    visibility[s.i] = lit / f32(k * k);
+}

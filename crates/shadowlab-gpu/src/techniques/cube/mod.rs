@@ -1,0 +1,303 @@
+//! Point-light shadows with cube maps (seed 002 section 3.3.1, chapter 5.3), two registry
+//! entries:
+//! - `cube`: six `res x res` faces, one depth pass per face (no multiview: lavapipe and the
+//!   trait's one-light-per-instance keep it simple; six passes are what the seed describes),
+//!   per-face triangle culling in the vertex stage. Stored depth: linear distance to the light
+//!   divided by `far`, 0 at the light (so sm's bias model in texels behaves the same on every
+//!   face). Lookup: NxN nearest-texel PCF whose taps cross face edges onto the neighbour face.
+//!   The face math is `shadowlab_core::cube` (CPU, tested) and `faces.wgsl`.
+//! - `cube-notw` (notw.rs): NoTW per face: each face is a 90 degree square perspective frustum
+//!   (a spot light along the face axis) handled by `warp::Warped` with the face's view samples
+//!   only (its own desired view, count map and warps: 8 w^2 bytes per face).
+
+mod clip;
+mod notw;
+pub use notw::CubeNotw;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use shadowlab_core::cube::{face_view_proj, FACES};
+use shadowlab_core::light::Light;
+use shadowlab_core::metrics::sampling_stats;
+use shadowlab_core::params::{ParamDef, ParamValues};
+
+use crate::scene_gpu::GpuScene;
+use crate::shaders::compose_depth;
+use crate::techniques::sm::{count_image, depth_image, BIAS, BIAS_WGSL, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
+use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{binding, raster, Gpu, GpuError};
+
+const FACES_WGSL: &str = include_str!("faces.wgsl");
+const DEPTH_WGSL: &str = include_str!("depth.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+const SPLIT_WGSL: &str = include_str!("split.wgsl");
+
+fn depth_src() -> String {
+    compose_depth(&format!("{FACES_WGSL}{DEPTH_WGSL}"))
+}
+fn eval_src() -> String {
+    compose_view(&format!("{FACES_WGSL}{BIAS_WGSL}{EVAL_WGSL}"), false)
+}
+fn split_src() -> String {
+    compose_view(&format!("{FACES_WGSL}{SPLIT_WGSL}"), false)
+}
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![
+        ("cube/depth.wgsl", depth_src()),
+        ("cube/eval.wgsl", eval_src()),
+        ("cube/split.wgsl", split_src()),
+        ("cube/scene_copy.wgsl", clip::scene_copy_src()),
+    ]
+}
+
+/// sm's parameters apply unchanged: `res` is per face (the seeds' 512), the bias is in texels of
+/// the face at the sample. sm's bias sweep was on directional/spot lights; see docs/bench/cube.md
+/// for the point-light check.
+pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET];
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "cube",
+    summary: "cube shadow map for point lights: six 90-degree faces of linear light distance, seamless NxN PCF across face edges",
+    cost: "six depth passes over the scene (per-face triangle culling) + N^2 fetches per pixel; 6 res^2 x 4 bytes",
+    quality: "as sm per face; the face the camera looks into gets all the view samples (seed 002 Fig. 5.6)",
+    source: "seed 002 section 3.3.1 and chapter 5.3 (CubeSM)",
+    lights: &["point"],
+    params: PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(CubeMap::new(gpu, scene, p, light)?)),
+};
+
+const W: &[ParamDef] = crate::techniques::warp::NOTW_PARAMS;
+
+/// cube-notw's smoothing window (rows/columns averaged). notw's 16 bends shadow edges in the
+/// room (512 x 512 view, 256 per face: 1.04 % wrong at 16, 0.65 at 128, subdiv 2); too high
+/// and the warp tends to RTW's rectilinear one.
+pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
+/// cube-notw's subdivision threshold (warped texels). Room, same view: 2 -> 1.04 %, 1 -> 0.70,
+/// 0.5 -> 0.60 (with window 128: 0.59 / 0.57); lower costs more pieces (capacity on big scenes).
+pub const DEFAULT_NOTW_SUBDIV: f64 = 1.0;
+
+const fn with_default(p: ParamDef, default: f64, source: &'static str) -> ParamDef {
+    ParamDef { default, source, ..p }
+}
+
+/// notw's parameters (same keys, order, ranges and docs), with the window and subdivision
+/// defaults measured for cube faces (tests/cube.rs checks the keys against notw's).
+pub const NOTW_PARAMS: &[ParamDef] = &[
+    W[0],
+    with_default(W[1], DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/cube.md)"),
+    W[2],
+    W[3],
+    W[4],
+    with_default(W[5], DEFAULT_NOTW_SUBDIV, "shadowlab measurement on room's point light (docs/bench/cube.md)"),
+    W[6],
+    W[7],
+    W[8],
+    W[9],
+    W[10],
+    W[11],
+    W[12],
+    W[13],
+    W[14],
+];
+
+pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
+    name: "cube-notw",
+    summary: "NoTW per cube face: each face's view samples get their own desired view, count map and row/column warps",
+    cost: "notw's analysis + warped depth pass for every face that has view samples; 8 w^2 bytes of warps per face",
+    quality: "spreads the view samples over each face; faces with few samples gain little",
+    source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
+    lights: &["point"],
+    params: NOTW_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
+};
+
+/// The light's position, or a clear error for other lights.
+pub(crate) fn point_position(name: &str, light: &Light) -> Result<Vec3, GpuError> {
+    match *light {
+        Light::Point { position } => Ok(position),
+        _ => Err(GpuError::Invalid(format!("{name} supports point lights only (got a {} light)", light.kind()))),
+    }
+}
+
+/// WGSL `CubeFace` (depth.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CubeFace {
+    pub view_proj: [[f32; 4]; 4],
+    pub light: [f32; 4],
+    pub face: [u32; 4],
+}
+
+/// WGSL `CubeParams` (eval.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CubeParams {
+    pub light: [f32; 4],
+    pub cfg: [f32; 4],
+    pub bias: [f32; 4],
+}
+
+/// A point light's cube shadow map: six layers of one Depth32Float array texture.
+pub struct CubeMap {
+    res: u32,
+    far: f32,
+    pcf: u32,
+    map: wgpu::Texture,
+    face_groups: Vec<wgpu::BindGroup>,
+    depth_pipeline: wgpu::RenderPipeline,
+    params: wgpu::Buffer,
+    counts: wgpu::Buffer,
+    eval_layout: wgpu::BindGroupLayout,
+    eval_pipeline: wgpu::ComputePipeline,
+}
+
+impl CubeMap {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<CubeMap, GpuError> {
+        let pos = point_position("cube", light)?;
+        let (res, pcf) = (p.get_u32("res"), p.get_u32("pcf"));
+        gpu.check_size(res, res, "cube face")?;
+        let far = bounds_far(scene, pos);
+        let near = (far * 1e-4).max(1e-5);
+        let d = &gpu.device;
+        let map = raster::depth_target(gpu, "cube.map", res, res, 6, wgpu::TextureUsages::empty());
+        let face_layout = binding::layout(d, "cube.depth", wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
+        let face_groups = (0..6)
+            .map(|f| {
+                let u = CubeFace {
+                    view_proj: face_view_proj(pos, f, near, far).to_cols_array_2d(),
+                    light: pos.extend(far).into(),
+                    face: [f as u32, 0, 0, 0],
+                };
+                let buf = gpu.uniform(&format!("cube.face{f}"), &u);
+                binding::group(d, "cube.depth", &face_layout, &[buf.as_entire_binding()])
+            })
+            .collect();
+        let depth_pipeline = raster::scene_pipeline(gpu, "cube.render", &depth_src(), &[&face_layout, &scene.layout], &[]);
+        let params = CubeParams {
+            light: pos.extend(far).into(),
+            cfg: [res as f32, pcf as f32, 0.0, 0.0],
+            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
+        };
+        let array = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        };
+        let eval_layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
+        let eval_pipeline = gpu.compute_pipeline("cube.evaluate", &eval_src(), "main", &[&eval_layout]);
+        Ok(CubeMap {
+            res,
+            far,
+            pcf,
+            map,
+            face_groups,
+            depth_pipeline,
+            params: gpu.uniform("cube.params", &params),
+            counts: gpu.storage("cube.counts", 6 * res as u64 * res as u64 * 4),
+            eval_layout,
+            eval_pipeline,
+        })
+    }
+
+    /// The distance stored as depth 1 (the faces hold distance / far).
+    pub fn far(&self) -> f32 {
+        self.far
+    }
+
+    /// The six faces (+x, -x, +y, -y, +z, -z), each `res x res` row-major: distance / far.
+    pub fn read_faces(&self, gpu: &Gpu) -> Vec<Vec<f32>> {
+        read_layers(gpu, &self.map)
+    }
+
+    /// View samples per texel of the last evaluation, face after face.
+    pub fn read_counts(&self, gpu: &Gpu) -> Vec<u32> {
+        gpu.read_buffer_as(&self.counts, 6 * (self.res * self.res) as usize)
+    }
+}
+
+/// The largest distance from `pos` to a corner of the scene bounds (+1 %): depth 1.
+fn bounds_far(scene: &GpuScene, pos: Vec3) -> f32 {
+    let far = scene.bounds.corners().iter().map(|c| (*c - pos).length()).fold(0.0f32, f32::max);
+    (far * 1.01).max(1e-3)
+}
+
+/// Every layer of a Depth32Float array texture, copied out one layer at a time.
+pub fn read_layers(gpu: &Gpu, tex: &wgpu::Texture) -> Vec<Vec<f32>> {
+    let (w, h) = (tex.width(), tex.height());
+    let tmp = raster::depth_target(gpu, "cube.readback", w, h, 1, wgpu::TextureUsages::COPY_DST);
+    (0..tex.depth_or_array_layers())
+        .map(|layer| {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            let src = wgpu::TexelCopyTextureInfo {
+                texture: tex,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
+                aspect: wgpu::TextureAspect::All,
+            };
+            enc.copy_texture_to_texture(src, tmp.as_image_copy(), wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 });
+            gpu.queue.submit([enc.finish()]);
+            bytemuck::pod_collect_to_vec(&gpu.read_texture(&tmp, 4))
+        })
+        .collect()
+}
+
+impl Technique for CubeMap {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let views: Vec<wgpu::TextureView> = (0..6)
+            .map(|layer| {
+                self.map.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        timer.stage(gpu, "cube.render", |enc| {
+            for (view, group) in views.iter().zip(&self.face_groups) {
+                let mut pass = raster::begin_pass(enc, "cube.render", &[], view);
+                pass.set_pipeline(&self.depth_pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.set_bind_group(1, &f.scene.group, &[]);
+                pass.draw(0..f.scene.triangle_count * 3, 0..1);
+            }
+        });
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let view = self
+            .map
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let group = f.view_group(
+            gpu,
+            "cube.evaluate",
+            &self.eval_layout,
+            &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), self.counts.as_entire_binding()],
+        );
+        timer.stage(gpu, "cube.evaluate", |enc| {
+            enc.clear_buffer(&self.counts, 0, None);
+            gpu.dispatch_2d(enc, "cube.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let (res, n) = (self.res, (self.res * self.res) as usize);
+        let counts = self.read_counts(gpu);
+        let mut r = TechniqueReport { shadow_data_bytes: 6 * n as u64 * 4, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+        r.counters.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
+        r.counters.insert("shadow_map_texels".into(), 6.0 * n as f64);
+        for (f, face) in self.read_faces(gpu).iter().enumerate() {
+            let samples = counts[f * n..(f + 1) * n].iter().map(|&c| c as u64).sum::<u64>();
+            r.counters.insert(format!("view_samples_face_{}", FACES[f].name), samples as f64);
+            r.images.push(depth_image(&format!("face {} (distance)", FACES[f].name), res, face));
+        }
+        for (f, c) in counts.chunks(n).enumerate() {
+            r.images.push(count_image(&format!("face {} view samples per texel", FACES[f].name), res, c));
+        }
+        r
+    }
+}

@@ -1,0 +1,241 @@
+//! `cube-notw`: NoTW per cube face (seed 002 chapter 5.3, "CubeSM w/ warping"). Each face is
+//! a 90 degree square perspective frustum, i.e. a spot light along the face axis, and is handled
+//! by one `warp::Warped` (notw's passes, unchanged): a `split` pass gives each face a mask of
+//! the view samples that fall on it (the same face rule as `cube`), the face's desired view,
+//! count map, row and column warps and warped depth map are built from those samples only, its
+//! evaluation writes a per-face visibility buffer, and `merge` copies each pixel's visibility
+//! from its face. Faces without view samples are skipped (no analysis, no depth pass).
+//! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
+//! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
+
+use shadowlab_core::cube::FACES;
+use shadowlab_core::light::Light;
+use shadowlab_core::metrics::sampling_stats;
+use shadowlab_core::params::ParamValues;
+
+use super::{clip, point_position, split_src};
+use crate::frame::LightUniform;
+use crate::gbuffer::GBuffer;
+use crate::scene_gpu::GpuScene;
+use crate::techniques::warp::{Variant, Warped};
+use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{binding, Gpu, GpuError};
+
+/// The names of the images of a face's `Warped` report that `cube-notw` passes on.
+const FACE_IMAGES: &[&str] = &["count map before warping", "count map after warping", "warped shadow map", "row warping", "column warping"];
+
+struct Face {
+    warped: Warped,
+    /// The scene's triangles clipped to this face (clip.rs).
+    scene: GpuScene,
+    light: Light,
+    light_buf: wgpu::Buffer,
+    sel: wgpu::Buffer,
+    /// u32 per pixel: 1 where the view sample falls on this face.
+    mask: Option<wgpu::Buffer>,
+    vis: Option<wgpu::Buffer>,
+    /// View samples on the face in the current frame.
+    samples: u32,
+}
+
+pub struct CubeNotw {
+    res: u32,
+    faces: Vec<Face>,
+    face_samples: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    split: wgpu::ComputePipeline,
+    merge: wgpu::ComputePipeline,
+    pixels: u64,
+}
+
+impl CubeNotw {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<CubeNotw, GpuError> {
+        let position = point_position("cube-notw", light)?;
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "cube face")?;
+        let window = p.get("window");
+        if window >= res as f64 {
+            return Err(GpuError::Invalid(format!("cube-notw: window {window} must be below res {res} (e.g. window={})", res / 2)));
+        }
+        // near plane of lightspace::fit's spot frustum; clip a little in front of it and a few
+        // texels outside the map's square (fit adds one texel of margin)
+        let far = scene.bounds.corners().iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
+        let near = (far * 1e-3).max(1e-4);
+        let scenes = clip::face_scenes(gpu, scene, position, 2.0 * near, 1.0 + 8.0 / res as f32);
+        let faces = FACES
+            .iter()
+            .zip(scenes)
+            .enumerate()
+            .map(|(f, (fc, face_scene))| {
+                // one face = a spot light along the axis whose fitted frustum is the face's square
+                let light = Light::Spot { position, direction: fc.n, cone_deg: 45.0 };
+                Ok(Face {
+                    warped: Warped::new(gpu, &face_scene, p, &light, Variant::Notw)?,
+                    scene: face_scene,
+                    light,
+                    light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
+                    sel: gpu.uniform(&format!("cube-notw.face{f}"), &[f as u32, 0, 0, 0]),
+                    mask: None,
+                    vis: None,
+                    samples: 0,
+                })
+            })
+            .collect::<Result<Vec<_>, GpuError>>()?;
+        let rw = binding::storage(false);
+        let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw, rw, rw]);
+        let src = split_src();
+        Ok(CubeNotw {
+            res,
+            faces,
+            face_samples: gpu.storage("cube-notw.face_samples", 6 * 4),
+            split: gpu.compute_pipeline("cube-notw.split", &src, "split", &[&layout]),
+            merge: gpu.compute_pipeline("cube-notw.merge", &src, "merge", &[&layout]),
+            layout,
+            pixels: 0,
+        })
+    }
+
+    /// View samples per face of the last frame (+x, -x, +y, -y, +z, -z).
+    pub fn face_samples(&self) -> [u32; 6] {
+        std::array::from_fn(|f| self.faces[f].samples)
+    }
+
+    /// The `Warped` of face `f` (its warps, count maps and map, for tests and pictures).
+    pub fn face(&self, f: usize) -> &Warped {
+        &self.faces[f].warped
+    }
+
+    fn group(&self, gpu: &Gpu, f: &FrameInputs, face: &Face) -> wgpu::BindGroup {
+        let (mask, vis) = (face.mask.as_ref().expect("sized in prepare"), face.vis.as_ref().expect("sized in prepare"));
+        f.view_group(
+            gpu,
+            "cube-notw.split",
+            &self.layout,
+            &[face.sel.as_entire_binding(), mask.as_entire_binding(), vis.as_entire_binding(), self.face_samples.as_entire_binding()],
+        )
+    }
+
+    /// Runs `step` on every face with view samples, with that face's inputs (its light, mask
+    /// and visibility buffer), and records the stages summed over the faces as `cube-notw.*`.
+    fn each_face(
+        &mut self,
+        gpu: &Gpu,
+        f: &FrameInputs,
+        timer: &mut StageTimer,
+        step: impl Fn(&mut Warped, &Gpu, &FrameInputs, &mut StageTimer) -> Result<(), GpuError>,
+    ) -> Result<(), GpuError> {
+        let mut local = StageTimer::default();
+        for face in self.faces.iter_mut().filter(|face| face.samples > 0) {
+            let g = f.gbuffer;
+            let gbuffer = GBuffer {
+                width: g.width,
+                height: g.height,
+                position: g.position.clone(),
+                normal: g.normal.clone(),
+                albedo: g.albedo.clone(),
+                motion: g.motion.clone(),
+                depth: g.depth.clone(),
+                mask: face.mask.clone().expect("sized in prepare"),
+            };
+            let vis = face.vis.clone().expect("sized in prepare");
+            let fi = FrameInputs {
+                scene: &face.scene,
+                gbuffer: &gbuffer,
+                light: face.light,
+                camera: f.camera,
+                prev_camera: f.prev_camera,
+                light_buf: &face.light_buf,
+                frame: f.frame,
+                visibility: &vis,
+            };
+            step(&mut face.warped, gpu, &fi, &mut local)?;
+        }
+        for (name, ms) in local.samples {
+            let stage = name.strip_prefix("notw.").unwrap_or(&name);
+            timer.add(&format!("cube-notw.{stage}"), ms.iter().sum());
+        }
+        Ok(())
+    }
+}
+
+impl Technique for CubeNotw {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let (w, h) = (f.gbuffer.width, f.gbuffer.height);
+        let pixels = w as u64 * h as u64;
+        if pixels != self.pixels {
+            for (i, face) in self.faces.iter_mut().enumerate() {
+                face.mask = Some(gpu.storage(&format!("cube-notw.mask{i}"), pixels * 4));
+                face.vis = Some(gpu.storage(&format!("cube-notw.vis{i}"), pixels * 4));
+            }
+            self.pixels = pixels;
+        }
+        let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
+        timer.stage(gpu, "cube-notw.split", |enc| {
+            enc.clear_buffer(&self.face_samples, 0, None);
+            for g in &groups {
+                gpu.dispatch_2d(enc, "cube-notw.split", &self.split, &[g], w, h);
+            }
+        });
+        let samples: Vec<u32> = gpu.read_buffer_as(&self.face_samples, 6);
+        for (face, s) in self.faces.iter_mut().zip(samples) {
+            face.samples = s;
+        }
+        self.each_face(gpu, f, timer, |w, gpu, fi, t| w.prepare(gpu, fi, t))
+    }
+
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        self.each_face(gpu, f, timer, |w, gpu, fi, t| w.render(gpu, fi, t))
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        self.each_face(gpu, f, timer, |w, gpu, fi, t| w.evaluate(gpu, fi, t))?;
+        let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
+        timer.stage(gpu, "cube-notw.merge", |enc| {
+            for g in &groups {
+                gpu.dispatch_2d(enc, "cube-notw.merge", &self.merge, &[g], f.gbuffer.width, f.gbuffer.height);
+            }
+        });
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let n = (self.res * self.res) as usize;
+        let mut r = TechniqueReport::default();
+        let mut after = Vec::with_capacity(6 * n);
+        let mut active = 0;
+        for (i, face) in self.faces.iter_mut().enumerate() {
+            let name = FACES[i].name;
+            r.counters.insert(format!("view_samples_face_{name}"), face.samples as f64);
+            r.counters.insert(format!("clipped_triangles_face_{name}"), face.scene.triangle_count as f64);
+            if face.samples == 0 {
+                // not rendered this frame: no samples, nothing to report but its memory
+                after.extend(std::iter::repeat_n(0, n));
+                r.shadow_data_bytes += n as u64 * 4 + face.warped.warp_bytes() + 32;
+                continue;
+            }
+            active += 1;
+            let fr = face.warped.report(gpu);
+            r.shadow_data_bytes += fr.shadow_data_bytes;
+            after.extend(face.warped.read_counts_after(gpu));
+            for (k, v) in fr.counters {
+                if k == "fetches_per_pixel" {
+                    r.counters.insert(k, v);
+                } else if k == "scratch_bytes" || k == "subdiv_triangles_drawn" {
+                    *r.counters.entry(k).or_default() += v;
+                } else if k.ends_with("fraction") || k.ends_with("warp") {
+                    r.counters.insert(format!("{k}_face_{name}"), v);
+                }
+            }
+            for img in fr.images.into_iter().filter(|img| FACE_IMAGES.iter().any(|p| img.name.starts_with(p))) {
+                r.images.push(crate::techniques::NamedImage { name: format!("face {name}: {}", img.name), ..img });
+            }
+        }
+        r.counters.insert("faces_rendered".into(), active as f64);
+        r.counters.insert("warp_bytes_per_face".into(), 8.0 * n as f64);
+        r.counters.insert("warp_bytes".into(), 6.0 * 8.0 * n as f64);
+        r.counters.insert("shadow_map_texels".into(), 6.0 * n as f64);
+        r.sampling = Some(sampling_stats(&after));
+        r
+    }
+}

@@ -1,0 +1,187 @@
+//! GPU tests of the point-light cube maps (`cube`, `cube-notw`) against the exact reference and
+//! against the CPU rules of `shadowlab_core::cube`.
+
+use glam::Vec3;
+use shadowlab_core::builtin::builtin;
+use shadowlab_core::cube::{face_of, project, tap_texel, texel_size};
+use shadowlab_core::light::Light;
+use shadowlab_core::params::TechniqueSpec;
+use shadowlab_gpu::lab::Lab;
+use shadowlab_gpu::techniques::cube::CubeMap;
+use shadowlab_gpu::techniques::{self, run_frame};
+use shadowlab_gpu::timing::StageTimer;
+use shadowlab_gpu::GpuError;
+
+mod common;
+use common::*;
+
+fn spec(s: &str) -> TechniqueSpec {
+    TechniqueSpec::parse(s).unwrap()
+}
+
+/// room's light 1 is the point light over the table.
+const ROOM_POINT: usize = 1;
+
+#[test]
+fn cube_at_high_resolution_agrees_with_rt_on_the_room_point_light() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    assert!(matches!(scene.lights[ROOM_POINT], Light::Point { .. }));
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, ROOM_POINT, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let cube = lab.run(&v, &spec("cube:res=2048"), 1).unwrap();
+    let a = agreement(&cube.visibility, &rt.visibility, &v.mask);
+    if a < 99.0 {
+        panic!("cube 2048 agrees with rt on {a:.3}% of room; {}", save_images("cube-room", &v, &cube, &rt));
+    }
+    let r = &cube.report;
+    assert_eq!(r.shadow_data_bytes, 6 * 2048 * 2048 * 4);
+    // every evaluated sample was counted on exactly one face
+    let evaluated = v.mask.iter().filter(|m| **m != 0).count() as f64;
+    let counted: f64 = ["+x", "-x", "+y", "-y", "+z", "-z"].iter().map(|f| r.counters[&format!("view_samples_face_{f}")]).sum();
+    assert_eq!(counted, evaluated);
+    assert_eq!(r.images.len(), 12, "six faces and six count maps");
+}
+
+#[test]
+fn cube_rejects_other_lights() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let (info, p) = techniques::resolve(&spec("cube"), None).unwrap();
+    for light in [scene.lights[0], Light::Directional { direction: -Vec3::Y }] {
+        assert!(matches!((info.create)(&gpu, &lab.gscene, &p, &light), Err(GpuError::Invalid(_))));
+        assert!(techniques::resolve(&spec("cube-notw"), Some(&light)).is_err());
+    }
+    // cube-notw's default window (128) needs res above it: a clear error, not a panic
+    let (info, p) = techniques::resolve(&spec("cube-notw:res=64"), Some(&scene.lights[ROOM_POINT])).unwrap();
+    match (info.create)(&gpu, &lab.gscene, &p, &scene.lights[ROOM_POINT]) {
+        Err(GpuError::Invalid(m)) => assert!(m.contains("window"), "{m}"),
+        _ => panic!("cube-notw:res=64 with window 128 accepted"),
+    }
+}
+
+/// The GPU's lookup follows the CPU rules of `shadowlab_core::cube` on every pixel, in
+/// particular where the 3x3 PCF kernel crosses a face edge and reads the neighbour face.
+#[test]
+fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let light = scene.lights[ROOM_POINT];
+    let Light::Point { position } = light else { panic!("room light 1 is a point light") };
+    let v = view(&lab, &scene, ROOM_POINT, 256);
+    let (_, p) = techniques::resolve(&spec("cube:res=64,pcf=3"), Some(&light)).unwrap();
+    let mut cube = CubeMap::new(&gpu, &lab.gscene, &p, &light).unwrap();
+    run_frame(&mut cube, &gpu, &v.inputs(&lab.gscene), &mut StageTimer::default()).unwrap();
+    let gpu_vis: Vec<f32> = gpu.read_buffer_as(&v.visibility, v.mask.len());
+    let faces = cube.read_faces(&gpu);
+    let (res, far) = (64u32, cube.far());
+    let (bias, no, max_slope) = (p.get("bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32);
+    let (mut seam, mut seam_agree, mut all, mut all_agree, mut clamp_differs) = (0, 0, 0, 0, 0);
+    for (i, m) in v.mask.iter().enumerate() {
+        if *m == 0 {
+            continue;
+        }
+        let pos = Vec3::from_slice(&v.position[i][..3]);
+        let n = Vec3::from_slice(&v.normal[i][..3]);
+        let l = (position - pos).normalize();
+        // sm's bias (bias.wgsl) with the kernel's reach of one texel
+        let d0 = pos - position;
+        let texel = texel_size(face_of(d0), d0, res);
+        let c = n.dot(l).clamp(1e-4, 1.0);
+        let tan = ((1.0 - c * c).sqrt() / c).min(max_slope);
+        let q = pos + n * (no * texel) + l * ((bias + tan) * texel);
+        let d = q - position;
+        let f = face_of(d);
+        let [mx, my] = project(f, d);
+        let dist = d.length() / far;
+        let mut lit = 0.0;
+        let mut clamped = 0.0;
+        let mut crosses = false;
+        for y in 0..3 {
+            for x in 0..3 {
+                let (g, cx, cy) = tap_texel(f, mx + (x as f32 - 1.0) / res as f32, my + (y as f32 - 1.0) / res as f32, res);
+                crosses |= g != f;
+                if dist <= faces[g][(cy * res + cx) as usize] {
+                    lit += 1.0 / 9.0;
+                }
+                // what a lookup clamped to the sample's own face would read
+                let t = |c: f32| ((c * res as f32).floor().max(0.0) as u32).min(res - 1);
+                let (ux, uy) = (t(mx + (x as f32 - 1.0) / res as f32), t(my + (y as f32 - 1.0) / res as f32));
+                if dist <= faces[f][(uy * res + ux) as usize] {
+                    clamped += 1.0 / 9.0;
+                }
+            }
+        }
+        let agree = (lit - gpu_vis[i]).abs() < 0.05;
+        all += 1;
+        all_agree += agree as u32;
+        if crosses {
+            seam += 1;
+            seam_agree += agree as u32;
+            clamp_differs += ((clamped - gpu_vis[i]).abs() >= 0.05) as u32;
+        }
+    }
+    assert!(seam > 500, "only {seam} pixels with a kernel across a face edge");
+    // float rounding may flip a comparison or a texel index on a few pixels
+    let (pa, ps) = (100.0 * all_agree as f64 / all as f64, 100.0 * seam_agree as f64 / seam as f64);
+    assert!(pa >= 99.5 && ps >= 99.0, "GPU = CPU rules on {pa:.2}% of pixels, {ps:.2}% of the {seam} seam pixels");
+    // the test can tell: a lookup clamped to the own face gives other answers on seam pixels
+    eprintln!("seam pixels {seam}, clamped lookup differs on {clamp_differs}");
+    assert!(clamp_differs * 50 > seam, "clamping differs on only {clamp_differs} of {seam} seam pixels");
+}
+
+/// NoTW per face on the room's point light (256 x 256 view, 128 per face: the seeds' ratio of
+/// 2 view pixels per texel along each axis; window 64 as res 128 allows). Asserts what NoTW
+/// does (more texels used, a more even count per texel than `cube`), fewer wrong pixels than
+/// `cube` (measured 1.15 % vs 1.28 %) with a bound of 1.5 % (before the per-face clipping it was
+/// ~10 %), and the per-face bookkeeping. At 1024 / 512 it does not beat `cube` on this scene
+/// (docs/bench/cube.md).
+#[test]
+fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_texel() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, ROOM_POINT, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let cube = lab.run(&v, &spec("cube:res=128"), 1).unwrap();
+    let notw = lab.run(&v, &spec("cube-notw:res=128,window=64"), 1).unwrap();
+    let wrong = 100.0 - agreement(&notw.visibility, &rt.visibility, &v.mask);
+    let cube_wrong = 100.0 - agreement(&cube.visibility, &rt.visibility, &v.mask);
+    if wrong > 1.5 || wrong >= cube_wrong {
+        panic!("cube-notw {wrong:.3}% wrong on room (cube {cube_wrong:.3}%); {}", save_images("cube-notw-room", &v, &notw, &rt));
+    }
+    let (s, c) = (notw.report.sampling.unwrap(), cube.report.sampling.unwrap());
+    assert!(s.used_texel_fraction > 1.2 * c.used_texel_fraction, "used texels {} vs cube {}", s.used_texel_fraction, c.used_texel_fraction);
+    assert!(
+        s.samples_per_used_texel_cv < 0.9 * c.samples_per_used_texel_cv,
+        "cv {} vs cube {}",
+        s.samples_per_used_texel_cv,
+        c.samples_per_used_texel_cv
+    );
+    let r = &notw.report.counters;
+    let evaluated = v.mask.iter().filter(|m| **m != 0).count() as f64;
+    let faces = ["+x", "-x", "+y", "-y", "+z", "-z"];
+    let counted: f64 = faces.iter().map(|f| r[&format!("view_samples_face_{f}")]).sum();
+    assert_eq!(counted, evaluated, "every evaluated sample on exactly one face");
+    let with_samples = faces.iter().filter(|f| r[&format!("view_samples_face_{f}")] > 0.0).count();
+    assert_eq!(r["faces_rendered"], with_samples as f64);
+    assert_eq!(r["warp_bytes"], 6.0 * 8.0 * 128.0 * 128.0);
+    // six warped maps (4 bytes a texel), six pairs of warps (8 w^2), 32 bytes of DV each
+    assert_eq!(notw.report.shadow_data_bytes, 6 * (128 * 128 * 4 + 8 * 128 * 128 + 32));
+    assert!(notw.report.images.iter().any(|i| i.name.starts_with("face -y: count map after warping")));
+}
+
+#[test]
+fn cube_notw_lists_notws_parameters_with_two_defaults_changed() {
+    use shadowlab_gpu::techniques::{cube, warp};
+    let (a, b) = (cube::NOTW_PARAMS, warp::NOTW_PARAMS);
+    assert_eq!(a.iter().map(|p| p.key).collect::<Vec<_>>(), b.iter().map(|p| p.key).collect::<Vec<_>>());
+    for (x, y) in a.iter().zip(b) {
+        let changed = x.default != y.default;
+        assert_eq!(changed, x.key == "window" || x.key == "subdiv", "{}", x.key);
+        assert_eq!((x.min, x.max, x.doc), (y.min, y.max, y.doc));
+    }
+}
