@@ -12,7 +12,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use shadowlab_core::bvh::{Bvh, BvhNode};
-use shadowlab_core::scene::{Bounds, Scene};
+use shadowlab_core::scene::{Bounds, Scene, Vertex};
 use wgpu::BufferUsages;
 
 use crate::{binding, Gpu, GpuError};
@@ -67,6 +67,8 @@ pub struct GpuScene {
     prims: wgpu::Buffer,
     /// Previous-frame positions of the dynamic vertices (binding 6; one vec4 each).
     prev: wgpu::Buffer,
+    materials: wgpu::Buffer,
+    texels: wgpu::Buffer,
     static_prims: u32,
     dynamic_node_capacity: usize,
 }
@@ -124,7 +126,7 @@ impl GpuScene {
             }
         }
         let st = BufferUsages::STORAGE | BufferUsages::COPY_DST;
-        let vertices = gpu.buffer_init("scene.vertices", bytemuck::cast_slice(&scene.vertices), st | BufferUsages::VERTEX);
+        let vertices = gpu.buffer_init("scene.vertices", bytemuck::cast_slice(&scene.vertices), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
         let mats = gpu.buffer_init("scene.materials", bytemuck::cast_slice(&materials), st);
         let tex = gpu.buffer_init("scene.texels", bytemuck::cast_slice(&texels), st);
         // static tree first, then room for the dynamic one (written by `set_time`)
@@ -174,11 +176,67 @@ impl GpuScene {
             nodes,
             prims,
             prev,
+            materials: mats,
+            texels: tex,
             static_prims: bvh.prim_indices.len() as u32,
             dynamic_node_capacity,
         };
         g.set_time(gpu, scene, 0.0, 0.0)?;
         Ok(g)
+    }
+
+    /// The current vertices (3 per triangle), read back from the GPU.
+    pub fn read_vertices(&self, gpu: &Gpu) -> Vec<Vertex> {
+        gpu.read_buffer_as(&self.vertices, self.triangle_count as usize * 3)
+    }
+
+    /// A static scene of other triangles (3 vertices each; e.g. this scene's clipped to a
+    /// frustum) drawn with this scene's materials and texels. It has no BVH: for raster passes
+    /// only, never for ray tracing.
+    pub fn with_triangles(&self, gpu: &Gpu, label: &str, triangles: &[Vertex]) -> GpuScene {
+        let placeholder = [Vertex::zeroed(); 3];
+        let tris = if triangles.is_empty() { &placeholder[..] } else { triangles };
+        let count = if triangles.is_empty() { 0 } else { tris.len() as u32 / 3 };
+        let st = BufferUsages::STORAGE | BufferUsages::COPY_DST;
+        let vertices = gpu.buffer_init(&format!("{label}.vertices"), bytemuck::cast_slice(tris), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
+        let nodes = gpu.buffer_init(&format!("{label}.no_bvh"), bytemuck::cast_slice(&[BvhNode::default()]), st);
+        let prims = gpu.storage(&format!("{label}.no_prims"), 16);
+        let prev = gpu.storage(&format!("{label}.no_prev"), 16);
+        let info = SceneInfo { triangle_count: count, dynamic_first: count, dynamic_root: 0, _pad: 0 };
+        let info_buf = gpu.uniform(&format!("{label}.info"), &info);
+        let group = binding::group(
+            &gpu.device,
+            label,
+            &self.layout,
+            &[
+                vertices.as_entire_binding(),
+                self.materials.as_entire_binding(),
+                self.texels.as_entire_binding(),
+                nodes.as_entire_binding(),
+                prims.as_entire_binding(),
+                info_buf.as_entire_binding(),
+                prev.as_entire_binding(),
+            ],
+        );
+        GpuScene {
+            vertices,
+            layout: self.layout.clone(),
+            group,
+            triangle_count: count,
+            dynamic_first: count,
+            bounds: self.bounds,
+            eps: self.eps,
+            bvh_bytes: 0,
+            texel_bytes: self.texel_bytes,
+            info,
+            nodes,
+            prims,
+            prev,
+            materials: self.materials.clone(),
+            texels: self.texels.clone(),
+            static_prims: 0,
+            dynamic_node_capacity: 0,
+        }
     }
 
     /// Whether the scene has moving objects.

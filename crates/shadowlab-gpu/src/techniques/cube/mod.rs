@@ -48,7 +48,6 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("cube/depth.wgsl", depth_src()),
         ("cube/eval.wgsl", eval_src()),
         ("cube/split.wgsl", split_src()),
-        ("cube/scene_copy.wgsl", clip::scene_copy_src()),
     ]
 }
 
