@@ -93,9 +93,7 @@ impl DualParaboloid {
     /// The matrix the shaders receive: world -> light space of `h`, scaled by 1/far (so the
     /// length of the result is the stored depth and its direction is n).
     pub fn view(&self, h: Hemisphere) -> Mat4 {
-        Mat4::from_scale(Vec3::splat(1.0 / self.far))
-            * Mat4::from_mat3(self.rotation(h))
-            * Mat4::from_translation(-self.position)
+        Mat4::from_scale(Vec3::splat(1.0 / self.far)) * Mat4::from_mat3(self.rotation(h)) * Mat4::from_translation(-self.position)
     }
 
     /// Map plane point (X, Y) of a light-space unit direction n (eq. 3.10).

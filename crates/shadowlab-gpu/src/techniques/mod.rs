@@ -2,6 +2,7 @@
 //! WGSL; adding one means adding a folder and one line to [`REGISTRY`].
 
 pub mod csm;
+pub mod dpsm;
 pub mod filtered;
 pub mod iasm;
 pub mod mdsm;
@@ -152,6 +153,8 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &filtered::MSM_INFO,
     &csm::INFO,
     &iasm::INFO,
+    &dpsm::INFO,
+    &dpsm::NOTW_INFO,
 ];
 
 /// Every technique's composed WGSL, for the naga validation test.
