@@ -98,7 +98,6 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     warp::INTERP,
     NOTW_SUBDIV,
     warp::SUBDIV_LEVELS,
-    warp::CLOSE_CRACKS,
     EXACT,
     sm::PCF,
     NOTW_BIAS,
