@@ -44,9 +44,21 @@ pub const DEFAULT_NOTW_BLUR: f64 = 4.0;
 /// Constant bias (texels). The depth between subdivided vertices is interpolated along chords of
 /// the paraboloid, so acne needs more than `sm`'s 0.5. See docs/bench/dpsm.md.
 pub const DEFAULT_BIAS: f64 = 1.0;
-/// `dpsm-notw`'s constant bias (warped texels). warp's exact depth (its default for `notw`) is
-/// planar-only, so the interpolated depth is used and warp.rs recommends 2 for it.
-pub const DEFAULT_NOTW_BIAS: f64 = 2.0;
+/// `dpsm-notw`'s constant bias (warped texels), with `DEFAULT_NOTW_NORMAL_OFFSET` and
+/// `DEFAULT_NOTW_WINDOW`. Room / conference / courtyard lantern (wrong %): bias 0.5 -> 0.470 /
+/// 0.587 / 0.760 (acne), 1 -> 0.401 / 0.498 / 0.398, 1.25 -> 0.399 / 0.499 / 0.358, 1.5 ->
+/// 0.400 / 0.507 / 0.339. High: leaks (false lit grows).
+pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
+/// `dpsm-notw`'s normal offset (warped texels). 0.5 (sm's) -> 0.25 with window 128, bias 1: room
+/// 0.438 -> 0.401, conference 0.580 -> 0.498, courtyard lantern 0.402 -> 0.398 % wrong. (For
+/// `dpsm` 0.25 is worse on courtyard: 0.586 -> 1.059, acne; it keeps sm's 0.5.)
+pub const DEFAULT_NOTW_NORMAL_OFFSET: f64 = 0.25;
+/// `dpsm-notw`'s smoothing window (functions averaged). The warp module's 16 (the authors'
+/// code, planar maps) bends the paraboloid maps too much: room / conference / courtyard lantern
+/// (bias 2) 16 -> 0.508 / 0.743 / 0.633 % wrong, 32 -> 0.516 / 0.725 / 0.416, 64 -> 0.455 /
+/// 0.704 / 0.375, 128 -> 0.448 / 0.641 / 0.392, 256 -> 0.459 / 0.621 / 0.400, 511 -> 0.502 /
+/// 0.618 / 0.426. Low: neighbouring rows warp apart, edges bend; high: RTW-like, less even.
+pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
 
 pub const RES: ParamDef = ParamDef { default: DEFAULT_RES, doc: "side of each hemisphere's map (texels); two maps", ..sm::RES };
 pub const SPLIT: ParamDef = ParamDef {
@@ -71,8 +83,21 @@ const NOTW_BLUR: ParamDef =
     ParamDef { default: DEFAULT_NOTW_BLUR, source: "shadowlab measurement on room light 1 (docs/bench/dpsm.md)", ..warp::NOTW_BLUR };
 const DPSM_BIAS: ParamDef =
     ParamDef { default: DEFAULT_BIAS, source: "shadowlab sweep on room/conference point lights (docs/bench/dpsm.md)", ..sm::BIAS };
-const NOTW_BIAS: ParamDef =
-    ParamDef { default: DEFAULT_NOTW_BIAS, source: "warp.rs: 2 with interpolated depth; shadowlab sweep (docs/bench/dpsm.md)", ..sm::BIAS };
+const NOTW_BIAS: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_BIAS,
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    ..sm::BIAS
+};
+const NOTW_WINDOW: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_WINDOW,
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    ..warp::WINDOW
+};
+const NOTW_NORMAL_OFFSET: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_NORMAL_OFFSET,
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    ..sm::NORMAL_OFFSET
+};
 
 /// Exact depth per fragment (the fragment's direction intersected with its triangle's plane,
 /// through the inverted warp for `dpsm-notw`) instead of the depth interpolated along the chords
@@ -92,7 +117,7 @@ pub const DPSM_PARAMS: &[ParamDef] =
 pub const NOTW_PARAMS: &[ParamDef] = &[
     RES,
     SPLIT,
-    warp::WINDOW,
+    NOTW_WINDOW,
     NOTW_BLUR,
     warp::MIX,
     warp::INTERP,
@@ -103,7 +128,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     NOTW_BIAS,
     sm::SLOPE_BIAS,
     sm::MAX_SLOPE,
-    sm::NORMAL_OFFSET,
+    NOTW_NORMAL_OFFSET,
     warp::DV_MARGIN,
 ];
 
