@@ -16,6 +16,10 @@
 //! the light (orthographic: linear), as in `sm`; with `exact_depth` (notw default) each fragment
 //! writes its triangle's depth at the warp's preimage of the fragment (depth_exact.wgsl) instead
 //! of the depth interpolated between warped vertices.
+//!
+//! [`Projection::Paraboloid`] makes a `Warped` one hemisphere of a point light's dual-paraboloid
+//! maps (`dpsm`, `dpsm-notw` in techniques/dpsm): the same passes over the view samples of that
+//! hemisphere, the paraboloid mapping in `base_clip` (params.wgsl).
 
 mod params;
 mod run;
