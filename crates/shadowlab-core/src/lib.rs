@@ -17,6 +17,7 @@ pub mod loaders;
 pub mod mdsm;
 pub mod metrics;
 pub mod moments;
+pub mod paraboloid;
 pub mod params;
 pub mod scene;
 pub mod setup;

@@ -3,6 +3,7 @@
 
 pub mod csm;
 pub mod cube;
+pub mod dpsm;
 pub mod filtered;
 pub mod iasm;
 pub mod mdsm;
@@ -155,6 +156,8 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &iasm::INFO,
     &cube::INFO,
     &cube::NOTW_INFO,
+    &dpsm::INFO,
+    &dpsm::NOTW_INFO,
 ];
 
 /// Every technique's composed WGSL, for the naga validation test.

@@ -2,6 +2,7 @@
 // Algorithm 1). Entry points run in this order: dv_reduce, count, then for NoTW blur_rows,
 // (prefix sums of the rows) offsets_rows, smooth_rows, rebuild, blur_cols, (column prefix
 // sums) offsets_cols, smooth_cols; for RTW rtw_collapse, rtw_blur, (prefix sums) rtw_offsets.
+// A paraboloid map analyses only the view samples of its hemisphere (`owns_sample`).
 //
 // work (u32): counts [0,n) | counts rebuilt through the row warps [n,2n) | RTW importance or
 // NoTW blurred counts as f32 bits [2n,3n) | blurred 1D importance as f32 bits [3n,3n+2w).  fwork (f32): prefix sums [0,n) |
@@ -39,7 +40,7 @@ fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
     }
     workgroupBarrier();
     var s: Sample;
-    if load_sample(id, &s) {
+    if load_sample(id, &s) && owns_sample(wp, s.p) {
         let m = clamp(clip_to_map(base_clip(wp, s.p)).xy, vec2<f32>(0.0), vec2<f32>(1.0));
         let f = vec2<u32>(min(m * DV_SCALE, vec2<f32>(DV_SCALE)));
         atomicMin(&wg_bounds[0], f.x);
@@ -73,7 +74,7 @@ fn inside(u: vec2<f32>) -> bool {
 @compute @workgroup_size(8, 8)
 fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     var s: Sample;
-    if !load_sample(id, &s) {
+    if !load_sample(id, &s) || !owns_sample(wp, s.p) {
         return;
     }
     let u = sample_dv(s.p);
@@ -220,7 +221,7 @@ fn row_offset(i: u32, x: f32) -> f32 {
 @compute @workgroup_size(8, 8)
 fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
     var s: Sample;
-    if !load_sample(id, &s) {
+    if !load_sample(id, &s) || !owns_sample(wp, s.p) {
         return;
     }
     let u = sample_dv(s.p);

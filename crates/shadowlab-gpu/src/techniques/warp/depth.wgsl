@@ -1,7 +1,7 @@
 // Warped shadow-map pass (seed 000 Algorithm 1 in the vertex stage): each vertex is projected,
 // cropped to the desired view and moved by the warp textures; depth stays the base projection's
-// post-projective depth (0 = near the light). With subdivision on, the vertices come from the
-// pieces of subdiv.wgsl.
+// post-projective depth (0 = near the light; paraboloid: distance / far). With subdivision on,
+// the vertices come from the pieces of subdiv.wgsl.
 //
 // `exact_depth` (wp.flags.z): the rasteriser interpolates depth linearly between warped
 // vertices, which is wrong inside a piece by up to the subdivision threshold. The stored depth
@@ -24,6 +24,14 @@ struct VsOut {
     @location(3) @interpolate(flat) plane: vec4<f32>,
     // exact depth: the piece corners' depth range (the exact depth is clamped to it)
     @location(4) @interpolate(flat) zrange: vec2<f32>,
+    // paraboloid: n.z of the vertex direction in the hemisphere's light space (planar: 1)
+    @location(5) side: f32,
+}
+
+// Paraboloid: fragments farther than SPLIT_OVERLAP behind the split plane (params.wgsl) are
+// discarded; their images would wrap around the map.
+fn behind_hemisphere(in: VsOut) -> bool {
+    return in.side < -SPLIT_OVERLAP;
 }
 
 fn bary_pos(tri: u32, b: vec2<f32>) -> vec3<f32> {
@@ -83,11 +91,17 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     o.u = vec2<f32>(0.0);
     o.plane = vec4<f32>(0.0);
     o.zrange = vec2<f32>(0.0, 1.0);
+    o.side = hemisphere_side(wp, v.pos);
     if wp.flags.z != 0u {
         let a = base_clip(wp, v.pos);
         o.u = to_dv(clip_to_map(a).xy, r);
         // the whole triangle's plane (better conditioned than a small piece's), else the piece's
         let t = piece.x;
+        if is_paraboloid(wp) {
+            o.plane = paraboloid_plane(t);
+            o.zrange = vec2<f32>(abs(o.plane.w), piece_zrange(piece).y);
+            return o;
+        }
         var plane = depth_plane(array<vec4<f32>, 3>(base_clip(wp, vertices[3u * t].pos), base_clip(wp, vertices[3u * t + 1u].pos),
             base_clip(wp, vertices[3u * t + 2u].pos)), r);
         let pc = array<vec4<f32>, 3>(base_clip(wp, bary_pos(t, unpack2x16unorm(piece.y))), base_clip(wp, bary_pos(t, unpack2x16unorm(piece.z))),
@@ -102,6 +116,32 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
         }
     }
     return o;
+}
+
+// Paraboloid exact depth: the triangle's plane dot(nrm, x) = c in the hemisphere's (scaled)
+// light space as (nrm, c); a point of the plane seen in direction n lies at depth c / dot(nrm, n)
+// (depth_exact.wgsl). c = 0 (plane through the light: seen edge-on) marks it invalid.
+fn paraboloid_plane(t: u32) -> vec4<f32> {
+    let a0 = (wp.light_view_proj * vec4<f32>(vertices[3u * t].pos, 1.0)).xyz;
+    let a1 = (wp.light_view_proj * vec4<f32>(vertices[3u * t + 1u].pos, 1.0)).xyz;
+    let a2 = (wp.light_view_proj * vec4<f32>(vertices[3u * t + 2u].pos, 1.0)).xyz;
+    let nrm = cross(a1 - a0, a2 - a0);
+    let len = length(nrm);
+    if len <= 1e-20 {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(nrm / len, dot(nrm / len, a0));
+}
+
+// Depth range of a piece's corners. Paraboloid depth is the distance: on a flat piece the
+// largest lies at a corner, the smallest possibly inside (the foot of the perpendicular from the
+// light), so the caller takes the plane's distance |c| as the low end.
+fn piece_zrange(piece: vec4<u32>) -> vec2<f32> {
+    let t = piece.x;
+    let z0 = clip_to_map(base_clip(wp, bary_pos(t, unpack2x16unorm(piece.y)))).z;
+    let z1 = clip_to_map(base_clip(wp, bary_pos(t, unpack2x16unorm(piece.z)))).z;
+    let z2 = clip_to_map(base_clip(wp, bary_pos(t, unpack2x16unorm(piece.w)))).z;
+    return vec2<f32>(0.0, max(max(z0, z1), z2));
 }
 
 // sin^2 of the angle between the projected edges below which a triangle counts as edge-on.

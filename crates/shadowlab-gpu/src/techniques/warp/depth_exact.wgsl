@@ -1,12 +1,13 @@
 // Fragment stage of the warped depth pass with `exact_depth` (see depth.wgsl): the fragment's
 // warped map coordinate t is pulled back through the warp by Newton steps on warp(u) = t
 // (forward-difference Jacobian over half a texel, the same lookups as the evaluation), and the
-// depth of the piece's plane at u is written. Clamped to the piece corners' depth range, so a
+// depth of the piece's plane at u is written (paraboloid: the distance along the direction of u
+// to the triangle's plane). Clamped to the piece corners' depth range, so a
 // bad inversion is never worse than the interpolated depth's worst case.
 
 @fragment
 fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
-    if cut_out(materials[in.material], in.uv) {
+    if cut_out(materials[in.material], in.uv) || behind_hemisphere(in) {
         discard;
     }
     if in.plane.w == 0.0 {
@@ -49,6 +50,19 @@ fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
         return in.clip.z;
     }
     u = best;
+    if is_paraboloid(wp) {
+        // the direction of the unwarped map point, then the distance to the plane along it
+        let r = dv_rect();
+        let m = r.xy + u * (r.zw - r.xy);
+        let x = vec2<f32>(2.0 * m.x - 1.0, 1.0 - 2.0 * m.y);
+        let r2 = dot(x, x);
+        let n = vec3<f32>(2.0 * x, 1.0 - r2) / (1.0 + r2);
+        let d = in.plane.w / dot(in.plane.xyz, n);
+        if !(d > 0.0) {
+            return in.clip.z;
+        }
+        return clamp(d, in.zrange.x, in.zrange.y);
+    }
     let d = dot(in.plane.xy, u) + in.plane.z;
     return clamp(d, in.zrange.x, in.zrange.y);
 }

@@ -38,7 +38,8 @@ fn sigma_min(a: vec2<f32>, b: vec2<f32>) -> f32 {
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var s: Sample;
-    if !load_sample(id, &s) {
+    // a paraboloid map writes only its hemisphere's samples; the other map writes the rest
+    if !load_sample(id, &s) || !owns_sample(wp, s.p) {
         return;
     }
     let p = s.p;
@@ -60,6 +61,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if wp.texel.y > 0.5 {
         texel *= max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
     }
+    if is_paraboloid(wp) {
+        // texel.x = 2 / res radians per texel at the rim; (1 + n.z) x that in general
+        texel *= distance(p, light.position.xyz) * (1.0 + max(hemisphere_side(wp, p), 0.0));
+    }
     if wp.cfg.z > 0.5 {
         let h = 0.5 / res;
         let jx = (warp(u0 + vec2<f32>(h, 0.0)) - warp(u0 - vec2<f32>(h, 0.0))) / (2.0 * h);
@@ -74,7 +79,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let q = p + n * (wp.bias.z * texel) + l * ((wp.bias.x + (wp.bias.y + half) * tan_t) * texel);
     let a = base_clip(wp, q);
     let m = clip_to_map(a);
-    let u = warp(to_dv(m.xy, r));
+    var u = warp(to_dv(m.xy, r));
+    if is_paraboloid(wp) && a.w > 0.0 {
+        // a biased point that crossed the split plane reads the map's border texels
+        u = clamp(u, vec2<f32>(0.0), vec2<f32>(1.0));
+    }
     if a.w <= 0.0 || any(u < vec2<f32>(0.0)) || any(u > vec2<f32>(1.0)) || m.z > 1.0 {
         visibility[s.i] = 1.0;
         return;

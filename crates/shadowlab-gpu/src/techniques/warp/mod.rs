@@ -16,6 +16,10 @@
 //! the light (orthographic: linear), as in `sm`; with `exact_depth` (notw default) each fragment
 //! writes its triangle's depth at the warp's preimage of the fragment (depth_exact.wgsl) instead
 //! of the depth interpolated between warped vertices.
+//!
+//! [`Projection::Paraboloid`] makes a `Warped` one hemisphere of a point light's dual-paraboloid
+//! maps (`dpsm`, `dpsm-notw` in techniques/dpsm): the same passes over the view samples of that
+//! hemisphere, the paraboloid mapping in `base_clip` (params.wgsl).
 
 mod params;
 mod run;
@@ -25,6 +29,7 @@ pub use params::*;
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
+use shadowlab_core::paraboloid::Hemisphere;
 use shadowlab_core::params::ParamValues;
 
 use crate::prefix_sum::PrefixSum;
@@ -135,6 +140,8 @@ pub struct WarpParams {
 /// One light's warped shadow map with its warps and scratch buffers.
 pub struct Warped {
     variant: Variant,
+    /// Prefix of the wgpu labels and stage names.
+    label: &'static str,
     res: u32,
     pcf: u32,
     params: WarpParams,
@@ -185,6 +192,18 @@ fn r32_texture(gpu: &Gpu, label: &str, w: u32, h: u32) -> wgpu::Texture {
     })
 }
 
+/// How a warped map projects the world before the desired view and the warp.
+#[derive(Clone, Copy, Debug)]
+pub enum Projection {
+    /// A directional or spot light's projection (`lightspace::fit`).
+    Planar(lightspace::LightProjection),
+    /// One hemisphere of a point light's dual-paraboloid maps (seed 002 eq. 3.3-3.10; params.wgsl
+    /// `base_clip`): `view` = world -> the hemisphere's light space scaled by 1/far
+    /// (`DualParaboloid::view`). Subdivision also follows the paraboloid's bending; `exact_depth`
+    /// intersects the fragment's direction with the triangle's plane (also without a warp).
+    Paraboloid { view: glam::Mat4, hemisphere: Hemisphere },
+}
+
 impl Warped {
     pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, variant: Variant) -> Result<Warped, GpuError> {
         let name = variant.name();
@@ -193,26 +212,53 @@ impl Warped {
         let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
             GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
         })?;
+        Warped::with_projection(gpu, scene, p, variant, Projection::Planar(lp), name, true)
+    }
+
+    /// A warped map over `proj`, labelled `name` (wgpu labels, stage names `{name}.<stage>`);
+    /// `dv`: crop to the desired view. `Variant::Dv` without `dv` is the plain (unwarped) map,
+    /// rendered with subdivision when `proj` is a paraboloid. The caller has checked `res`.
+    pub fn with_projection(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        p: &ParamValues,
+        variant: Variant,
+        proj: Projection,
+        name: &'static str,
+        dv: bool,
+    ) -> Result<Warped, GpuError> {
+        let res = p.get_u32("res");
+        let (view_proj, texel, perspective, kind) = match proj {
+            Projection::Planar(lp) => (lp.view_proj, lp.texel, lp.perspective, 0),
+            // 2/res of the map plane per texel: 2 (1 + n.z) / res radians (paraboloid.rs)
+            Projection::Paraboloid { view, hemisphere } => (view, 2.0 / res as f32, false, 1 + (hemisphere == Hemisphere::Back) as u32),
+        };
+        let paraboloid = kind != 0;
         let opt = |k: &str, d: f64| if p.0.contains_key(k) { p.get(k) } else { d };
         let window = opt("window", 0.0);
         if window >= res as f64 {
             return Err(GpuError::Invalid(format!("{name}: window {window} must be below res {res}")));
         }
         let subdiv = opt("subdiv", 0.0) as f32;
-        let exact = opt("exact_depth", 0.0) != 0.0 && variant != Variant::Dv;
+        let exact = opt("exact_depth", 0.0) != 0.0 && (variant != Variant::Dv || paraboloid);
         let tris = scene.triangle_count;
         let limit = gpu.limits.max_storage_buffer_binding_size / 16;
-        let on = subdiv > 0.0 && variant != Variant::Dv;
+        let on = subdiv > 0.0 && (variant != Variant::Dv || paraboloid);
         let extra = if on { (8 * tris as u64).max(1 << 21).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
         let queue = if on { (tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
         let params = WarpParams {
-            light_view_proj: lp.view_proj.to_cols_array_2d(),
-            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, p.get("pcf") as f32],
+            light_view_proj: view_proj.to_cols_array_2d(),
+            texel: [texel, perspective as u32 as f32, res as f32, p.get("pcf") as f32],
             bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
-            cfg: [p.get("dv_margin") as f32, 1.0 + opt("close_cracks", 0.0) as f32, (variant != Variant::Dv) as u32 as f32, window as f32],
+            cfg: [
+                opt("dv_margin", 0.0) as f32,
+                if dv { 1.0 + opt("close_cracks", 0.0) as f32 } else { 0.0 },
+                (variant != Variant::Dv) as u32 as f32,
+                window as f32,
+            ],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
             ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
-            flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, 0],
+            flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, kind],
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;
@@ -296,6 +342,7 @@ impl Warped {
         });
         Ok(Warped {
             variant,
+            label: name,
             res,
             pcf: p.get_u32("pcf"),
             params,

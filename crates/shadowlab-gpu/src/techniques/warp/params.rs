@@ -75,7 +75,7 @@ const NORMAL_OFFSET: ParamDef = p(
     "offset along the normal in warped texels (local size from the warp's Jacobian); low: acne, high: shifted shadows",
     "Holbert 2011; value as sm",
 );
-const DV_MARGIN: ParamDef = p(
+pub const DV_MARGIN: ParamDef = p(
     "dv_margin",
     DEFAULT_DV_MARGIN,
     0.0,
@@ -84,7 +84,7 @@ const DV_MARGIN: ParamDef = p(
     "texels added around the desired view; low: biased samples fall outside (lit)",
     "shadowlab: covers bias + normal offset",
 );
-const WINDOW: ParamDef = p(
+pub const WINDOW: ParamDef = p(
     "window",
     DEFAULT_WINDOW,
     0.0,
@@ -102,7 +102,7 @@ const BLUR: ParamDef = p(
     "RTW blur half-width of the 1D importance; low: abrupt warps, high: flat warps",
     "window 16 (GUIDE)",
 );
-const NOTW_BLUR: ParamDef = p(
+pub const NOTW_BLUR: ParamDef = p(
     "blur",
     DEFAULT_NOTW_BLUR,
     0.0,
@@ -111,7 +111,7 @@ const NOTW_BLUR: ParamDef = p(
     "NoTW box blur half-width of the counts along each row/column before the prefix sums; 0 = the seeds' method; low: a kink per texel that subdivision must follow, high: less even sampling",
     "shadowlab measurement (docs/bench/warp.md)",
 );
-const MIX: ParamDef = p(
+pub const MIX: ParamDef = p(
     "mix",
     DEFAULT_MIX,
     0.0,
@@ -131,13 +131,13 @@ const W_DV: ParamDef = p(
 );
 const W_EYE: ParamDef =
     p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
-const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
+pub const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
 const NOTW_BIASP: ParamDef = ParamDef {
     default: DEFAULT_NOTW_BIAS,
     source: "shadowlab sweep 0.5/1/1.5/2 with exact depth on six setups (docs/bench/warp.md)",
     ..BIAS
 };
-const SUBDIV: ParamDef = p(
+pub const SUBDIV: ParamDef = p(
     "subdiv",
     DEFAULT_SUBDIV,
     0.0,
@@ -146,7 +146,7 @@ const SUBDIV: ParamDef = p(
     "split triangles until the warp bends no edge (or centroid) by more than this many warped texels from the rasterised line; 0 = off; low: many pieces, high: bent edges",
     "shadowlab measurement (docs/bench/warp.md)",
 );
-const INTERP: ParamDef = ParamDef {
+pub const INTERP: ParamDef = ParamDef {
     key: "interp",
     default: DEFAULT_INTERP,
     min: 0.0,
@@ -156,7 +156,7 @@ const INTERP: ParamDef = ParamDef {
     source: "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard",
     choices: shadowlab_core::params::BOOL,
 };
-const SUBDIV_LEVELS: ParamDef = p(
+pub const SUBDIV_LEVELS: ParamDef = p(
     "subdiv_levels",
     DEFAULT_SUBDIV_LEVELS,
     1.0,

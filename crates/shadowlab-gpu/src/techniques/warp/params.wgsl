@@ -22,16 +22,62 @@ struct WarpParams {
     ints: vec4<u32>,
     // x: 1 = offsets interpolated linearly between neighbouring functions (continuous warp),
     // 0 = eq. 6 as printed (function floor(y w) / floor(x' w)); y: NoTW uniform floor `mix`
-    // (f32 bits); z: 1 = exact depth per fragment (depth_exact.wgsl)
+    // (f32 bits); z: 1 = exact depth per fragment (depth_exact.wgsl); w: projection kind
+    // (PLANAR, or PARABOLOID_FRONT / _BACK: one hemisphere of a point light, paraboloid.rs)
     flags: vec4<u32>,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.
 const DV_SCALE: f32 = 16777216.0;
 
-// Base map coordinates (x, y) and post-projective depth of a world point; w <= 0 behind a spot.
+// Projection kinds (flags.w). PLANAR: light_view_proj is the light's view-projection.
+// PARABOLOID_FRONT / _BACK (seed 002 eq. 3.3-3.10): light_view_proj is world -> the hemisphere's light space
+// (+z = its axis) scaled by 1/far; the map plane point is (n.x, n.y) / (1 + n.z) for the unit
+// direction n, depth = distance / far (linear, 0 at the light).
+const PLANAR: u32 = 0u;
+const PARABOLOID_FRONT: u32 = 1u;
+const PARABOLOID_BACK: u32 = 2u;
+
+fn is_paraboloid(pw: WarpParams) -> bool {
+    return pw.flags.w != PLANAR;
+}
+
+// Base map coordinates (x, y) and depth of a world point as a clip position; w <= 0 behind a
+// spot. Paraboloid: the homogeneous form (n.x, n.y, depth (1 + n.z), 1 + n.z), finite for every
+// direction but the opposite axis (w = 0); directions of the other hemisphere land outside the
+// unit disc (the depth pass discards them by `hemisphere_side`).
 fn base_clip(pw: WarpParams, p: vec3<f32>) -> vec4<f32> {
-    return pw.light_view_proj * vec4<f32>(p, 1.0);
+    let a = pw.light_view_proj * vec4<f32>(p, 1.0);
+    if !is_paraboloid(pw) {
+        return a;
+    }
+    let d = length(a.xyz);
+    let n = a.xyz / max(d, 1e-20);
+    let w = 1.0 + n.z;
+    return vec4<f32>(n.x, n.y, d * w, w);
+}
+
+// Paraboloid: n.z of the direction of p in the hemisphere's light space (>= 0: this
+// hemisphere; the split plane belongs to the front, whose axis the light space's +z is). Planar: 1.
+fn hemisphere_side(pw: WarpParams, p: vec3<f32>) -> f32 {
+    if !is_paraboloid(pw) {
+        return 1.0;
+    }
+    let a = (pw.light_view_proj * vec4<f32>(p, 1.0)).xyz;
+    return a.z / max(length(a), 1e-20);
+}
+
+// Paraboloid maps draw (and subdivide) the scene up to SPLIT_OVERLAP (in n.z) past the split
+// plane: that part lands just outside the unit disc, so samples whose biased position crosses
+// the plane still find their occluders in the border texels. Farther back nothing is drawn:
+// the images of triangles there would wrap around the map (the opposite axis maps to infinity).
+const SPLIT_OVERLAP: f32 = 0.1;
+
+// Whether this map owns view sample p: planar always; of the two paraboloid maps the front
+// owns the split plane (side >= 0), the back (whose +z is the opposite axis) only side > 0.
+fn owns_sample(pw: WarpParams, p: vec3<f32>) -> bool {
+    let s = hemisphere_side(pw, p);
+    return !is_paraboloid(pw) || s > 0.0 || (s == 0.0 && pw.flags.w == PARABOLOID_FRONT);
 }
 
 fn clip_to_map(c: vec4<f32>) -> vec3<f32> {

@@ -30,7 +30,7 @@ pub fn offset_image(name: &str, w: u32, h: u32, o: &[f32]) -> NamedImage {
 
 impl Warped {
     fn name(&self) -> &'static str {
-        self.variant.name()
+        self.label
     }
 
     fn pipeline(&self, entry: &str) -> &wgpu::ComputePipeline {
@@ -49,7 +49,7 @@ impl Warped {
     /// The DV rectangle (lo x, lo y, hi x, hi y) in base map coordinates, as the shaders use it.
     pub fn read_dv_rect(&self, gpu: &Gpu) -> [f32; 4] {
         let b: Vec<u32> = gpu.read_buffer_as(&self.dv, 4);
-        if b[0] > b[2] || b[1] > b[3] {
+        if self.params.cfg[1] < 0.5 || b[0] > b[2] || b[1] > b[3] {
             return [0.0, 0.0, 1.0, 1.0];
         }
         let s = 16777216.0f32;
@@ -68,8 +68,8 @@ impl Warped {
         gpu.read_buffer_as(&self.work, 2 * n)[..n].to_vec()
     }
 
-    /// The count map of the last evaluation, through the final warp (cube-notw merges the faces').
-    pub fn read_counts_after(&self, gpu: &Gpu) -> Vec<u32> {
+    /// The view samples per texel of the final (warped) map, counted by the last evaluation.
+    pub fn read_counts_final(&self, gpu: &Gpu) -> Vec<u32> {
         gpu.read_buffer_as(&self.counts, (self.res * self.res) as usize)
     }
 

@@ -54,9 +54,15 @@ fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32
 // so the two pieces sharing an edge decide alike and no T-junction (crack) appears.
 fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
     let r = dv_rect();
-    let a = base_clip(wp, corner_pos(tri, ca));
-    let b = base_clip(wp, corner_pos(tri, cb));
+    let pa = corner_pos(tri, ca);
+    let pb = corner_pos(tri, cb);
+    let a = base_clip(wp, pa);
+    let b = base_clip(wp, pb);
     if min(a.w, b.w) <= 1e-7 {
+        return false;
+    }
+    // paraboloid: an edge wholly behind the drawn part of the hemisphere is never drawn
+    if is_paraboloid(wp) && max(hemisphere_side(wp, pa), hemisphere_side(wp, pb)) < -SPLIT_OVERLAP {
         return false;
     }
     let ua = to_dv(clip_to_map(a).xy, r);
@@ -64,7 +70,33 @@ fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
     if any(max(ua, ub) < vec2<f32>(0.0)) || any(min(ua, ub) > vec2<f32>(1.0)) {
         return false;
     }
+    if is_paraboloid(wp) {
+        return paraboloid_edge_error(pa, pb, warp(ua), warp(ub), r) > wp.imp.w;
+    }
     return edge_error(ua, ub, warp(ua), warp(ub)) > wp.imp.w;
+}
+
+// The paraboloid mapping bends straight world edges (seed 002 section 3.3.2: "the rendered scene
+// needs to be finely tessellated"): distance (warped texels) of the images of the world points
+// at 1/4, 1/2, 3/4 of the edge from the straight line the rasteriser draws between its warped
+// ends (the line, not the point at the same parameter: only coverage matters here).
+fn paraboloid_edge_error(pa: vec3<f32>, pb: vec3<f32>, wa: vec2<f32>, wb: vec2<f32>, r: vec4<f32>) -> f32 {
+    let dir = wb - wa;
+    let len = length(dir);
+    var e = 0.0;
+    for (var s = 1u; s <= 3u; s++) {
+        let c = base_clip(wp, mix(pa, pb, f32(s) / 4.0));
+        if c.w <= 1e-7 {
+            return 1e30;
+        }
+        let m = warp(to_dv(clip_to_map(c).xy, r)) - wa;
+        var d = length(m);
+        if len > 1e-12 {
+            d = abs(m.x * dir.y - m.y * dir.x) / len;
+        }
+        e = max(e, d);
+    }
+    return e * wp.texel.z;
 }
 
 // A piece larger than BIG_PIECE of the cropped map that overlaps it splits all three edges even when
@@ -78,6 +110,13 @@ fn interior_needs_split(p: vec4<u32>) -> bool {
     let c = base_clip(wp, corner_pos(p.x, p.w));
     if min(min(a.w, b.w), c.w) <= 1e-7 {
         return false;
+    }
+    if is_paraboloid(wp) {
+        let side = max(max(hemisphere_side(wp, corner_pos(p.x, p.y)), hemisphere_side(wp, corner_pos(p.x, p.z))),
+            hemisphere_side(wp, corner_pos(p.x, p.w)));
+        if side < -SPLIT_OVERLAP {
+            return false;
+        }
     }
     let u = array<vec2<f32>, 3>(to_dv(clip_to_map(a).xy, r), to_dv(clip_to_map(b).xy, r), to_dv(clip_to_map(c).xy, r));
     let lo = min(min(u[0], u[1]), u[2]);

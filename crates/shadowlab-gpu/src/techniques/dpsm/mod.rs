@@ -1,0 +1,254 @@
+//! Dual-paraboloid shadow maps for point lights (seed 002 section 3.3.2), two registry entries:
+//! - `dpsm`: two `res x res` depth maps, one per hemisphere of the split plane
+//!   (`shadowlab_core::paraboloid`: the plane through the light perpendicular to `split`, +Y by
+//!   default), the paraboloid mapping of eq. 3.3-3.10 applied per vertex. The mapping is not
+//!   linear, so long edges are split first by the warping module's GPU subdivision
+//!   (warp/subdiv.wgsl, `subdiv` = largest bend in texels). Stored depth: linear, distance /
+//!   far, 0 at the light.
+//! - `dpsm-notw`: NoTW (seed 000 section 3) per hemisphere: each hemisphere's desired view,
+//!   count map, row and column warps over its own view samples (seed 002 section 5.3).
+//!
+//! Both are two instances of the warping module's `Warped` in its paraboloid projection mode
+//! (warp/params.wgsl `base_clip`): no pass is duplicated here. A view sample is evaluated by the
+//! map of its hemisphere (warp/params.wgsl `owns_sample`).
+
+use shadowlab_core::light::Light;
+use shadowlab_core::metrics::sampling_stats;
+use shadowlab_core::paraboloid::{split_axis, DualParaboloid, Hemisphere, SPLIT_AXES};
+use shadowlab_core::params::{ParamDef, ParamValues};
+
+use crate::scene_gpu::GpuScene;
+use crate::techniques::warp::{self, Projection, Variant, Warped};
+use crate::techniques::{sm, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::timing::StageTimer;
+use crate::{Gpu, GpuError};
+
+/// Side of each hemisphere's map (texels). The setting: 512 per hemisphere against
+/// 1024x1024 output (seeds 000/002 evaluate 512 maps).
+pub const DEFAULT_RES: f64 = 512.0;
+/// Split axis: +Y (a horizontal split plane). The floor and the table tops of indoor scenes lie in
+/// the lower hemisphere, away from the seam; walls cross it.
+pub const DEFAULT_SPLIT: f64 = 0.0;
+/// Subdivision threshold (texels of bend of an edge under the paraboloid mapping). Room light 1,
+/// 1024x1024 output, 512 maps: 1 -> 0.740 % wrong, 0.5 -> 0.704 %, 0.25 -> 0.692 % (docs/bench/dpsm.md);
+/// lower: more pieces (10 k -> 15 k per hemisphere from 0.5 to 0.25), higher: bent edges
+/// (triangles drawn along chords of the paraboloid: misplaced shadow edges, leaks).
+pub const DEFAULT_SUBDIV: f64 = 0.5;
+/// `dpsm-notw`: the paraboloid and the warp bend together; room light 1: 2 (warp's default for
+/// notw) -> 1.13 % wrong (worse than dpsm), 1 -> 0.72, 0.5 -> 0.556, 0.25 -> 0.508 (with
+/// blur 4), at 0.2 M -> 0.5 M pieces in the lower hemisphere.
+pub const DEFAULT_NOTW_SUBDIV: f64 = 0.25;
+/// `dpsm-notw`'s blur of the counts (half-width, texels). Room light 1 (subdiv 0.5): 8 (warp's
+/// default) -> 0.570 %, 4 -> 0.556, 2 -> 0.551; 4 halves the pieces of 2. Too high: flatter warp.
+pub const DEFAULT_NOTW_BLUR: f64 = 4.0;
+/// Constant bias (texels). The depth between subdivided vertices is interpolated along chords of
+/// the paraboloid, so acne needs more than `sm`'s 0.5. See docs/bench/dpsm.md.
+pub const DEFAULT_BIAS: f64 = 1.0;
+/// `dpsm-notw`'s constant bias (warped texels), with `DEFAULT_NOTW_NORMAL_OFFSET` and
+/// `DEFAULT_NOTW_WINDOW`. Room / conference / courtyard lantern (wrong %): bias 0.5 -> 0.470 /
+/// 0.587 / 0.760 (acne), 1 -> 0.401 / 0.498 / 0.398, 1.25 -> 0.399 / 0.499 / 0.358, 1.5 ->
+/// 0.400 / 0.507 / 0.339. High: leaks (false lit grows).
+pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
+/// `dpsm-notw`'s normal offset (warped texels). 0.5 (sm's) -> 0.25 with window 128, bias 1: room
+/// 0.438 -> 0.401, conference 0.580 -> 0.498, courtyard lantern 0.402 -> 0.398 % wrong. (For
+/// `dpsm` 0.25 is worse on courtyard: 0.586 -> 1.059, acne; it keeps sm's 0.5.)
+pub const DEFAULT_NOTW_NORMAL_OFFSET: f64 = 0.25;
+/// `dpsm-notw`'s smoothing window (functions averaged). The warp module's 16 (the authors'
+/// code, planar maps) bends the paraboloid maps too much: room / conference / courtyard lantern
+/// (bias 2) 16 -> 0.508 / 0.743 / 0.633 % wrong, 32 -> 0.516 / 0.725 / 0.416, 64 -> 0.455 /
+/// 0.704 / 0.375, 128 -> 0.448 / 0.641 / 0.392, 256 -> 0.459 / 0.621 / 0.400, 511 -> 0.502 /
+/// 0.618 / 0.426. Low: neighbouring rows warp apart, edges bend; high: RTW-like, less even.
+pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
+
+pub const RES: ParamDef = ParamDef { default: DEFAULT_RES, doc: "side of each hemisphere's map (texels); two maps", ..sm::RES };
+pub const SPLIT: ParamDef = ParamDef {
+    key: "split",
+    default: DEFAULT_SPLIT,
+    min: 0.0,
+    max: 2.0,
+    integer: true,
+    doc: "axis of the front hemisphere: the split plane passes through the light perpendicular to it; pick one that keeps the seam off the important surfaces",
+    source: "seed 002 section 3.3.2 (the model-view matrix sets the split); y: shadowlab choice for indoor scenes",
+    choices: SPLIT_AXES,
+};
+const DPSM_SUBDIV: ParamDef = ParamDef {
+    default: DEFAULT_SUBDIV,
+    doc: "split triangles until the paraboloid mapping (and warp) bends no edge by more than this many texels from its rasterised chord; 0 = off (big triangles drawn as chords: wrong); low: many pieces",
+    source: "seed 002 section 3.3.2 (tessellation needed); value: shadowlab measurement (docs/bench/dpsm.md)",
+    ..warp::SUBDIV
+};
+const NOTW_SUBDIV: ParamDef =
+    ParamDef { default: DEFAULT_NOTW_SUBDIV, source: "shadowlab measurement on room light 1 (docs/bench/dpsm.md)", ..DPSM_SUBDIV };
+const NOTW_BLUR: ParamDef =
+    ParamDef { default: DEFAULT_NOTW_BLUR, source: "shadowlab measurement on room light 1 (docs/bench/dpsm.md)", ..warp::NOTW_BLUR };
+const DPSM_BIAS: ParamDef =
+    ParamDef { default: DEFAULT_BIAS, source: "shadowlab sweep on room/conference point lights (docs/bench/dpsm.md)", ..sm::BIAS };
+const NOTW_BIAS: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_BIAS,
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    ..sm::BIAS
+};
+const NOTW_WINDOW: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_WINDOW,
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    ..warp::WINDOW
+};
+const NOTW_NORMAL_OFFSET: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_NORMAL_OFFSET,
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    ..sm::NORMAL_OFFSET
+};
+
+/// Exact depth per fragment (the fragment's direction intersected with its triangle's plane,
+/// through the inverted warp for `dpsm-notw`) instead of the depth interpolated along the chords
+/// of subdivided pieces. Off: on room light 1 it did not help (dpsm 0.740 -> 0.783 % wrong,
+/// dpsm-notw at subdiv 0.25 0.537 -> 0.543) and it disables early depth tests; with fine
+/// subdivision the chords are short. See docs/bench/dpsm.md.
+pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
+const EXACT: ParamDef = ParamDef {
+    default: DEFAULT_EXACT_DEPTH,
+    doc: "write the exact depth per fragment: the distance along the fragment's direction (warp inverted by Newton steps for dpsm-notw) to its triangle's plane; false = depth interpolated between (warped) vertices, off along chords of the paraboloid; disables early depth test",
+    source: "shadowlab (docs/bench/dpsm.md)",
+    ..warp::EXACT_DEPTH
+};
+
+pub const DPSM_PARAMS: &[ParamDef] =
+    &[RES, SPLIT, DPSM_SUBDIV, warp::SUBDIV_LEVELS, EXACT, sm::PCF, DPSM_BIAS, sm::SLOPE_BIAS, sm::MAX_SLOPE, sm::NORMAL_OFFSET];
+pub const NOTW_PARAMS: &[ParamDef] = &[
+    RES,
+    SPLIT,
+    NOTW_WINDOW,
+    NOTW_BLUR,
+    warp::MIX,
+    warp::INTERP,
+    NOTW_SUBDIV,
+    warp::SUBDIV_LEVELS,
+    EXACT,
+    sm::PCF,
+    NOTW_BIAS,
+    sm::SLOPE_BIAS,
+    sm::MAX_SLOPE,
+    NOTW_NORMAL_OFFSET,
+    warp::DV_MARGIN,
+];
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "dpsm",
+    summary: "dual-paraboloid shadow maps: two hemisphere depth maps of a point light, paraboloid mapping per vertex after GPU subdivision",
+    cost: "subdivision + two depth passes over the scene; 2 w^2 x 4 bytes; N^2 fetches per pixel",
+    quality: "resolution fixed per solid angle (twice as fine at the rim as at the centre), blind to the view: aliasing near the camera",
+    source: "Brabec, Annen, Seidel 2002; seed 002 section 3.3.2 (eq. 3.3-3.10)",
+    lights: &["point"],
+    params: DPSM_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, false)?)),
+};
+
+pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
+    name: "dpsm-notw",
+    summary: "dual-paraboloid maps warped by NoTW per hemisphere: desired view, count map, row and column warps of each hemisphere's view samples",
+    cost: "per hemisphere: DV reduction, count map, 2 prefix-sum passes, 2 rebuilds; subdivision + warped depth pass; 2 x (4 + 8) w^2 bytes",
+    quality: "the view samples of each hemisphere spread over its whole map; seam at the split plane",
+    source: "seed 002 section 5.3 (DPSM with NoTW), seed 000 section 3",
+    lights: &["point"],
+    params: NOTW_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, true)?)),
+};
+
+/// A point light's two hemisphere maps.
+pub struct Dpsm {
+    maps: [Warped; 2],
+    warped: bool,
+    res: u32,
+    pcf: u32,
+}
+
+impl Dpsm {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, warped: bool) -> Result<Dpsm, GpuError> {
+        let name = if warped { "dpsm-notw" } else { "dpsm" };
+        let Light::Point { position } = *light else {
+            return Err(GpuError::Invalid(format!("{name} supports point lights only (got a {} light)", light.kind())));
+        };
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "paraboloid map")?;
+        if warped && p.get("window") >= res as f64 {
+            return Err(GpuError::Invalid(format!("{name}: window {} must be below res {res}", p.get("window"))));
+        }
+        let axis = split_axis(p.get_u32("split") as usize).ok_or_else(|| GpuError::Invalid(format!("{name}: bad split axis")))?;
+        let dp = DualParaboloid::fit(position, axis, &scene.bounds)
+            .ok_or_else(|| GpuError::Invalid(format!("{name}: light position {position} or scene bounds not usable")))?;
+        let labels: [&'static str; 2] = if warped { ["dpsm-notw.front", "dpsm-notw.back"] } else { ["dpsm.front", "dpsm.back"] };
+        let variant = if warped { Variant::Notw } else { Variant::Dv };
+        let make = |i: usize| {
+            let h = Hemisphere::BOTH[i];
+            Warped::with_projection(gpu, scene, p, variant, Projection::Paraboloid { view: dp.view(h), hemisphere: h }, labels[i], warped)
+        };
+        Ok(Dpsm { maps: [make(0)?, make(1)?], warped, res, pcf: p.get_u32("pcf") })
+    }
+}
+
+impl Technique for Dpsm {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        if self.warped {
+            for m in &mut self.maps {
+                m.prepare(gpu, f, timer)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        for m in &mut self.maps {
+            m.render(gpu, f, timer)?;
+        }
+        Ok(())
+    }
+
+    /// Each map writes the visibility of its hemisphere's samples.
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        for m in &mut self.maps {
+            m.evaluate(gpu, f, timer)?;
+        }
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let n = (self.res * self.res) as u64;
+        let mut r = TechniqueReport::default();
+        let mut all_counts = Vec::with_capacity(2 * n as usize);
+        let mut total_samples = [0u64; 2];
+        for (i, m) in self.maps.iter_mut().enumerate() {
+            let h = Hemisphere::BOTH[i].name();
+            let sub = m.report(gpu);
+            let counts = m.read_counts_final(gpu);
+            total_samples[i] = counts.iter().map(|&c| c as u64).sum();
+            all_counts.extend_from_slice(&counts);
+            for (k, v) in sub.counters {
+                if k.starts_with("subdiv_") || k.ends_with("_before_warp") || k == "dv_area_fraction" {
+                    r.counters.insert(format!("{h}.{k}"), v);
+                }
+            }
+            for mut img in sub.images {
+                if !self.warped {
+                    img.name =
+                        img.name.replace("count map after warping", "view samples per texel").replace("warped shadow map", "shadow map");
+                }
+                img.name = format!("{h} hemisphere: {}", img.name);
+                r.images.push(img);
+            }
+            let s = sampling_stats(&counts);
+            r.counters.insert(format!("{h}.used_texel_fraction"), s.used_texel_fraction);
+            r.counters.insert(format!("{h}.samples_per_used_texel_cv"), s.samples_per_used_texel_cv);
+        }
+        // maps (f32 depth) + warps (two R32Float res x res per hemisphere) + DV bounds
+        let warp_bytes = if self.warped { 2 * 8 * n } else { 0 };
+        r.shadow_data_bytes = 2 * 4 * n + warp_bytes + if self.warped { 2 * 32 } else { 0 };
+        r.sampling = Some(sampling_stats(&all_counts));
+        let c = &mut r.counters;
+        c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
+        c.insert("shadow_map_texels".into(), 2.0 * n as f64);
+        c.insert("warp_bytes".into(), warp_bytes as f64);
+        let sum = (total_samples[0] + total_samples[1]).max(1) as f64;
+        c.insert("front.sample_fraction".into(), total_samples[0] as f64 / sum);
+        r
+    }
+}
