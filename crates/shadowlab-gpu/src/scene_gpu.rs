@@ -126,7 +126,8 @@ impl GpuScene {
             }
         }
         let st = BufferUsages::STORAGE | BufferUsages::COPY_DST;
-        let vertices = gpu.buffer_init("scene.vertices", bytemuck::cast_slice(&scene.vertices), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
+        let vertices =
+            gpu.buffer_init("scene.vertices", bytemuck::cast_slice(&scene.vertices), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
         let mats = gpu.buffer_init("scene.materials", bytemuck::cast_slice(&materials), st);
         let tex = gpu.buffer_init("scene.texels", bytemuck::cast_slice(&texels), st);
         // static tree first, then room for the dynamic one (written by `set_time`)
@@ -198,7 +199,8 @@ impl GpuScene {
         let tris = if triangles.is_empty() { &placeholder[..] } else { triangles };
         let count = if triangles.is_empty() { 0 } else { tris.len() as u32 / 3 };
         let st = BufferUsages::STORAGE | BufferUsages::COPY_DST;
-        let vertices = gpu.buffer_init(&format!("{label}.vertices"), bytemuck::cast_slice(tris), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
+        let vertices =
+            gpu.buffer_init(&format!("{label}.vertices"), bytemuck::cast_slice(tris), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
         let nodes = gpu.buffer_init(&format!("{label}.no_bvh"), bytemuck::cast_slice(&[BvhNode::default()]), st);
         let prims = gpu.storage(&format!("{label}.no_prims"), 16);
         let prev = gpu.storage(&format!("{label}.no_prev"), 16);

@@ -44,11 +44,7 @@ fn split_src() -> String {
 }
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![
-        ("cube/depth.wgsl", depth_src()),
-        ("cube/eval.wgsl", eval_src()),
-        ("cube/split.wgsl", split_src()),
-    ]
+    vec![("cube/depth.wgsl", depth_src()), ("cube/eval.wgsl", eval_src()), ("cube/split.wgsl", split_src())]
 }
 
 /// sm's parameters apply unchanged: `res` is per face (the seeds' 512), the bias is in texels of

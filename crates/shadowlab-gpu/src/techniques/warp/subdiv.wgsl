@@ -159,18 +159,70 @@ fn enqueue(p: vec4<u32>, q: u32) {
     q_out[i] = p;
 }
 
+// A root piece in the triangle's own slot: kept, or queued (the slot then holds nothing).
+fn place_root(tri: u32, p: vec4<u32>) {
+    if split_mask(p) != 0u {
+        pieces[tri] = vec4<u32>(tri, 0u, 0u, 0u);
+        enqueue(p, 0u);
+    } else {
+        pieces[tri] = p;
+    }
+}
+
+// The corner a fraction t of the way from corner a to corner b.
+fn mix_corner(a: u32, b: u32, t: f32) -> u32 {
+    return pack_corner(vec2<u32>(round(mix(vec2<f32>(corner(a)), vec2<f32>(corner(b)), t))));
+}
+
+// Planar projections: the triangle clipped to the light's near plane (clip z >= 0) before any
+// warping, because the warp of a vertex behind a spot light is meaningless (its projection
+// flips) and one such vertex spreads its triangle across the whole map. Clip space is affine in
+// world space, so the cut corners are exact barycentric mixes. Wholly behind: nothing drawn;
+// a cut leaving a quad: its second half is appended like a finished piece.
 @compute @workgroup_size(64)
 fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
     if tri >= wp.ints.x {
         return;
     }
-    let p = vec4<u32>(tri, 0u, 0xffffu, 0xffff0000u);
-    if split_mask(p) != 0u {
+    let c = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
+    if is_paraboloid(wp) {
+        place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
+        return;
+    }
+    var z: array<f32, 3>;
+    for (var i = 0u; i < 3u; i++) {
+        z[i] = base_clip(wp, corner_pos(tri, c[i])).z;
+    }
+    if min(min(z[0], z[1]), z[2]) >= 0.0 {
+        place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
+        return;
+    }
+    var poly: array<u32, 4>;
+    var n = 0u;
+    for (var i = 0u; i < 3u; i++) {
+        let j = (i + 1u) % 3u;
+        if z[i] >= 0.0 {
+            poly[n] = c[i];
+            n += 1u;
+        }
+        if (z[i] >= 0.0) != (z[j] >= 0.0) {
+            poly[n] = mix_corner(c[i], c[j], z[i] / (z[i] - z[j]));
+            n += 1u;
+        }
+    }
+    if n < 3u {
         pieces[tri] = vec4<u32>(tri, 0u, 0u, 0u);
-        enqueue(p, 0u);
-    } else {
-        pieces[tri] = p;
+        return;
+    }
+    place_root(tri, vec4<u32>(tri, poly[0], poly[1], poly[2]));
+    if n == 4u {
+        let q = vec4<u32>(tri, poly[0], poly[2], poly[3]);
+        if split_mask(q) != 0u {
+            enqueue(q, 0u);
+        } else {
+            finish(q);
+        }
     }
 }
 
