@@ -9,6 +9,7 @@ pub mod camera;
 pub mod cascades;
 pub mod edges;
 pub mod iasm;
+pub mod leak;
 pub mod light;
 pub mod lightspace;
 pub mod loaders;
