@@ -284,3 +284,25 @@ fn warp_struct_layouts_match_rust() {
         ],
     );
 }
+
+#[test]
+fn lt_params_layout_matches_wgsl() {
+    use shadowlab_gpu::techniques::lt::{LtParams, TraceParams};
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap_or_else(|| panic!("{n} not composed")).1);
+    check(
+        &get("lt/classify.wgsl"),
+        "LtParams",
+        size_of::<LtParams>(),
+        &[
+            ("texel", offset_of!(LtParams, texel)),
+            ("mode", offset_of!(LtParams, mode)),
+            ("shape", offset_of!(LtParams, shape)),
+            ("bias", offset_of!(LtParams, bias)),
+            ("history", offset_of!(LtParams, history)),
+        ],
+    );
+    for n in ["lt/trace.wgsl", "lt/args.wgsl"] {
+        check(&get(n), "TraceParams", size_of::<TraceParams>(), &[("cfg", offset_of!(TraceParams, cfg))]);
+    }
+}

@@ -4,6 +4,7 @@
 pub mod csm;
 pub mod filtered;
 pub mod iasm;
+pub mod lt;
 pub mod mdsm;
 pub mod min_sm;
 pub mod sm;
@@ -152,6 +153,9 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &filtered::MSM_INFO,
     &csm::INFO,
     &iasm::INFO,
+    &lt::LT_INFO,
+    &lt::LTT_INFO,
+    &lt::HYBRID_INFO,
 ];
 
 /// Every technique's composed WGSL, for the naga validation test.
@@ -165,6 +169,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(filtered::shaders());
     v.extend(min_sm::shaders());
     v.extend(warp::shaders());
+    v.extend(lt::shaders());
     v
 }
 

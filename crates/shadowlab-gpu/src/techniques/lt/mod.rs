@@ -1,0 +1,248 @@
+//! Leak tracing (seed 004, Kern, Brüll, Grosch): a filterable shadow map says where it is sure
+//! (bound 0 or 1), rays answer the rest. Three registry entries, one implementation:
+//! - `lt`: the single-depth filterable map (default EVSM; depth only, 2x2 gather, moments
+//!   rebuilt in the shader, section 3.2), the leak-tracing test LTT (eq. 3), and the 3-bit
+//!   temporal mask (section 3.1: expand rays eq. 6, optional remove rays eq. 8, reprojected
+//!   with the G-buffer's motion vectors, a failed reprojection forces a ray);
+//! - `ltt`: LTT alone, no temporal mask;
+//! - `hybrid-pcf`: a ray where a 2x2 PCF of the plain (biased) depth map is not unanimous
+//!   (AMD FidelityFX hybrid shadows, the paper's HySM comparator), no temporal mask.
+//!
+//! Passes: `<name>.render` draws the static triangles (`0..dynamic_first`) into the static map
+//! (once, reused across frames with `reuse`, section 3.3-3.4; the map is fitted to the scene
+//! bounds, so it stays valid for any camera while the light does not move) and the dynamic
+//! triangles into the dynamic map every frame (skipped while there are none); `<name>.classify`
+//! evaluates every pixel and appends the ones needing a ray to a list (atomic append);
+//! `<name>.trace` sizes an indirect dispatch from the list's count and traces one ray per
+//! listed pixel with `rt`'s BVH traversal (`reference::TRACE_WGSL`).
+//! Stored depth: linear light-space depth in [0, 1], 0 = near the light (filtered/'s `sd`
+//! maps, rendered with its render.wgsl). CPU half: `shadowlab_core::leak`.
+//! Not done: cascades (section 3.3's cascade reuse); directional lights use one map fitted to
+//! the scene bounds.
+
+mod pass;
+mod report;
+
+use bytemuck::{Pod, Zeroable};
+use shadowlab_core::leak;
+use shadowlab_core::moments as cpu;
+use shadowlab_core::params::{ParamDef, BOOL};
+
+use crate::reference::TRACE_WGSL;
+use crate::techniques::filtered::MOMENTS_WGSL;
+use crate::techniques::{compose_view, TechniqueInfo};
+pub use pass::LeakTracing;
+
+const CLASSIFY_WGSL: &str = include_str!("classify.wgsl");
+const TRACE_BODY_WGSL: &str = include_str!("trace.wgsl");
+const ARGS_WGSL: &str = include_str!("args.wgsl");
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("lt/classify.wgsl", classify_source()), ("lt/trace.wgsl", trace_source()), ("lt/args.wgsl", ARGS_WGSL.to_string())]
+}
+fn classify_source() -> String {
+    compose_view(&format!("{MOMENTS_WGSL}{CLASSIFY_WGSL}"), false)
+}
+fn trace_source() -> String {
+    compose_view(&format!("{TRACE_WGSL}{TRACE_BODY_WGSL}"), true)
+}
+
+/// Which of the three techniques (`mode.x` in classify.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Lt = 0,
+    Ltt = 1,
+    HybridPcf = 2,
+}
+
+impl Mode {
+    pub fn name(self) -> &'static str {
+        ["lt", "ltt", "hybrid-pcf"][self as usize]
+    }
+}
+
+/// WGSL `LtParams` (classify.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LtParams {
+    pub light_view_proj: [[f32; 4]; 4],
+    pub texel: [f32; 4],
+    pub mode: [u32; 4],
+    pub shape: [f32; 4],
+    pub bias: [f32; 4],
+    pub history: [f32; 4],
+}
+
+/// WGSL `TraceParams` (trace.wgsl, args.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TraceParams {
+    pub cfg: [u32; 4],
+}
+
+pub const FLAG_RR: u32 = 1;
+pub const FLAG_FULL: u32 = 2;
+pub const FLAG_FORCE_ALL: u32 = 4;
+pub const FLAG_HISTORY_TEST: u32 = 8;
+pub const FLAG_DYNAMIC: u32 = 16;
+pub const FLAG_HAS_HISTORY: u32 = 32;
+
+/// Reprojection depth tolerance, relative to the view depth. Too low: sloped surfaces seen at
+/// grazing angles fail (the reprojected pixel centre lies elsewhere on the slope) and trace
+/// rays every frame; too high: disocclusions reuse the occluder's mask.
+pub const DEFAULT_DEPTH_TOL: f64 = 0.05;
+/// Reprojection normal test: minimum cosine between this and last frame's normal. Too high:
+/// curved surfaces fail; too low: creases reuse the other face's mask.
+pub const DEFAULT_NORMAL_COS: f64 = 0.9;
+/// `hybrid-pcf` bias: `sm`'s defaults (constant 0.5 texel, normal offset 0.5 texel, the
+/// shadowlab sweep). Too low: acne becomes rays (not wrong, but slow); too high: the unanimous
+/// 2x2 test misses thin lit gaps (wrong pixels).
+pub const DEFAULT_PCF_BIAS: f64 = 0.5;
+pub const DEFAULT_PCF_NORMAL_OFFSET: f64 = 0.5;
+
+const fn p(key: &'static str, default: f64, min: f64, max: f64, doc: &'static str, source: &'static str) -> ParamDef {
+    ParamDef { key, default, min, max, integer: false, doc, source, choices: &[] }
+}
+const fn flag(key: &'static str, default: bool, doc: &'static str, source: &'static str) -> ParamDef {
+    ParamDef { key, default: default as u32 as f64, min: 0.0, max: 1.0, integer: true, doc, source, choices: BOOL }
+}
+
+const RES: ParamDef = ParamDef {
+    key: "res",
+    default: 512.0,
+    min: 16.0,
+    max: 16384.0,
+    integer: true,
+    doc: "shadow map side (texels); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
+    source: "seeds' evaluation: 512 with 1024x1024 output (seed 004 used 2048 per cascade)",
+    choices: &[],
+};
+const BASE: ParamDef = ParamDef {
+    key: "base",
+    default: 2.0,
+    min: 0.0,
+    max: 3.0,
+    integer: true,
+    doc: "filterable representation rebuilt from the gathered depths: vsm, esm, evsm, msm",
+    source: "seed 004 section 4.1 (EVSM fastest, VSM close; ESM/MSM need more rays)",
+    choices: &["vsm", "esm", "evsm", "msm"],
+};
+const EPS: ParamDef = p(
+    "eps",
+    leak::DEFAULT_EPS as f64,
+    0.0,
+    0.5,
+    "LTT epsilon: a ray where eps < s < 1-eps; low: bound noise becomes rays, high: misses leaks (0.5: no LTT rays)",
+    "seed 004 eq. 3 (0.01)",
+);
+const RR: ParamDef = flag(
+    "rr",
+    true,
+    "remove rays (eq. 8) where all neighbours confirmed the shadow test; off: more rays, never fewer correct pixels",
+    "seed 004 section 3.1.2",
+);
+const REUSE: ParamDef = flag(
+    "reuse",
+    true,
+    "render the static map once and reuse it (the light is fixed); off: re-render it every frame",
+    "seed 004 sections 3.3-3.4",
+);
+const FULL: ParamDef = flag(
+    "full",
+    false,
+    "full 3x3 neighbourhood every frame instead of the jittered 2x2 that covers 3x3 over 4 frames",
+    "seed 004 section 3.1.1 (2x2 jitter as good, cheaper)",
+);
+const HISTORY_TEST: ParamDef = flag(
+    "history_test",
+    true,
+    "reprojection also fails (forcing a ray) where last frame's depth or normal differs (disocclusion); includes section 3.1.2's temporal depth test; off: only off-screen fails",
+    "seed 004 sections 3.1 and 3.1.2 (temporal depth test)",
+);
+const DEPTH_TOL: ParamDef = p(
+    "depth_tol",
+    DEFAULT_DEPTH_TOL,
+    0.0,
+    1.0,
+    "relative view-depth tolerance of the reprojection test; low: rays on grazing surfaces, high: disocclusions reuse stale bits",
+    "shadowlab choice (not in the paper)",
+);
+const NORMAL_COS: ParamDef = p(
+    "normal_cos",
+    DEFAULT_NORMAL_COS,
+    -1.0,
+    1.0,
+    "minimum cosine between current and last frame's normal in the reprojection test",
+    "shadowlab choice (not in the paper)",
+);
+const FORCE_ALL: ParamDef =
+    flag("force_all", false, "trace a ray for every evaluated pixel (equals rt; for tests)", "shadowlab test switch");
+const MIN_VARIANCE: ParamDef =
+    p("min_variance", cpu::DEFAULT_MIN_VARIANCE, 0.0, 1.0, "VSM/EVSM minimum variance (depth units^2)", "seed 004 section 4 (1e-10)");
+const ESM_C: ParamDef = p("c", cpu::DEFAULT_ESM_C, 0.0, 88.0, "ESM exponent", "seed 004 section 4 (80)");
+const C_POS: ParamDef = p("c_pos", cpu::DEFAULT_EVSM_C_POS, 0.0, 42.0, "EVSM positive exponent (depth in [-1,1])", "seed 004 section 4 (20)");
+const C_NEG: ParamDef = p("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
+const MOMENT_BIAS: ParamDef = p("moment_bias", cpu::DEFAULT_MOMENT_BIAS, 0.0, 1.0, "MSM moment bias", "seed 004 section 4 (3e-6)");
+const PCF_BIAS: ParamDef = p(
+    "bias",
+    DEFAULT_PCF_BIAS,
+    0.0,
+    100.0,
+    "constant depth bias (texels); low: acne turns into rays, high: lit gaps missed",
+    "sm's default (shadowlab sweep); seed 004 section 4.2: HySM needs a tuned bias",
+);
+const PCF_NORMAL_OFFSET: ParamDef =
+    p("normal_offset", DEFAULT_PCF_NORMAL_OFFSET, 0.0, 100.0, "normal offset (texels)", "sm's default (shadowlab sweep)");
+
+pub const LT_PARAMS: &[ParamDef] = &[
+    RES,
+    BASE,
+    EPS,
+    RR,
+    REUSE,
+    FULL,
+    HISTORY_TEST,
+    DEPTH_TOL,
+    NORMAL_COS,
+    FORCE_ALL,
+    MIN_VARIANCE,
+    ESM_C,
+    C_POS,
+    C_NEG,
+    MOMENT_BIAS,
+];
+pub const LTT_PARAMS: &[ParamDef] = &[RES, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
+pub const HYBRID_PARAMS: &[ParamDef] = &[RES, REUSE, FORCE_ALL, PCF_BIAS, PCF_NORMAL_OFFSET];
+
+const LIGHTS: &[&str] = &["directional", "spot"];
+
+pub const LT_INFO: TechniqueInfo = TechniqueInfo {
+    name: "lt",
+    summary: "leak tracing: single-depth EVSM + LTT + 3-bit temporal mask (expand/remove rays), rays only where unsure",
+    cost: "static map once + 1 gather and 4 (9) mask reads per pixel + one BVH ray per listed pixel (indirect dispatch)",
+    quality: "converges to rt within a few frames; thin lit gaps missing from the map can stay closed",
+    source: "Kern, Brüll, Grosch 2024 (seed 004) sections 3-3.4",
+    lights: LIGHTS,
+    params: LT_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Lt)?)),
+};
+pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
+    name: "ltt",
+    summary: "leak-tracing test alone: a ray where the single-depth filterable bound is strictly between eps and 1-eps",
+    cost: "static map once + 1 gather per pixel + one ray per listed pixel",
+    quality: "misses LTT's failure cases (grazing receivers, edges near gaps: seed 004 figure 4)",
+    source: "seed 004 eq. 3 ('LTT only' of table 3)",
+    lights: LIGHTS,
+    params: LTT_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Ltt)?)),
+};
+pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
+    name: "hybrid-pcf",
+    summary: "hybrid shadows: a ray where the 2x2 PCF of a biased plain depth map is not unanimous",
+    cost: "static map once + 1 gather per pixel + one ray per listed pixel",
+    quality: "needs a tuned bias; misses edges the biased map does not see",
+    source: "AMD FidelityFX Hybrid Shadows 2021 (seed 004's HySM)",
+    lights: LIGHTS,
+    params: HYBRID_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::HybridPcf)?)),
+};
