@@ -135,38 +135,72 @@ fn reprojection_off_screen_forces_a_ray() {
     assert!(rays < off + on / 2, "{rays} rays for {off} off-screen and {on} reprojected pixels");
 }
 
-/// Seed 004 section 3.1.1: on a static scene, the temporal mask fixes LTT's failures within a
-/// few frames; from frame 8 on `lt` must agree with `rt` up to a small margin, with fewer rays.
+/// Runs `spec` and `rt` along `cams` (256x256), returning per frame (wrong %, rays, rt rays).
+fn along(lab: &Lab, scene: &Scene, spec: &str, cams: &[Camera]) -> Vec<(f64, f64, f64)> {
+    let info = techniques::find(&TechniqueSpec::parse(spec).unwrap().name).unwrap();
+    let params = TechniqueSpec::parse(spec).unwrap().resolve(info.params).unwrap();
+    let light = scene.lights[0];
+    let mut inst = lab.instantiate(info, params, spec.into(), &light).unwrap();
+    let mut rt_inst = lab.instantiate(&shadowlab_gpu::reference::INFO, Default::default(), "rt".into(), &light).unwrap();
+    let mut out = Vec::new();
+    for (f, cam) in cams.iter().enumerate() {
+        let prev = if f == 0 { cam } else { &cams[f - 1] };
+        let v = lab.view(cam, prev, &light, 256, 256).unwrap();
+        let rt = lab.step(&v, &mut rt_inst, false, 1).unwrap();
+        let r = lab.step(&v, &mut inst, false, 1).unwrap();
+        let c = compare(&r.visibility, &rt.visibility, &v.mask);
+        let (rays, rt_rays) = (r.report.counters["rays_traced"], rt.report.counters["rays_traced"]);
+        eprintln!("{} {spec} frame {f}: wrong {:.4} % rays {rays} (rt {rt_rays})", scene.name, c.wrong_pct);
+        if f >= 8 && c.wrong_pct > LT_MARGIN_PCT {
+            save_images(&format!("{spec}-{}-{f}", scene.name), &v, &r, &rt);
+        }
+        out.push((c.wrong_pct, rays, rt_rays));
+    }
+    out
+}
+
+/// Seed 004 section 3.1.1: with the camera still, the temporal mask expands rays from LTT's
+/// corrections until they cover the failures (4-8 frames in the paper). On courtyard (no
+/// sub-texel casters) `lt` must agree with `rt` from frame 8 on up to a small margin, below
+/// `ltt` alone, with far fewer rays than `rt`.
 #[test]
-fn lt_converges_to_rt_on_a_static_path() {
+fn lt_converges_to_rt_with_a_still_camera() {
     let Some(gpu) = gpu() else { return };
-    for (name, margin_pct) in [("courtyard", LT_MARGIN_PCT), ("foliage", LT_MARGIN_PCT)] {
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let cams = vec![scene.camera; 10];
+    let lt = along(&lab, &scene, "lt", &cams);
+    let ltt = along(&lab, &scene, "ltt", &cams[..1]);
+    assert!(ltt[0].0 > 0.0, "ltt alone has failures here to fix");
+    for (f, (wrong, rays, rt_rays)) in lt.iter().enumerate().skip(8) {
+        assert!(*wrong <= LT_STILL_MARGIN_PCT, "frame {f}: lt wrong {wrong:.4} % (ltt {:.4} %)", ltt[0].0);
+        assert!(*rays < 0.2 * rt_rays, "frame {f}: {rays} rays");
+    }
+}
+/// Still camera: courtyard converges to 0 wrong pixels in practice; margin for lavapipe-vs-GPU
+/// float differences on a handful of edge pixels (256x256: 0.01 % = 6 pixels).
+const LT_STILL_MARGIN_PCT: f64 = 0.01;
+
+/// Along the scenes' camera paths (12 frames, static geometry): from frame 8 on `lt` stays
+/// within the margin of `rt` on every frame with at most half of its rays.
+#[test]
+fn lt_tracks_rt_along_camera_paths() {
+    let Some(gpu) = gpu() else { return };
+    for (name, margin) in [("courtyard", LT_MARGIN_PCT), ("foliage", LT_FOLIAGE_MARGIN_PCT)] {
         let scene = builtin(name).unwrap();
         let lab = Lab::new(&gpu, &scene).unwrap();
         let cams = path(&scene, 12);
-        let info = techniques::find("lt").unwrap();
-        let params = TechniqueSpec::parse("lt").unwrap().resolve(info.params).unwrap();
-        let mut inst = lab.instantiate(info, params, "lt".into(), &scene.lights[0]).unwrap();
-        let mut rt_inst = lab.instantiate(&shadowlab_gpu::reference::INFO, Default::default(), "rt".into(), &scene.lights[0]).unwrap();
-        for (f, cam) in cams.iter().enumerate() {
-            let prev = if f == 0 { cam } else { &cams[f - 1] };
-            let v = lab.view(cam, prev, &scene.lights[0], 256, 256).unwrap();
-            let rt = lab.step(&v, &mut rt_inst, false, 1).unwrap();
-            let r = lab.step(&v, &mut inst, false, 1).unwrap();
-            let c = compare(&r.visibility, &rt.visibility, &v.mask);
-            let rays = r.report.counters["rays_traced"];
-            eprintln!("{name} frame {f}: wrong {:.4} % rays {rays} (rt {})", c.wrong_pct, rt.report.counters["rays_traced"]);
-            if f >= 8 {
-                if c.wrong_pct > margin_pct {
-                    panic!("{name} frame {f}: lt wrong {:.4} %; {}", c.wrong_pct, save_images(&format!("lt-{name}-{f}"), &v, &r, &rt));
-                }
-                assert!(rays < 0.5 * rt.report.counters["rays_traced"], "{name} frame {f}: {rays} rays");
-            }
+        for (f, (wrong, rays, rt_rays)) in along(&lab, &scene, "lt", &cams).iter().enumerate().skip(8) {
+            assert!(*wrong <= margin, "{name} frame {f}: lt wrong {wrong:.4} % (images in target/test-output)");
+            assert!(*rays < 0.5 * rt_rays, "{name} frame {f}: {rays} rays");
         }
     }
 }
-/// Margin of the convergence test (256x256 views).
-const LT_MARGIN_PCT: f64 = 0.1;
+/// Margin of the path test on courtyard (measured 0.003-0.012 %, 256x256).
+const LT_MARGIN_PCT: f64 = 0.05;
+/// foliage: wires and leaves thinner than a texel of the 512 map are missing from it, so no
+/// LTT correction leads rays to them (seed 004 section 4.3, figure 10); measured 0.16-0.19 %.
+const LT_FOLIAGE_MARGIN_PCT: f64 = 0.25;
 
 /// The report: memory of map + 8-bit ping-pong mask + history, Table 1 mask picture, counters.
 #[test]

@@ -135,11 +135,16 @@ const EPS: ParamDef = p(
     "LTT epsilon: a ray where eps < s < 1-eps; low: bound noise becomes rays, high: misses leaks (0.5: no LTT rays)",
     "seed 004 eq. 3 (0.01)",
 );
+/// Remove rays off by default: measured on camera paths (courtyard and foliage, 256x256, 12
+/// frames, docs/bench/lt.md) RR removed 10-20 % of the rays but raised the wrong pixels after
+/// frame 8 from 0.003 % to 0.11 % (courtyard) and 0.18 % to 0.30 % (foliage), at no measurable
+/// time gain. The paper uses it (1.05x speed-up, seed 004 table 3).
+pub const DEFAULT_RR: bool = false;
 const RR: ParamDef = flag(
     "rr",
-    true,
-    "remove rays (eq. 8) where all neighbours confirmed the shadow test; off: more rays, never fewer correct pixels",
-    "seed 004 section 3.1.2",
+    DEFAULT_RR,
+    "remove rays (eq. 8) where all reprojected neighbours confirmed the shadow test (removed rays snap to the test); on: fewer rays, edges that move under the camera can be lost",
+    "seed 004 section 3.1.2 (on); default off: shadowlab measurement (docs/bench/lt.md)",
 );
 const REUSE: ParamDef = flag(
     "reuse",
