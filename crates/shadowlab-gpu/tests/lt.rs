@@ -10,7 +10,7 @@ use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::techniques::lt::{LeakTracing, Mode};
-use shadowlab_gpu::techniques::{self, run_frame};
+use shadowlab_gpu::techniques::{self, run_frame, Technique};
 use shadowlab_gpu::timing::StageTimer;
 
 mod common;
@@ -217,4 +217,33 @@ fn lt_report_has_mask_memory_and_pictures() {
     assert_eq!(c["static_map_renders"], 1.0, "warm-up and timed run share one static map");
     assert_eq!(r.report.images.len(), 3);
     assert!(r.report.images.iter().all(|i| i.rgba.len() as u32 == i.width * i.height * 4));
+}
+
+/// Section 3.4: with the triangles split into a static and a dynamic range, the two maps
+/// min-combined per gathered texel are the map of the whole scene, so `ltt` gives the same
+/// pixels and the same rays; the static map is drawn once, the dynamic one every frame.
+#[test]
+fn static_and_dynamic_maps_combine_to_the_whole_scene() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("foliage").unwrap();
+    let mut lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let mut whole = make(&lab, "ltt", &v.light);
+    let want = frame(&lab, &mut whole, &v);
+    let want_rays: BTreeSet<u32> = whole.ray_list(&gpu).into_iter().collect();
+    assert_eq!(lab.gscene.dynamic_first, lab.gscene.triangle_count, "built-in scenes are static today");
+    lab.gscene.dynamic_first = lab.gscene.triangle_count / 2;
+    let mut split = make(&lab, "ltt", &v.light);
+    for _ in 0..3 {
+        let got = frame(&lab, &mut split, &v);
+        let rays: BTreeSet<u32> = split.ray_list(&gpu).into_iter().collect();
+        assert_eq!(rays, want_rays);
+        let diff = (0..want.len()).filter(|&i| v.mask[i] != 0 && got[i] != want[i]).count();
+        assert_eq!(diff, 0, "pixels differ with split maps");
+    }
+    let r = split.report(&gpu);
+    assert_eq!(r.counters["maps"], 2.0);
+    assert_eq!(r.counters["static_map_renders"], 1.0);
+    assert_eq!(r.counters["dynamic_map_renders"], 3.0);
+    assert_eq!(r.shadow_data_bytes, 2 * 512 * 512 * 4);
 }

@@ -42,6 +42,7 @@ pub struct LeakTracing {
     pub(super) dynamic_map: Option<wgpu::Texture>,
     depth: wgpu::Texture,
     pub(super) static_renders: u32,
+    pub(super) dynamic_renders: u32,
     static_valid: bool,
     _map_uniform: wgpu::Buffer,
     render_pipeline: wgpu::RenderPipeline,
@@ -142,6 +143,7 @@ impl LeakTracing {
             dynamic_map,
             depth,
             static_renders: 0,
+            dynamic_renders: 0,
             static_valid: false,
             _map_uniform: map_uniform,
             render_pipeline,
@@ -240,6 +242,7 @@ impl Technique for LeakTracing {
         if !redraw_static && dynamic.is_none() {
             return Ok(());
         }
+        let draw_dynamic = dynamic.is_some();
         timer.stage(gpu, &label, |enc| {
             if redraw_static {
                 self.draw(enc, &label, f, &self.static_map, 0..f.scene.dynamic_first);
@@ -248,6 +251,7 @@ impl Technique for LeakTracing {
                 self.draw(enc, &label, f, map, range);
             }
         });
+        self.dynamic_renders += draw_dynamic as u32;
         if redraw_static {
             self.static_renders += 1;
             self.static_valid = true;

@@ -29,6 +29,7 @@ pub(super) fn report(t: &LeakTracing, gpu: &Gpu) -> TechniqueReport {
     c.insert("shadow_map_texels".into(), texels as f64);
     c.insert("maps".into(), maps as f64);
     c.insert("static_map_renders".into(), t.static_renders as f64);
+    c.insert("dynamic_map_renders".into(), t.dynamic_renders as f64);
     c.insert("fetches_per_pixel".into(), 4.0 * maps as f64);
     if temporal {
         let full = t.params.mode[3] & super::FLAG_FULL != 0;
