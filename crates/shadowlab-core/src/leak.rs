@@ -2,7 +2,13 @@
 //! (LTT, eq. 3), the 3-bit temporal mask (section 3.1: shadow test ST, LTT, ray result RS), its
 //! Table 1 classes, expand rays (ER, eq. 6), remove rays (RR, eq. 8), the per-pixel decision of
 //! section 3.1.3, the 2x2 jittered neighbourhood that covers 3x3 over 4 frames, and the mask
-//! format chosen by the light count. `techniques/lt/classify.wgsl` mirrors these functions.
+//! format chosen by the light count, and the cascade reuse of section 3.3.
+//! `techniques/lt/classify.wgsl` mirrors the per-pixel functions.
+
+use glam::Vec4Swizzles;
+
+use crate::cascades::CascadeBox;
+use crate::scene::Bounds;
 
 /// LTT epsilon: a ray where `eps < s < 1 - eps` (seed 004 eq. 3 and section 4: 0.01). Too low:
 /// numerical noise of the bounds flags whole lit/shadowed regions; too high: misses leaks whose
@@ -150,6 +156,36 @@ pub fn mask_bytes_per_light(lights: usize, pixels: u64) -> Result<f64, String> {
     Ok((2 * pixels * bits / 8) as f64 / lights as f64)
 }
 
+/// Cascade reuse: each box is enlarged by 15 % when it is rendered (seed 004 section 3.3).
+/// Too low: every small camera move re-renders the cascade; too high: coarser texels (wider
+/// uncertain bands, more rays).
+pub const DEFAULT_ENLARGE: f32 = 0.15;
+
+/// The box a cascade is rendered with for reuse (section 3.3): this frame's fitted box `fit`
+/// with its side enlarged by `1 + enlarge` and its depth range extended to the whole scene
+/// (so any later slice it still covers sideways also fits in depth).
+pub fn reuse_box(fit: &CascadeBox, scene: &Bounds, enlarge: f32, res: u32) -> CascadeBox {
+    let zlo = scene.corners().iter().map(|p| (fit.light_view * p.extend(1.0)).z).fold(f32::INFINITY, f32::min);
+    let margin = scene.diagonal().max(1e-6) * 1e-3;
+    let far_z = fit.far_z.min(zlo - margin);
+    CascadeBox { far_z, ..*fit }.enlarged(1.0 + enlarge, res)
+}
+
+/// Whether the kept (enlarged) box still serves this frame's fitted box: the same light view,
+/// and the fitted square inside the kept one in light x/y (section 3.3: "all edges of the
+/// current cascade frustum within the enlarged one of the last frame").
+pub fn reusable(kept: &CascadeBox, fit: &CascadeBox) -> bool {
+    let d = (fit.origin - kept.origin).abs();
+    kept.light_view == fit.light_view && d.x + fit.half <= kept.half && d.y + fit.half <= kept.half
+}
+
+/// Whether world point `p` lies in `b`'s x/y square (any depth).
+pub fn covers(b: &CascadeBox, p: glam::Vec3) -> bool {
+    let q = (b.light_view * p.extend(1.0)).xy();
+    let d = (q - b.origin).abs();
+    d.x <= b.half && d.y <= b.half
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -265,5 +301,45 @@ mod tests {
         // one light: two R8Uint textures, 2 bytes per pixel
         assert_eq!(mask_bytes_per_light(1, 100), Ok(200.0));
         assert_eq!(mask_bytes_per_light(10, 100), Ok(80.0));
+    }
+}
+
+#[cfg(test)]
+mod cascade_tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::cascades::{fit_cascade, Fit, ViewFrustum};
+    use glam::Vec3;
+
+    fn fit_at(x: f32, yaw: f32) -> (CascadeBox, [Vec3; 8]) {
+        let cam = Camera::new(Vec3::new(x, 2.0, 0.0), Vec3::new(x + 10.0 * yaw.cos(), 2.0, 10.0 * yaw.sin()), 60.0, 0.1, 100.0);
+        let f = ViewFrustum::from_view_proj(cam.view_proj(16, 9), cam.position).unwrap();
+        let scene = Bounds { min: Vec3::new(-50.0, 0.0, -50.0), max: Vec3::new(50.0, 10.0, 50.0) };
+        let dir = Vec3::new(0.3, -1.0, 0.2);
+        (fit_cascade(&f, dir, &scene, 1.0, 8.0, 512, true, Fit::Sphere), f.slice_corners(1.0, 8.0))
+    }
+
+    #[test]
+    fn enlarged_boxes_are_reused_for_small_moves_only() {
+        let scene = Bounds { min: Vec3::new(-50.0, 0.0, -50.0), max: Vec3::new(50.0, 10.0, 50.0) };
+        let (fit0, corners0) = fit_at(0.0, 0.0);
+        let kept = reuse_box(&fit0, &scene, DEFAULT_ENLARGE, 512);
+        assert!((kept.half - fit0.half * 1.15).abs() < 1e-5 * kept.half);
+        assert!((kept.texel - 2.0 * kept.half / 512.0).abs() < 1e-9);
+        assert!(reusable(&kept, &fit0));
+        assert!(corners0.iter().all(|c| covers(&kept, *c)));
+        // every point of the scene is inside the kept box's depth range
+        for c in scene.corners() {
+            let z = (kept.view_proj * c.extend(1.0)).z;
+            assert!(z >= 0.0 && z <= 1.0 || !covers(&kept, c), "scene corner depth {z}");
+        }
+        // a small step keeps it, and the slice stays covered; a large one does not
+        let (fit1, corners1) = fit_at(0.3, 0.0);
+        assert!(reusable(&kept, &fit1));
+        assert!(corners1.iter().all(|c| covers(&kept, *c)));
+        let (fit2, _) = fit_at(3.0, 0.0);
+        assert!(!reusable(&kept, &fit2));
+        let (fit3, _) = fit_at(0.0, 1.0);
+        assert!(!reusable(&kept, &fit3), "a large turn moves the slice out");
     }
 }

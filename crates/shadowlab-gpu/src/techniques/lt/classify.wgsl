@@ -1,4 +1,6 @@
-// Leak tracing, per pixel (seed 004 sections 3-3.4): the single-depth filterable map
+// Leak tracing, per pixel (seed 004 sections 3-3.4): the map level (cascade) holding the
+// pixel's view depth (beyond the last hybrid level: a ray, section 3.3), its single-depth
+// filterable map
 // (`*_visibility_gather` of filtered/moments.wgsl: 2x2 gathered depths, moments rebuilt here)
 // of the static map, min-combined with the dynamic map; then, by technique,
 //   lt:         LTT (eq. 3), reprojection into last frame's temporal mask, ER (eq. 6) and RR
@@ -10,10 +12,17 @@
 // follows in trace.wgsl) and this pixel's depth/normal for next frame's reprojection test.
 // Mirrors shadowlab_core::leak.
 
-struct LtParams {
-    light_view_proj: mat4x4<f32>,
+// One map level: a cascade (orthographic) or the whole map (spot: perspective).
+struct Level {
+    view_proj: mat4x4<f32>,
     // x: world texel size (orthographic) or per unit of light depth (perspective),
-    // y: 1 if perspective, z: resolution, w: 1 / far (perspective linear depth)
+    // y, z: the view depths it serves (z: 1e30 for the only level), w: unused
+    info: vec4<f32>,
+}
+
+struct LtParams {
+    levels: array<Level, 3>,
+    // x: hybrid levels (map layers), y: 1 if perspective, z: resolution, w: 1 / far
     texel: vec4<f32>,
     // x: technique (0 lt, 1 ltt, 2 hybrid-pcf), y: base (0 vsm, 1 esm, 2 evsm, 3 msm),
     // z: frame index, w: flags (FLAG_*)
@@ -39,8 +48,8 @@ const BIT_LTT: u32 = 2u;
 const BIT_RS: u32 = 4u;
 
 @group(0) @binding(6) var<uniform> lp: LtParams;
-@group(0) @binding(7) var static_map: texture_2d<f32>;
-@group(0) @binding(8) var dynamic_map: texture_2d<f32>;
+@group(0) @binding(7) var static_map: texture_2d_array<f32>;
+@group(0) @binding(8) var dynamic_map: texture_2d_array<f32>;
 @group(0) @binding(9) var gather_sampler: sampler;
 @group(0) @binding(10) var g_motion: texture_2d<f32>;
 @group(0) @binding(11) var<storage, read> prev_mask: array<u32>;
@@ -49,8 +58,8 @@ const BIT_RS: u32 = 4u;
 @group(0) @binding(14) var<storage, read_write> cur_history: array<vec2<f32>>;
 @group(0) @binding(15) var<storage, read_write> list: array<atomic<u32>>;
 
-fn to_map(p: vec3<f32>) -> vec3<f32> {
-    let c = lp.light_view_proj * vec4<f32>(p, 1.0);
+fn to_map(level: u32, p: vec3<f32>) -> vec3<f32> {
+    let c = lp.levels[level].view_proj * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
     let depth = select(c.z, c.w * lp.texel.w, lp.texel.y > 0.5);
     return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, depth);
@@ -168,23 +177,31 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     cur_history[s.i] = vec2<f32>(textureLoad(g_position, id.xy, 0).w, pack_normal(s.n));
 
-    var texel = lp.texel.x;
+    // the level serving this view depth; beyond the hybrid levels every pixel traces a ray
+    let depth = textureLoad(g_position, id.xy, 0).w;
+    let levels = u32(lp.texel.x);
+    var c = 0u;
+    while c < levels && depth > lp.levels[c].info.z {
+        c++;
+    }
+    let level = min(c, levels - 1u);
+    var texel = lp.levels[level].info.x;
     if lp.texel.y > 0.5 {
-        texel = lp.texel.x * max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
+        texel *= max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
     }
     let l = to_light(light, s.p);
-    let m = to_map(s.p + s.n * (lp.bias.z * texel) + l * (lp.bias.y * texel));
+    let m = to_map(level, s.p + s.n * (lp.bias.z * texel) + l * (lp.bias.y * texel));
     var v = 1.0;
     var ray = true;
     var st = false;
     var may_remove = true;
-    // samples outside the map (should not happen: it is fitted to the scene) trace a ray
-    if all(m.xy >= vec2<f32>(0.0)) && all(m.xy <= vec2<f32>(1.0)) && m.z <= 1.0 {
+    // samples outside the map (should not happen: it covers the slice) trace a ray
+    if c < levels && all(m.xy >= vec2<f32>(0.0)) && all(m.xy <= vec2<f32>(1.0)) && m.z <= 1.0 {
         let d = max(m.z, 0.0);
-        var z = textureGather(0, static_map, gather_sampler, m.xy);
+        var z = textureGather(0, static_map, gather_sampler, m.xy, level);
         if (lp.mode.w & FLAG_DYNAMIC) != 0u {
             // section 3.4: minimum of both maps per gathered texel, no RR where dynamic won
-            let zd = textureGather(0, dynamic_map, gather_sampler, m.xy);
+            let zd = textureGather(0, dynamic_map, gather_sampler, m.xy, level);
             may_remove = !any(zd < z);
             z = min(z, zd);
         }

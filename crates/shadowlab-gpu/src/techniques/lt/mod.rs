@@ -17,9 +17,12 @@
 //! listed pixel with `rt`'s BVH traversal (`reference::TRACE_WGSL`).
 //! Stored depth: linear light-space depth in [0, 1], 0 = near the light (filtered/'s `sd`
 //! maps, rendered with its render.wgsl). CPU half: `shadowlab_core::leak`.
-//! Not done: cascades (section 3.3's cascade reuse); directional lights use one map fitted to
-//! the scene bounds.
+//! Directional lights (`cascades` > 1, default 4): the view frustum split with the practical
+//! scheme, cascades 0..n-2 hybrid with maps fitted to their slices, enlarged by 15 % and
+//! re-rendered only when this frame's slice leaves the kept box (section 3.3); the last
+//! cascade is ray traced. `cascades=1`: one map fitted to the scene bounds. Spot: one map.
 
+mod cascade;
 mod pass;
 mod report;
 
@@ -61,11 +64,23 @@ impl Mode {
     }
 }
 
+/// Hybrid map levels at most (cascades 0-2; a 4th cascade is ray traced, seed 004 section 4).
+pub const MAX_LEVELS: usize = 3;
+
+/// WGSL `Level` (classify.wgsl): one cascade or the whole map.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LevelU {
+    pub view_proj: [[f32; 4]; 4],
+    /// x: world texel (per unit of light depth for spot), y/z: view depths served.
+    pub info: [f32; 4],
+}
+
 /// WGSL `LtParams` (classify.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct LtParams {
-    pub light_view_proj: [[f32; 4]; 4],
+    pub levels: [LevelU; MAX_LEVELS],
     pub texel: [f32; 4],
     pub mode: [u32; 4],
     pub shape: [f32; 4],
@@ -113,7 +128,7 @@ const RES: ParamDef = ParamDef {
     min: 16.0,
     max: 16384.0,
     integer: true,
-    doc: "shadow map side (texels); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
+    doc: "shadow map side (texels, per cascade); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
     source: "seeds' evaluation: 512 with 1024x1024 output (seed 004 used 2048 per cascade)",
     choices: &[],
 };
@@ -149,7 +164,7 @@ const RR: ParamDef = flag(
 const REUSE: ParamDef = flag(
     "reuse",
     true,
-    "render the static map once and reuse it (the light is fixed); off: re-render it every frame",
+    "reuse the static maps: a cascade's enlarged map until its slice leaves it, the whole-scene/spot map forever (fixed light); off: every map refitted and re-rendered each frame",
     "seed 004 sections 3.3-3.4",
 );
 const FULL: ParamDef = flag(
@@ -180,6 +195,32 @@ const NORMAL_COS: ParamDef = p(
     "minimum cosine between current and last frame's normal in the reprojection test",
     "shadowlab choice (not in the paper)",
 );
+const CASCADES: ParamDef = ParamDef {
+    key: "cascades",
+    default: 4.0,
+    min: 1.0,
+    max: (MAX_LEVELS + 1) as f64,
+    integer: true,
+    doc: "directional lights: cascades, the last one ray traced (1 = one map over the whole scene, no ray-traced level)",
+    source: "seed 004 section 4 (4 cascades, levels 0-2 hybrid, the last ray traced)",
+    choices: &[],
+};
+const LAMBDA: ParamDef = p(
+    "lambda",
+    shadowlab_core::cascades::DEFAULT_LAMBDA as f64,
+    0.0,
+    1.0,
+    "practical split blend (1 = logarithmic); low: coarse near cascade, high: far cascades coarse and the ray-traced one large",
+    "seed 004's code (0.85 log + 0.15 uniform)",
+);
+const ENLARGE: ParamDef = p(
+    "enlarge",
+    leak::DEFAULT_ENLARGE as f64,
+    0.0,
+    1.0,
+    "cascade box enlargement for reuse; low: re-rendered on small moves, high: coarser texels",
+    "seed 004 section 3.3 (15 %)",
+);
 const FORCE_ALL: ParamDef =
     flag("force_all", false, "trace a ray for every evaluated pixel (equals rt; for tests)", "shadowlab test switch");
 const MIN_VARIANCE: ParamDef =
@@ -201,6 +242,9 @@ const PCF_NORMAL_OFFSET: ParamDef =
 
 pub const LT_PARAMS: &[ParamDef] = &[
     RES,
+    CASCADES,
+    LAMBDA,
+    ENLARGE,
     BASE,
     EPS,
     RR,
@@ -216,8 +260,8 @@ pub const LT_PARAMS: &[ParamDef] = &[
     C_NEG,
     MOMENT_BIAS,
 ];
-pub const LTT_PARAMS: &[ParamDef] = &[RES, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
-pub const HYBRID_PARAMS: &[ParamDef] = &[RES, REUSE, FORCE_ALL, PCF_BIAS, PCF_NORMAL_OFFSET];
+pub const LTT_PARAMS: &[ParamDef] = &[RES, CASCADES, LAMBDA, ENLARGE, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
+pub const HYBRID_PARAMS: &[ParamDef] = &[RES, CASCADES, LAMBDA, ENLARGE, REUSE, FORCE_ALL, PCF_BIAS, PCF_NORMAL_OFFSET];
 
 const LIGHTS: &[&str] = &["directional", "spot"];
 

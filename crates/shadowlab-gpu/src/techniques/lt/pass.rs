@@ -1,12 +1,14 @@
 //! The passes of leak tracing: static/dynamic map raster, classification with ray-list
 //! compaction, indirect list tracing; the screen-sized state (temporal mask and history, ping-pong).
 
+use bytemuck::Zeroable;
 use shadowlab_core::leak;
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
 use shadowlab_core::params::ParamValues;
 
-use super::{classify_source, trace_source, LtParams, Mode, TraceParams, ARGS_WGSL};
+use super::cascade::{single_level, Cascades};
+use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, MAX_LEVELS};
 use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_RR};
 use crate::scene_gpu::GpuScene;
 use crate::techniques::filtered::{render_source, FilteredParams};
@@ -38,15 +40,20 @@ pub struct LeakTracing {
     reuse: bool,
     pub(super) params: LtParams,
     pub(super) mask_bits: u32,
+    /// One layer per hybrid level.
     pub(super) static_map: wgpu::Texture,
     pub(super) dynamic_map: Option<wgpu::Texture>,
     depth: wgpu::Texture,
+    pub(super) levels: usize,
+    pub(super) cascades: Option<Cascades>,
+    /// Layer renders of the static map, of the dynamic map.
     pub(super) static_renders: u32,
     pub(super) dynamic_renders: u32,
-    static_valid: bool,
-    _map_uniform: wgpu::Buffer,
+    static_dirty: Vec<bool>,
+    map_params: FilteredParams,
+    /// Per level: the raster's `FilteredParams` and its bind group.
+    map_uniforms: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
     render_pipeline: wgpu::RenderPipeline,
-    render_group: wgpu::BindGroup,
     classify_pipeline: wgpu::ComputePipeline,
     classify_layout: wgpu::BindGroupLayout,
     trace_pipeline: wgpu::ComputePipeline,
@@ -89,9 +96,22 @@ impl LeakTracing {
             get(p, "c_pos", 20.0) as f32,
             get(p, "c_neg", 5.0) as f32,
         ];
+        let cascades = match *light {
+            Light::Directional { direction } if p.get_u32("cascades") > 1 => Some(Cascades {
+                count: p.get_u32("cascades") as usize,
+                lambda: p.get("lambda") as f32,
+                enlarge: p.get("enlarge") as f32,
+                dir: direction,
+                kept: vec![None; p.get_u32("cascades") as usize - 1],
+            }),
+            _ => None,
+        };
+        let levels = cascades.as_ref().map_or(1, |c| c.levels());
+        let mut level_u = [LevelU::zeroed(); MAX_LEVELS];
+        level_u[0] = single_level(lp.view_proj, lp.texel);
         let params = LtParams {
-            light_view_proj: lp.view_proj.to_cols_array_2d(),
-            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, inv_far],
+            levels: level_u,
+            texel: [levels as f32, lp.perspective as u32 as f32, res as f32, inv_far],
             mode: [mode as u32, get(p, "base", 2.0) as u32, 0, flags],
             shape,
             bias: [get(p, "moment_bias", 3e-6) as f32, bias as f32, normal_offset as f32, get(p, "eps", 0.01) as f32],
@@ -99,28 +119,49 @@ impl LeakTracing {
         };
         // the raster of filtered/ in single-depth mode: linear depth into an R32Float target
         let map_params = FilteredParams {
-            light_view_proj: params.light_view_proj,
-            texel: params.texel,
+            light_view_proj: lp.view_proj.to_cols_array_2d(),
+            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, inv_far],
             mode: [0, 1, 1, 0],
             shape,
             bias: [0.0; 4],
         };
         let d = &gpu.device;
         use wgpu::TextureUsages as U;
-        let map = |label: &str| raster::render_target(gpu, label, res, res, wgpu::TextureFormat::R32Float, U::COPY_SRC);
+        let map = |label: &str| {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: levels as u32 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::R32Float,
+                usage: U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+                view_formats: &[],
+            })
+        };
         let static_map = map(&format!("{name}.static_map"));
         let dynamic_map = (scene.dynamic_first < scene.triangle_count).then(|| map(&format!("{name}.dynamic_map")));
         let depth = raster::render_target(gpu, &format!("{name}.raster_depth"), res, res, raster::DEPTH_FORMAT, U::empty());
-        let map_uniform = gpu.uniform(&format!("{name}.map_params"), &map_params);
         let render_layout = binding::layout(d, name, wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
-        let render_group = binding::group(d, name, &render_layout, &[map_uniform.as_entire_binding()]);
+        let map_uniforms = (0..levels)
+            .map(|_| {
+                let u = gpu.uniform(&format!("{name}.map_params"), &map_params);
+                let g = binding::group(d, name, &render_layout, &[u.as_entire_binding()]);
+                (u, g)
+            })
+            .collect();
         let target = wgpu::ColorTargetState { format: wgpu::TextureFormat::R32Float, blend: None, write_mask: wgpu::ColorWrites::ALL };
         let render_pipeline =
             raster::scene_pipeline(gpu, &format!("{name}.render"), &render_source(), &[&render_layout, &scene.layout], &[Some(target)]);
         let nf = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering);
         let (ro, rw, tex) = (binding::storage(true), binding::storage(false), binding::texture_float());
+        let arr = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        };
         let classify_layout =
-            view_layout(gpu, &format!("{name}.classify"), &[binding::uniform(), tex, tex, nf, tex, ro, rw, ro, rw, rw]);
+            view_layout(gpu, &format!("{name}.classify"), &[binding::uniform(), arr, arr, nf, tex, ro, rw, ro, rw, rw]);
         let classify_pipeline = gpu.compute_pipeline(&format!("{name}.classify"), &classify_source(), "main", &[&classify_layout]);
         let trace_layout = view_layout(gpu, &format!("{name}.trace"), &[binding::uniform(), ro, rw]);
         let trace_pipeline = gpu.compute_pipeline(&format!("{name}.trace"), &trace_source(), "main", &[&trace_layout, &scene.layout]);
@@ -142,12 +183,14 @@ impl LeakTracing {
             static_map,
             dynamic_map,
             depth,
+            levels,
+            cascades,
             static_renders: 0,
             dynamic_renders: 0,
-            static_valid: false,
-            _map_uniform: map_uniform,
+            static_dirty: vec![true; levels],
+            map_params,
+            map_uniforms,
             render_pipeline,
-            render_group,
             classify_pipeline,
             classify_layout,
             trace_pipeline,
@@ -160,8 +203,14 @@ impl LeakTracing {
         })
     }
 
-    fn draw(&self, enc: &mut wgpu::CommandEncoder, label: &str, f: &FrameInputs, target: &wgpu::Texture, tris: std::ops::Range<u32>) {
-        let view = target.create_view(&Default::default());
+    #[allow(clippy::too_many_arguments)]
+    fn draw(&self, enc: &mut wgpu::CommandEncoder, label: &str, f: &FrameInputs, target: &wgpu::Texture, layer: usize, tris: std::ops::Range<u32>) {
+        let view = target.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: layer as u32,
+            array_layer_count: Some(1),
+            ..Default::default()
+        });
         let depth_view = self.depth.create_view(&Default::default());
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
@@ -182,7 +231,7 @@ impl LeakTracing {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.render_pipeline);
-        pass.set_bind_group(0, &self.render_group, &[]);
+        pass.set_bind_group(0, &self.map_uniforms[layer].1, &[]);
         pass.set_bind_group(1, &f.scene.group, &[]);
         pass.draw(tris.start * 3..tris.end * 3, 0..1);
     }
@@ -231,31 +280,50 @@ impl LeakTracing {
 }
 
 impl Technique for LeakTracing {
+    /// Cascades: fit this frame's slices, keep or replace each level's box (section 3.3).
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+        let t0 = std::time::Instant::now();
+        if let Some(c) = self.cascades.as_mut() {
+            let dirty = c.update(f, self.res, self.reuse, &mut self.params)?;
+            for (l, d) in dirty.into_iter().enumerate() {
+                if d {
+                    self.map_params.light_view_proj = self.params.levels[l].view_proj;
+                    self.map_params.texel[0] = self.params.levels[l].info[0];
+                    gpu.queue.write_buffer(&self.map_uniforms[l].0, 0, bytemuck::bytes_of(&self.map_params));
+                    self.static_dirty[l] = true;
+                }
+            }
+            timer.add(&format!("{}.fit", self.mode.name()), t0.elapsed().as_secs_f64() * 1e3);
+        } else if !self.reuse {
+            self.static_dirty.iter_mut().for_each(|d| *d = true);
+        }
+        Ok(())
+    }
+
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
         let name = self.mode.name();
         let label = format!("{name}.render");
-        let redraw_static = !self.reuse || !self.static_valid;
         let dynamic = (f.scene.dynamic_first < f.scene.triangle_count).then_some(f.scene.dynamic_first..f.scene.triangle_count);
         if dynamic.is_some() && self.dynamic_map.is_none() {
             return Err(GpuError::Invalid(format!("{name}: the scene gained dynamic triangles after creation")));
         }
-        if !redraw_static && dynamic.is_none() {
+        let redraw: Vec<usize> = (0..self.levels).filter(|l| self.static_dirty[*l]).collect();
+        if redraw.is_empty() && dynamic.is_none() {
             return Ok(());
         }
-        let draw_dynamic = dynamic.is_some();
         timer.stage(gpu, &label, |enc| {
-            if redraw_static {
-                self.draw(enc, &label, f, &self.static_map, 0..f.scene.dynamic_first);
+            for &l in &redraw {
+                self.draw(enc, &label, f, &self.static_map, l, 0..f.scene.dynamic_first);
             }
-            if let (Some(range), Some(map)) = (dynamic, &self.dynamic_map) {
-                self.draw(enc, &label, f, map, range);
+            if let (Some(range), Some(map)) = (&dynamic, &self.dynamic_map) {
+                for l in 0..self.levels {
+                    self.draw(enc, &label, f, map, l, range.clone());
+                }
             }
         });
-        self.dynamic_renders += draw_dynamic as u32;
-        if redraw_static {
-            self.static_renders += 1;
-            self.static_valid = true;
-        }
+        self.static_renders += redraw.len() as u32;
+        self.dynamic_renders += if dynamic.is_some() { self.levels as u32 } else { 0 };
+        self.static_dirty.iter_mut().for_each(|d| *d = false);
         Ok(())
     }
 
@@ -271,8 +339,9 @@ impl Technique for LeakTracing {
         let trace = gpu.uniform(&format!("{name}.trace_params"), &TraceParams { cfg: [self.mask_bits, w * h, 0, 0] });
         let s = self.screen.as_ref().expect("allocated above");
         let (cur, prev) = ((frames % 2) as usize, ((frames + 1) % 2) as usize);
-        let static_view = self.static_map.create_view(&Default::default());
-        let dynamic_view = self.dynamic_map.as_ref().unwrap_or(&self.static_map).create_view(&Default::default());
+        let array = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
+        let static_view = self.static_map.create_view(&array);
+        let dynamic_view = self.dynamic_map.as_ref().unwrap_or(&self.static_map).create_view(&array);
         let motion_view = f.gbuffer.motion.create_view(&Default::default());
         use wgpu::BindingResource as R;
         let classify = f.view_group(

@@ -11,7 +11,7 @@ use crate::Gpu;
 
 pub(super) fn report(t: &LeakTracing, gpu: &Gpu) -> TechniqueReport {
     let texels = (t.res * t.res) as u64;
-    let maps = 1 + t.dynamic_map.is_some() as u64;
+    let maps = (1 + t.dynamic_map.is_some() as u64) * t.levels as u64;
     let mut r = TechniqueReport::default();
     let Some(s) = &t.screen else { return r };
     let (w, h) = (s.width, s.height);
@@ -28,9 +28,11 @@ pub(super) fn report(t: &LeakTracing, gpu: &Gpu) -> TechniqueReport {
     c.insert("rays_traced".into(), rays as f64);
     c.insert("shadow_map_texels".into(), texels as f64);
     c.insert("maps".into(), maps as f64);
+    c.insert("map_levels".into(), t.levels as f64);
+    c.insert("ray_traced_cascade".into(), t.cascades.is_some() as u32 as f64);
     c.insert("static_map_renders".into(), t.static_renders as f64);
     c.insert("dynamic_map_renders".into(), t.dynamic_renders as f64);
-    c.insert("fetches_per_pixel".into(), 4.0 * maps as f64);
+    c.insert("fetches_per_pixel".into(), 4.0 * (1 + t.dynamic_map.is_some() as u32) as f64);
     if temporal {
         let full = t.params.mode[3] & super::FLAG_FULL != 0;
         c.insert("mask_bits_per_pixel".into(), t.mask_bits as f64);
@@ -41,7 +43,7 @@ pub(super) fn report(t: &LeakTracing, gpu: &Gpu) -> TechniqueReport {
     // per-frame scratch: the ray list and the indirect arguments
     c.insert("list_bytes".into(), ((pixels + 1) * 4 + 16) as f64);
     let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&t.static_map, 4));
-    r.images.push(depth_image("static shadow map (linear depth)", t.res, &depth));
+    r.images.push(depth_image("static shadow map, level 0 (linear depth)", t.res, &depth));
     r.images.push(mask_image(w, h, &mask));
     r.images.push(rays_image(w, h, &mask));
     r
