@@ -44,7 +44,7 @@ pub struct Mask {
 
 impl Mask {
     pub fn bits(self) -> u32 {
-        (self.st as u32) * BIT_ST | (self.ltt as u32) * BIT_LTT | (self.rs as u32) * BIT_RS
+        ((self.st as u32) * BIT_ST) | ((self.ltt as u32) * BIT_LTT) | ((self.rs as u32) * BIT_RS)
     }
     pub fn from_bits(b: u32) -> Mask {
         Mask { st: b & BIT_ST != 0, ltt: b & BIT_LTT != 0, rs: b & BIT_RS != 0 }
@@ -331,7 +331,7 @@ mod cascade_tests {
         // every point of the scene is inside the kept box's depth range
         for c in scene.corners() {
             let z = (kept.view_proj * c.extend(1.0)).z;
-            assert!(z >= 0.0 && z <= 1.0 || !covers(&kept, c), "scene corner depth {z}");
+            assert!((0.0..=1.0).contains(&z) || !covers(&kept, c), "scene corner depth {z}");
         }
         // a small step keeps it, and the slice stays covered; a large one does not
         let (fit1, corners1) = fit_at(0.3, 0.0);

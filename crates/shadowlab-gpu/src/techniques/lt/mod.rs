@@ -226,8 +226,10 @@ const FORCE_ALL: ParamDef =
 const MIN_VARIANCE: ParamDef =
     p("min_variance", cpu::DEFAULT_MIN_VARIANCE, 0.0, 1.0, "VSM/EVSM minimum variance (depth units^2)", "seed 004 section 4 (1e-10)");
 const ESM_C: ParamDef = p("c", cpu::DEFAULT_ESM_C, 0.0, 88.0, "ESM exponent", "seed 004 section 4 (80)");
-const C_POS: ParamDef = p("c_pos", cpu::DEFAULT_EVSM_C_POS, 0.0, 42.0, "EVSM positive exponent (depth in [-1,1])", "seed 004 section 4 (20)");
-const C_NEG: ParamDef = p("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
+const C_POS: ParamDef =
+    p("c_pos", cpu::DEFAULT_EVSM_C_POS, 0.0, 42.0, "EVSM positive exponent (depth in [-1,1])", "seed 004 section 4 (20)");
+const C_NEG: ParamDef =
+    p("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
 const MOMENT_BIAS: ParamDef = p("moment_bias", cpu::DEFAULT_MOMENT_BIAS, 0.0, 1.0, "MSM moment bias", "seed 004 section 4 (3e-6)");
 const PCF_BIAS: ParamDef = p(
     "bias",
@@ -260,7 +262,8 @@ pub const LT_PARAMS: &[ParamDef] = &[
     C_NEG,
     MOMENT_BIAS,
 ];
-pub const LTT_PARAMS: &[ParamDef] = &[RES, CASCADES, LAMBDA, ENLARGE, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
+pub const LTT_PARAMS: &[ParamDef] =
+    &[RES, CASCADES, LAMBDA, ENLARGE, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
 pub const HYBRID_PARAMS: &[ParamDef] = &[RES, CASCADES, LAMBDA, ENLARGE, REUSE, FORCE_ALL, PCF_BIAS, PCF_NORMAL_OFFSET];
 
 const LIGHTS: &[&str] = &["directional", "spot"];

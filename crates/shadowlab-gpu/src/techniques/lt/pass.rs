@@ -85,17 +85,14 @@ impl LeakTracing {
         };
         let mask_bits = leak::mask_texel_bits(LIGHTS).map_err(GpuError::Invalid)?;
         let flag = |key: &str, bit: u32| if get(p, key, 0.0) != 0.0 { bit } else { 0 };
-        let flags = flag("rr", FLAG_RR) | flag("full", FLAG_FULL) | flag("force_all", FLAG_FORCE_ALL) | flag("history_test", FLAG_HISTORY_TEST);
+        let flags =
+            flag("rr", FLAG_RR) | flag("full", FLAG_FULL) | flag("force_all", FLAG_FORCE_ALL) | flag("history_test", FLAG_HISTORY_TEST);
         let (bias, normal_offset) = match mode {
             Mode::HybridPcf => (p.get("bias"), p.get("normal_offset")),
             _ => (0.0, 0.0),
         };
-        let shape = [
-            get(p, "min_variance", 1e-10) as f32,
-            get(p, "c", 80.0) as f32,
-            get(p, "c_pos", 20.0) as f32,
-            get(p, "c_neg", 5.0) as f32,
-        ];
+        let shape =
+            [get(p, "min_variance", 1e-10) as f32, get(p, "c", 80.0) as f32, get(p, "c_pos", 20.0) as f32, get(p, "c_neg", 5.0) as f32];
         let cascades = match *light {
             Light::Directional { direction } if p.get_u32("cascades") > 1 => Some(Cascades {
                 count: p.get_u32("cascades") as usize,
@@ -160,8 +157,7 @@ impl LeakTracing {
             view_dimension: wgpu::TextureViewDimension::D2Array,
             multisampled: false,
         };
-        let classify_layout =
-            view_layout(gpu, &format!("{name}.classify"), &[binding::uniform(), arr, arr, nf, tex, ro, rw, ro, rw, rw]);
+        let classify_layout = view_layout(gpu, &format!("{name}.classify"), &[binding::uniform(), arr, arr, nf, tex, ro, rw, ro, rw, rw]);
         let classify_pipeline = gpu.compute_pipeline(&format!("{name}.classify"), &classify_source(), "main", &[&classify_layout]);
         let trace_layout = view_layout(gpu, &format!("{name}.trace"), &[binding::uniform(), ro, rw]);
         let trace_pipeline = gpu.compute_pipeline(&format!("{name}.trace"), &trace_source(), "main", &[&trace_layout, &scene.layout]);
@@ -204,7 +200,15 @@ impl LeakTracing {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn draw(&self, enc: &mut wgpu::CommandEncoder, label: &str, f: &FrameInputs, target: &wgpu::Texture, layer: usize, tris: std::ops::Range<u32>) {
+    fn draw(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        label: &str,
+        f: &FrameInputs,
+        target: &wgpu::Texture,
+        layer: usize,
+        tris: std::ops::Range<u32>,
+    ) {
         let view = target.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2),
             base_array_layer: layer as u32,
