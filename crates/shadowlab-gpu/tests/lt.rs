@@ -249,3 +249,53 @@ fn static_and_dynamic_maps_combine_to_the_whole_scene() {
     assert_eq!(r.counters["dynamic_map_renders"], 3.0);
     assert_eq!(r.shadow_data_bytes, 2 * 512 * 512 * 4);
 }
+
+/// Section 3.3 on a camera path: the pixels beyond the hybrid cascades (view depth past the
+/// third practical split) are all ray traced, and the enlarged cascade maps are re-rendered
+/// only now and then (fewer layer renders than 3 per frame).
+#[test]
+fn cascades_trace_the_last_level_and_reuse_the_others() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let cams = path(&scene, 12);
+    let light = scene.lights[0];
+    let mut t = make(&lab, "lt", &light);
+    let mut beyond_total = 0;
+    for (f, cam) in cams.iter().enumerate() {
+        let prev = if f == 0 { cam } else { &cams[f - 1] };
+        let v = lab.view(cam, prev, &light, 128, 128).unwrap();
+        frame(&lab, &mut t, &v);
+        let splits = shadowlab_core::cascades::practical_splits(cam.near, cam.far, 4, shadowlab_core::cascades::DEFAULT_LAMBDA);
+        let mask = t.mask(&gpu);
+        for i in 0..v.mask.len() {
+            if v.mask[i] != 0 && v.position[i][3] > splits[3] * 1.0001 {
+                beyond_total += 1;
+                assert!(mask[i] & BIT_LTT != 0, "frame {f} pixel {i} at depth {} beyond {} without a ray", v.position[i][3], splits[3]);
+            }
+        }
+    }
+    assert!(beyond_total > 0, "courtyard's far end lies in the ray-traced cascade");
+    let r = t.report(&gpu);
+    let renders = r.counters["static_map_renders"];
+    assert!((3.0..3.0 * 12.0).contains(&renders), "{renders} layer renders over 12 frames");
+}
+
+/// Spot lights: one perspective map, and the same guarantees (exact with every pixel flagged,
+/// close to rt with a still camera).
+#[test]
+fn spot_light_uses_one_map() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let all = lab.run(&v, &TechniqueSpec::parse("lt:force_all=true").unwrap(), 1).unwrap();
+    assert!((0..v.mask.len()).all(|i| v.mask[i] == 0 || all.visibility[i] == rt.visibility[i]));
+    let r = lab.run(&v, &TechniqueSpec::parse("lt").unwrap(), 3).unwrap();
+    assert_eq!(r.report.counters["map_levels"], 1.0);
+    assert_eq!(r.report.counters["ray_traced_cascade"], 0.0);
+    let c = compare(&r.visibility, &rt.visibility, &v.mask);
+    assert!(c.wrong_pct <= LT_STILL_MARGIN_PCT, "room (spot): lt wrong {:.4} %", c.wrong_pct);
+    assert!(r.report.counters["rays_traced"] < 0.2 * rt.report.counters["rays_traced"]);
+}
