@@ -15,6 +15,14 @@
 //! evaluates every pixel and appends the ones needing a ray to a list (atomic append);
 //! `<name>.trace` sizes an indirect dispatch from the list's count and traces one ray per
 //! listed pixel with `rt`'s BVH traversal (`reference::TRACE_WGSL`).
+//! Temporal mask: 3 bits per light (ST, LTT = a ray was traced, RS) in two ping-pong buffers
+//! of `leak::mask_texel_bits(lights)` bits per pixel (8 for the one light of an instance),
+//! packed into u32 words (WebGPU cannot write R8Uint storage textures; the bytes are those of
+//! an R8Uint texture), written with atomic OR. Reprojection: the pixel's motion vector leads to
+//! last frame's pixel; it fails (forcing a ray) off-screen, and with `history_test` where last
+//! frame's view depth there differs from this point's depth seen from the previous camera by
+//! more than `depth_tol` (relative) or the normals differ by more than `normal_cos`; that needs
+//! 8 bytes per pixel of history (view depth + packed normal, ping-pong).
 //! Stored depth: linear light-space depth in [0, 1], 0 = near the light (filtered/'s `sd`
 //! maps, rendered with its render.wgsl). CPU half: `shadowlab_core::leak`.
 //! Directional lights (`cascades` > 1, default 4): the view frustum split with the practical
