@@ -13,7 +13,7 @@ use crate::scene::Bounds;
 /// LTT epsilon: a ray where `eps < s < 1 - eps` (seed 004 eq. 3 and section 4: 0.01). Too low:
 /// numerical noise of the bounds flags whole lit/shadowed regions; too high: misses leaks whose
 /// bound is close to 0 or 1.
-pub const DEFAULT_EPS: f32 = 0.01;
+pub const DEFAULT_EPS: f64 = 0.01;
 /// Shadow test cut-off: ST := s < 0.5 (seed 004 eq. 4).
 pub const ST_CUTOFF: f32 = 0.5;
 /// Lights one mask texel can hold (3 bits each in at most 32 bits).
@@ -159,7 +159,7 @@ pub fn mask_bytes_per_light(lights: usize, pixels: u64) -> Result<f64, String> {
 /// Cascade reuse: each box is enlarged by 15 % when it is rendered (seed 004 section 3.3).
 /// Too low: every small camera move re-renders the cascade; too high: coarser texels (wider
 /// uncertain bands, more rays).
-pub const DEFAULT_ENLARGE: f32 = 0.15;
+pub const DEFAULT_ENLARGE: f64 = 0.15;
 
 /// The box a cascade is rendered with for reuse (section 3.3): this frame's fitted box `fit`
 /// with its side enlarged by `1 + enlarge` and its depth range extended to the whole scene
@@ -196,7 +196,7 @@ mod tests {
 
     #[test]
     fn ltt_is_strict_on_both_sides() {
-        let eps = DEFAULT_EPS;
+        let eps = DEFAULT_EPS as f32;
         assert!(!ltt(0.0, eps) && !ltt(0.01, eps) && !ltt(0.99, eps) && !ltt(1.0, eps));
         assert!(ltt(0.0101, eps) && ltt(0.5, eps) && ltt(0.9899, eps));
         assert!(!ltt(0.3, 0.5), "eps = 0.5 flags nothing");
@@ -323,7 +323,7 @@ mod cascade_tests {
     fn enlarged_boxes_are_reused_for_small_moves_only() {
         let scene = Bounds { min: Vec3::new(-50.0, 0.0, -50.0), max: Vec3::new(50.0, 10.0, 50.0) };
         let (fit0, corners0) = fit_at(0.0, 0.0);
-        let kept = reuse_box(&fit0, &scene, DEFAULT_ENLARGE, 512);
+        let kept = reuse_box(&fit0, &scene, DEFAULT_ENLARGE as f32, 512);
         assert!((kept.half - fit0.half * 1.15).abs() < 1e-5 * kept.half);
         assert!((kept.texel - 2.0 * kept.half / 512.0).abs() < 1e-9);
         assert!(reusable(&kept, &fit0));

@@ -152,7 +152,7 @@ const BASE: ParamDef = ParamDef {
 };
 const EPS: ParamDef = p(
     "eps",
-    leak::DEFAULT_EPS as f64,
+    leak::DEFAULT_EPS,
     0.0,
     0.5,
     "LTT epsilon: a ray where eps < s < 1-eps; low: bound noise becomes rays, high: misses leaks (0.5: no LTT rays)",
@@ -203,6 +203,8 @@ const NORMAL_COS: ParamDef = p(
     "minimum cosine between current and last frame's normal in the reprojection test",
     "shadowlab choice (not in the paper)",
 );
+/// `shadowlab_core::cascades::DEFAULT_LAMBDA` (an f32) as written: the authors' 0.85.
+pub const DEFAULT_LAMBDA: f64 = 0.85;
 const CASCADES: ParamDef = ParamDef {
     key: "cascades",
     default: 4.0,
@@ -215,7 +217,7 @@ const CASCADES: ParamDef = ParamDef {
 };
 const LAMBDA: ParamDef = p(
     "lambda",
-    shadowlab_core::cascades::DEFAULT_LAMBDA as f64,
+    DEFAULT_LAMBDA,
     0.0,
     1.0,
     "practical split blend (1 = logarithmic); low: coarse near cascade, high: far cascades coarse and the ray-traced one large",
@@ -223,7 +225,7 @@ const LAMBDA: ParamDef = p(
 );
 const ENLARGE: ParamDef = p(
     "enlarge",
-    leak::DEFAULT_ENLARGE as f64,
+    leak::DEFAULT_ENLARGE,
     0.0,
     1.0,
     "cascade box enlargement for reuse; low: re-rendered on small moves, high: coarser texels",
