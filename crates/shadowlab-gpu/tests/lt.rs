@@ -268,10 +268,10 @@ fn cascades_trace_the_last_level_and_reuse_the_others() {
         frame(&lab, &mut t, &v);
         let splits = shadowlab_core::cascades::practical_splits(cam.near, cam.far, 4, shadowlab_core::cascades::DEFAULT_LAMBDA);
         let mask = t.mask(&gpu);
-        for i in 0..v.mask.len() {
+        for (i, m) in mask.iter().enumerate() {
             if v.mask[i] != 0 && v.position[i][3] > splits[3] * 1.0001 {
                 beyond_total += 1;
-                assert!(mask[i] & BIT_LTT != 0, "frame {f} pixel {i} at depth {} beyond {} without a ray", v.position[i][3], splits[3]);
+                assert!(m & BIT_LTT != 0, "frame {f} pixel {i} at depth {} beyond {} without a ray", v.position[i][3], splits[3]);
             }
         }
     }
