@@ -67,7 +67,7 @@ fn compaction_lists_exactly_the_flagged_pixels() {
     let v = view(&lab, &scene, 0, 256);
     let evsm = lab.run(&v, &TechniqueSpec::parse("evsm:sd=true").unwrap(), 1).unwrap();
     let rt = lab.reference(&v, 1).unwrap();
-    let mut t = make(&lab, "ltt:cascades=1", &v.light);
+    let mut t = make(&lab, "ltt:cascades=1,res=512", &v.light);
     let vis = frame(&lab, &mut t, &v);
     let list = t.ray_list(&gpu);
     let set: BTreeSet<u32> = list.iter().copied().collect();
@@ -230,12 +230,12 @@ fn static_and_dynamic_maps_combine_to_the_whole_scene() {
     let scene = builtin("foliage").unwrap();
     let mut lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 256);
-    let mut whole = make(&lab, "ltt:cascades=1", &v.light);
+    let mut whole = make(&lab, "ltt:cascades=1,res=512", &v.light);
     let want = frame(&lab, &mut whole, &v);
     let want_rays: BTreeSet<u32> = whole.ray_list(&gpu).into_iter().collect();
     assert_eq!(lab.gscene.dynamic_first, lab.gscene.triangle_count, "built-in scenes are static today");
     lab.gscene.dynamic_first = lab.gscene.triangle_count / 2;
-    let mut split = make(&lab, "ltt:cascades=1", &v.light);
+    let mut split = make(&lab, "ltt:cascades=1,res=512", &v.light);
     for _ in 0..3 {
         let got = frame(&lab, &mut split, &v);
         let rays: BTreeSet<u32> = split.ray_list(&gpu).into_iter().collect();

@@ -130,14 +130,20 @@ const fn flag(key: &'static str, default: bool, doc: &'static str, source: &'sta
     ParamDef { key, default: default as u32 as f64, min: 0.0, max: 1.0, integer: true, doc, source, choices: BOOL }
 }
 
+/// Map side per cascade: the authors' 2048 (seed 004 section 4). Measured (docs/bench/lt.md,
+/// 1024x1024, foliage / sponza paths): 512 -> 2048 lowers the wrong pixels 0.078 -> 0.022 % /
+/// 0.013 -> 0.007 % and the rays by 26 % / 34 % at about the same time (the cascades are
+/// re-rendered rarely), for 48 MiB of maps instead of 3. Too low: wide uncertain bands (rays)
+/// and sub-texel casters missing from the map (wrong pixels the mask cannot find).
+pub const DEFAULT_RES: f64 = 2048.0;
 const RES: ParamDef = ParamDef {
     key: "res",
-    default: 512.0,
+    default: DEFAULT_RES,
     min: 16.0,
     max: 16384.0,
     integer: true,
     doc: "shadow map side (texels, per cascade); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
-    source: "seeds' evaluation: 512 with 1024x1024 output (seed 004 used 2048 per cascade)",
+    source: "seed 004 section 4 (2048 per cascade); shadowlab measurement (docs/bench/lt.md)",
     choices: &[],
 };
 const BASE: ParamDef = ParamDef {
