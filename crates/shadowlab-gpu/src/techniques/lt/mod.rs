@@ -33,6 +33,7 @@
 mod cascade;
 mod pass;
 mod report;
+mod screen;
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::leak;

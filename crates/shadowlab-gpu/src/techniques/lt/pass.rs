@@ -8,6 +8,7 @@ use shadowlab_core::lightspace;
 use shadowlab_core::params::ParamValues;
 
 use super::cascade::{single_level, Cascades};
+use super::screen::Screen;
 use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, MAX_LEVELS};
 use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_RR};
 use crate::scene_gpu::GpuScene;
@@ -18,21 +19,6 @@ use crate::{binding, raster, Gpu, GpuError};
 
 /// Lights per technique instance (the lab runs one instance per light).
 const LIGHTS: usize = 1;
-
-/// Screen-sized buffers, reallocated when the view size changes.
-pub(super) struct Screen {
-    pub width: u32,
-    pub height: u32,
-    /// Temporal mask, ping-pong: `mask_bits` per pixel packed in u32 words.
-    pub masks: [wgpu::Buffer; 2],
-    /// (linear view depth, packed normal) per pixel, ping-pong, for the reprojection test.
-    pub history: [wgpu::Buffer; 2],
-    /// list[0] = count, then pixel indices.
-    pub list: wgpu::Buffer,
-    pub args: wgpu::Buffer,
-    /// Frames evaluated at this size; the mask written last is `masks[(frames + 1) % 2]`.
-    pub frames: u32,
-}
 
 pub struct LeakTracing {
     pub(super) mode: Mode,
@@ -242,26 +228,7 @@ impl LeakTracing {
 
     fn screen(&mut self, gpu: &Gpu, w: u32, h: u32) -> &mut Screen {
         if !matches!(&self.screen, Some(s) if s.width == w && s.height == h) {
-            let n = w as u64 * h as u64;
-            let per_word = (32 / self.mask_bits) as u64;
-            let name = self.mode.name();
-            let mask = || gpu.storage(&format!("{name}.mask"), n.div_ceil(per_word) * 4);
-            let history = || gpu.storage(&format!("{name}.history"), n * 8);
-            let args = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(&format!("{name}.args")),
-                size: 16,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            self.screen = Some(Screen {
-                width: w,
-                height: h,
-                masks: [mask(), mask()],
-                history: [history(), history()],
-                list: gpu.storage(&format!("{name}.list"), (n + 1) * 4),
-                args,
-                frames: 0,
-            });
+            self.screen = Some(Screen::new(gpu, self.mode.name(), w, h, self.mask_bits));
         }
         self.screen.as_mut().expect("allocated above")
     }
