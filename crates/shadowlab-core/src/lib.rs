@@ -11,6 +11,7 @@ pub mod cascades;
 pub mod cube;
 pub mod edges;
 pub mod iasm;
+pub mod leak;
 pub mod light;
 pub mod lightspace;
 pub mod loaders;

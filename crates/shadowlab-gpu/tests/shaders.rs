@@ -322,3 +322,27 @@ fn cube_layouts_match_wgsl() {
         &[("cfg", offset_of!(CubeParams, cfg)), ("bias", offset_of!(CubeParams, bias))],
     );
 }
+
+#[test]
+fn lt_params_layout_matches_wgsl() {
+    use shadowlab_gpu::techniques::lt::{LevelU, LtParams, TraceParams};
+    let all = shadowlab_gpu::shaders::all();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap_or_else(|| panic!("{n} not composed")).1);
+    check(
+        &get("lt/classify.wgsl"),
+        "LtParams",
+        size_of::<LtParams>(),
+        &[
+            ("levels", offset_of!(LtParams, levels)),
+            ("texel", offset_of!(LtParams, texel)),
+            ("mode", offset_of!(LtParams, mode)),
+            ("shape", offset_of!(LtParams, shape)),
+            ("bias", offset_of!(LtParams, bias)),
+            ("history", offset_of!(LtParams, history)),
+        ],
+    );
+    check(&get("lt/classify.wgsl"), "Level", size_of::<LevelU>(), &[("info", offset_of!(LevelU, info))]);
+    for n in ["lt/trace.wgsl", "lt/args.wgsl"] {
+        check(&get(n), "TraceParams", size_of::<TraceParams>(), &[("cfg", offset_of!(TraceParams, cfg))]);
+    }
+}

@@ -6,6 +6,7 @@ pub mod cube;
 pub mod dpsm;
 pub mod filtered;
 pub mod iasm;
+pub mod lt;
 pub mod mdsm;
 pub mod min_sm;
 pub mod sm;
@@ -158,6 +159,9 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &cube::NOTW_INFO,
     &dpsm::INFO,
     &dpsm::NOTW_INFO,
+    &lt::LT_INFO,
+    &lt::LTT_INFO,
+    &lt::HYBRID_INFO,
 ];
 
 /// Every technique's composed WGSL, for the naga validation test.
@@ -172,6 +176,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     v.extend(min_sm::shaders());
     v.extend(warp::shaders());
     v.extend(cube::shaders());
+    v.extend(lt::shaders());
     v
 }
 

@@ -41,7 +41,8 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("filtered/mips.wgsl (rgba32float)", mips::source("rgba32float")),
     ]
 }
-fn render_source() -> String {
+/// The composed moments raster (`FilteredParams` at group 0; leak tracing renders its sd maps with it).
+pub fn render_source() -> String {
     compose(&format!("{MOMENTS_WGSL}{RENDER_WGSL}"), true)
 }
 fn eval_source() -> String {

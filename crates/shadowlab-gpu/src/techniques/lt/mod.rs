@@ -1,0 +1,317 @@
+//! Leak tracing (seed 004, Kern, Brüll, Grosch): a filterable shadow map says where it is sure
+//! (bound 0 or 1), rays answer the rest. Three registry entries, one implementation:
+//! - `lt`: the single-depth filterable map (default EVSM; depth only, 2x2 gather, moments
+//!   rebuilt in the shader, section 3.2), the leak-tracing test LTT (eq. 3), and the 3-bit
+//!   temporal mask (section 3.1: expand rays eq. 6, optional remove rays eq. 8, reprojected
+//!   with the G-buffer's motion vectors, a failed reprojection forces a ray);
+//! - `ltt`: LTT alone, no temporal mask;
+//! - `hybrid-pcf`: a ray where a 2x2 PCF of the plain (biased) depth map is not unanimous
+//!   (AMD FidelityFX hybrid shadows, the paper's HySM comparator), no temporal mask.
+//!
+//! Passes: `<name>.render` draws the static triangles (`0..dynamic_first`) into the static map
+//! (once, reused across frames with `reuse`, section 3.3-3.4; the map is fitted to the scene
+//! bounds, so it stays valid for any camera while the light does not move) and the dynamic
+//! triangles into the dynamic map every frame (skipped while there are none); `<name>.classify`
+//! evaluates every pixel and appends the ones needing a ray to a list (atomic append);
+//! `<name>.trace` sizes an indirect dispatch from the list's count and traces one ray per
+//! listed pixel with `rt`'s BVH traversal (`reference::TRACE_WGSL`).
+//! Temporal mask: 3 bits per light (ST, LTT = a ray was traced, RS) in two ping-pong buffers
+//! of `leak::mask_texel_bits(lights)` bits per pixel (8 for the one light of an instance),
+//! packed into u32 words (WebGPU cannot write R8Uint storage textures; the bytes are those of
+//! an R8Uint texture), written with atomic OR. Reprojection: the pixel's motion vector leads to
+//! last frame's pixel; it fails (forcing a ray) off-screen, and with `history_test` where last
+//! frame's view depth there differs from this point's depth seen from the previous camera by
+//! more than `depth_tol` (relative) or the normals differ by more than `normal_cos`; that needs
+//! 8 bytes per pixel of history (view depth + packed normal, ping-pong).
+//! Stored depth: linear light-space depth in [0, 1], 0 = near the light (filtered/'s `sd`
+//! maps, rendered with its render.wgsl). CPU half: `shadowlab_core::leak`.
+//! Directional lights (`cascades` > 1, default 4): the view frustum split with the practical
+//! scheme, cascades 0..n-2 hybrid with maps fitted to their slices, enlarged by 15 % and
+//! re-rendered only when this frame's slice leaves the kept box (section 3.3); the last
+//! cascade is ray traced. `cascades=1`: one map fitted to the scene bounds. Spot: one map.
+
+mod cascade;
+mod pass;
+mod report;
+mod screen;
+
+use bytemuck::{Pod, Zeroable};
+use shadowlab_core::leak;
+use shadowlab_core::moments as cpu;
+use shadowlab_core::params::{ParamDef, BOOL};
+
+use crate::reference::TRACE_WGSL;
+use crate::techniques::filtered::MOMENTS_WGSL;
+use crate::techniques::{compose_view, TechniqueInfo};
+pub use pass::LeakTracing;
+
+const CLASSIFY_WGSL: &str = include_str!("classify.wgsl");
+const TRACE_BODY_WGSL: &str = include_str!("trace.wgsl");
+const ARGS_WGSL: &str = include_str!("args.wgsl");
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("lt/classify.wgsl", classify_source()), ("lt/trace.wgsl", trace_source()), ("lt/args.wgsl", ARGS_WGSL.to_string())]
+}
+fn classify_source() -> String {
+    compose_view(&format!("{MOMENTS_WGSL}{CLASSIFY_WGSL}"), false)
+}
+fn trace_source() -> String {
+    compose_view(&format!("{TRACE_WGSL}{TRACE_BODY_WGSL}"), true)
+}
+
+/// Which of the three techniques (`mode.x` in classify.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Lt = 0,
+    Ltt = 1,
+    HybridPcf = 2,
+}
+
+impl Mode {
+    pub fn name(self) -> &'static str {
+        ["lt", "ltt", "hybrid-pcf"][self as usize]
+    }
+}
+
+/// Hybrid map levels at most (cascades 0-2; a 4th cascade is ray traced, seed 004 section 4).
+pub const MAX_LEVELS: usize = 3;
+
+/// WGSL `Level` (classify.wgsl): one cascade or the whole map.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LevelU {
+    pub view_proj: [[f32; 4]; 4],
+    /// x: world texel (per unit of light depth for spot), y/z: view depths served.
+    pub info: [f32; 4],
+}
+
+/// WGSL `LtParams` (classify.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LtParams {
+    pub levels: [LevelU; MAX_LEVELS],
+    pub texel: [f32; 4],
+    pub mode: [u32; 4],
+    pub shape: [f32; 4],
+    pub bias: [f32; 4],
+    pub history: [f32; 4],
+}
+
+/// WGSL `TraceParams` (trace.wgsl, args.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TraceParams {
+    pub cfg: [u32; 4],
+}
+
+pub const FLAG_RR: u32 = 1;
+pub const FLAG_FULL: u32 = 2;
+pub const FLAG_FORCE_ALL: u32 = 4;
+pub const FLAG_HISTORY_TEST: u32 = 8;
+pub const FLAG_DYNAMIC: u32 = 16;
+pub const FLAG_HAS_HISTORY: u32 = 32;
+
+/// Reprojection depth tolerance, relative to the view depth. Too low: sloped surfaces seen at
+/// grazing angles fail (the reprojected pixel centre lies elsewhere on the slope) and trace
+/// rays every frame; too high: disocclusions reuse the occluder's mask.
+pub const DEFAULT_DEPTH_TOL: f64 = 0.05;
+/// Reprojection normal test: minimum cosine between this and last frame's normal. Too high:
+/// curved surfaces fail; too low: creases reuse the other face's mask.
+pub const DEFAULT_NORMAL_COS: f64 = 0.9;
+/// `hybrid-pcf` bias: `sm`'s defaults (constant 0.5 texel, normal offset 0.5 texel, the
+/// shadowlab sweep). Too low: acne becomes rays (not wrong, but slow); too high: the unanimous
+/// 2x2 test misses thin lit gaps (wrong pixels).
+pub const DEFAULT_PCF_BIAS: f64 = 0.5;
+pub const DEFAULT_PCF_NORMAL_OFFSET: f64 = 0.5;
+
+const fn p(key: &'static str, default: f64, min: f64, max: f64, doc: &'static str, source: &'static str) -> ParamDef {
+    ParamDef { key, default, min, max, integer: false, doc, source, choices: &[] }
+}
+const fn flag(key: &'static str, default: bool, doc: &'static str, source: &'static str) -> ParamDef {
+    ParamDef { key, default: default as u32 as f64, min: 0.0, max: 1.0, integer: true, doc, source, choices: BOOL }
+}
+
+/// Map side per cascade: the authors' 2048 (seed 004 section 4). Measured (docs/bench/lt.md,
+/// 1024x1024, foliage / sponza paths): 512 -> 2048 lowers the wrong pixels 0.078 -> 0.022 % /
+/// 0.013 -> 0.007 % and the rays by 26 % / 34 % at about the same time (the cascades are
+/// re-rendered rarely), for 48 MiB of maps instead of 3. Too low: wide uncertain bands (rays)
+/// and sub-texel casters missing from the map (wrong pixels the mask cannot find).
+pub const DEFAULT_RES: f64 = 2048.0;
+const RES: ParamDef = ParamDef {
+    key: "res",
+    default: DEFAULT_RES,
+    min: 16.0,
+    max: 16384.0,
+    integer: true,
+    doc: "shadow map side (texels, per cascade); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
+    source: "seed 004 section 4 (2048 per cascade); shadowlab measurement (docs/bench/lt.md)",
+    choices: &[],
+};
+const BASE: ParamDef = ParamDef {
+    key: "base",
+    default: 2.0,
+    min: 0.0,
+    max: 3.0,
+    integer: true,
+    doc: "filterable representation rebuilt from the gathered depths: vsm, esm, evsm, msm",
+    source: "seed 004 section 4.1 (EVSM fastest, VSM close; ESM/MSM need more rays)",
+    choices: &["vsm", "esm", "evsm", "msm"],
+};
+const EPS: ParamDef = p(
+    "eps",
+    leak::DEFAULT_EPS,
+    0.0,
+    0.5,
+    "LTT epsilon: a ray where eps < s < 1-eps; low: bound noise becomes rays, high: misses leaks (0.5: no LTT rays)",
+    "seed 004 eq. 3 (0.01)",
+);
+/// Remove rays off by default: measured on camera paths (courtyard and foliage, 256x256, 12
+/// frames, docs/bench/lt.md) RR removed 10-20 % of the rays but raised the wrong pixels after
+/// frame 8 from 0.003 % to 0.11 % (courtyard) and 0.18 % to 0.30 % (foliage), at no measurable
+/// time gain. The paper uses it (1.05x speed-up, seed 004 table 3).
+pub const DEFAULT_RR: bool = false;
+const RR: ParamDef = flag(
+    "rr",
+    DEFAULT_RR,
+    "remove rays (eq. 8) where all reprojected neighbours confirmed the shadow test (removed rays snap to the test); on: fewer rays, edges that move under the camera can be lost",
+    "seed 004 section 3.1.2 (on); default off: shadowlab measurement (docs/bench/lt.md)",
+);
+const REUSE: ParamDef = flag(
+    "reuse",
+    true,
+    "reuse the static maps: a cascade's enlarged map until its slice leaves it, the whole-scene/spot map forever (fixed light); off: every map refitted and re-rendered each frame",
+    "seed 004 sections 3.3-3.4",
+);
+const FULL: ParamDef = flag(
+    "full",
+    false,
+    "full 3x3 neighbourhood every frame instead of the jittered 2x2 that covers 3x3 over 4 frames",
+    "seed 004 section 3.1.1 (2x2 jitter as good, cheaper)",
+);
+const HISTORY_TEST: ParamDef = flag(
+    "history_test",
+    true,
+    "reprojection also fails (forcing a ray) where last frame's depth or normal differs (disocclusion); includes section 3.1.2's temporal depth test; off: only off-screen fails",
+    "seed 004 sections 3.1 and 3.1.2 (temporal depth test)",
+);
+const DEPTH_TOL: ParamDef = p(
+    "depth_tol",
+    DEFAULT_DEPTH_TOL,
+    0.0,
+    1.0,
+    "relative view-depth tolerance of the reprojection test; low: rays on grazing surfaces, high: disocclusions reuse stale bits",
+    "shadowlab choice (not in the paper)",
+);
+const NORMAL_COS: ParamDef = p(
+    "normal_cos",
+    DEFAULT_NORMAL_COS,
+    -1.0,
+    1.0,
+    "minimum cosine between current and last frame's normal in the reprojection test",
+    "shadowlab choice (not in the paper)",
+);
+/// `shadowlab_core::cascades::DEFAULT_LAMBDA` (an f32) as written: the authors' 0.85.
+pub const DEFAULT_LAMBDA: f64 = 0.85;
+const CASCADES: ParamDef = ParamDef {
+    key: "cascades",
+    default: 4.0,
+    min: 1.0,
+    max: (MAX_LEVELS + 1) as f64,
+    integer: true,
+    doc: "directional lights: cascades, the last one ray traced (1 = one map over the whole scene, no ray-traced level)",
+    source: "seed 004 section 4 (4 cascades, levels 0-2 hybrid, the last ray traced)",
+    choices: &[],
+};
+const LAMBDA: ParamDef = p(
+    "lambda",
+    DEFAULT_LAMBDA,
+    0.0,
+    1.0,
+    "practical split blend (1 = logarithmic); low: coarse near cascade, high: far cascades coarse and the ray-traced one large",
+    "seed 004's code (0.85 log + 0.15 uniform)",
+);
+const ENLARGE: ParamDef = p(
+    "enlarge",
+    leak::DEFAULT_ENLARGE,
+    0.0,
+    1.0,
+    "cascade box enlargement for reuse; low: re-rendered on small moves, high: coarser texels",
+    "seed 004 section 3.3 (15 %)",
+);
+const FORCE_ALL: ParamDef =
+    flag("force_all", false, "trace a ray for every evaluated pixel (equals rt; for tests)", "shadowlab test switch");
+const MIN_VARIANCE: ParamDef =
+    p("min_variance", cpu::DEFAULT_MIN_VARIANCE, 0.0, 1.0, "VSM/EVSM minimum variance (depth units^2)", "seed 004 section 4 (1e-10)");
+const ESM_C: ParamDef = p("c", cpu::DEFAULT_ESM_C, 0.0, 88.0, "ESM exponent", "seed 004 section 4 (80)");
+const C_POS: ParamDef =
+    p("c_pos", cpu::DEFAULT_EVSM_C_POS, 0.0, 42.0, "EVSM positive exponent (depth in [-1,1])", "seed 004 section 4 (20)");
+const C_NEG: ParamDef =
+    p("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
+const MOMENT_BIAS: ParamDef = p("moment_bias", cpu::DEFAULT_MOMENT_BIAS, 0.0, 1.0, "MSM moment bias", "seed 004 section 4 (3e-6)");
+const PCF_BIAS: ParamDef = p(
+    "bias",
+    DEFAULT_PCF_BIAS,
+    0.0,
+    100.0,
+    "constant depth bias (texels); low: acne turns into rays, high: lit gaps missed",
+    "sm's default (shadowlab sweep); seed 004 section 4.2: HySM needs a tuned bias",
+);
+const PCF_NORMAL_OFFSET: ParamDef =
+    p("normal_offset", DEFAULT_PCF_NORMAL_OFFSET, 0.0, 100.0, "normal offset (texels)", "sm's default (shadowlab sweep)");
+
+pub const LT_PARAMS: &[ParamDef] = &[
+    RES,
+    CASCADES,
+    LAMBDA,
+    ENLARGE,
+    BASE,
+    EPS,
+    RR,
+    REUSE,
+    FULL,
+    HISTORY_TEST,
+    DEPTH_TOL,
+    NORMAL_COS,
+    FORCE_ALL,
+    MIN_VARIANCE,
+    ESM_C,
+    C_POS,
+    C_NEG,
+    MOMENT_BIAS,
+];
+pub const LTT_PARAMS: &[ParamDef] =
+    &[RES, CASCADES, LAMBDA, ENLARGE, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
+pub const HYBRID_PARAMS: &[ParamDef] = &[RES, CASCADES, LAMBDA, ENLARGE, REUSE, FORCE_ALL, PCF_BIAS, PCF_NORMAL_OFFSET];
+
+const LIGHTS: &[&str] = &["directional", "spot"];
+
+pub const LT_INFO: TechniqueInfo = TechniqueInfo {
+    name: "lt",
+    summary: "leak tracing: single-depth EVSM + LTT + 3-bit temporal mask (expand/remove rays), rays only where unsure",
+    cost: "static map once + 1 gather and 4 (9) mask reads per pixel + one BVH ray per listed pixel (indirect dispatch)",
+    quality: "converges to rt within a few frames; thin lit gaps missing from the map can stay closed",
+    source: "Kern, Brüll, Grosch 2024 (seed 004) sections 3-3.4",
+    lights: LIGHTS,
+    params: LT_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Lt)?)),
+};
+pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
+    name: "ltt",
+    summary: "leak-tracing test alone: a ray where the single-depth filterable bound is strictly between eps and 1-eps",
+    cost: "static map once + 1 gather per pixel + one ray per listed pixel",
+    quality: "misses LTT's failure cases (grazing receivers, edges near gaps: seed 004 figure 4)",
+    source: "seed 004 eq. 3 ('LTT only' of table 3)",
+    lights: LIGHTS,
+    params: LTT_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Ltt)?)),
+};
+pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
+    name: "hybrid-pcf",
+    summary: "hybrid shadows: a ray where the 2x2 PCF of a biased plain depth map is not unanimous",
+    cost: "static map once + 1 gather per pixel + one ray per listed pixel",
+    quality: "needs a tuned bias; misses edges the biased map does not see",
+    source: "AMD FidelityFX Hybrid Shadows 2021 (seed 004's HySM)",
+    lights: LIGHTS,
+    params: HYBRID_PARAMS,
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::HybridPcf)?)),
+};
