@@ -235,7 +235,7 @@ fn static_and_dynamic_maps_combine_to_the_whole_scene() {
     let mut whole = make(&lab, "ltt:cascades=1,res=512", &v.light);
     let want = frame(&lab, &mut whole, &v);
     let want_rays: BTreeSet<u32> = whole.ray_list(&gpu).into_iter().collect();
-    assert_eq!(lab.gscene.dynamic_first, lab.gscene.triangle_count, "built-in scenes are static today");
+    // at t = 0 nothing has moved, so any split of the triangles into two ranges is a valid one
     lab.gscene.dynamic_first = lab.gscene.triangle_count / 2;
     let mut split = make(&lab, "ltt:cascades=1,res=512", &v.light);
     for _ in 0..3 {
