@@ -16,8 +16,29 @@ use crate::RunArgs;
 
 /// Techniques `compare` runs when neither the setup nor `-t` names any: one of each family at
 /// its defaults (those that do not support the run's light type are left out).
-pub const BASELINE: &[&str] =
-    &["sm", "sm:pcf=3", "sv", "rtw", "notw", "notw-dv", "min-sm", "mdsm", "vsm", "evsm", "msm", "evsm:sd=true", "csm", "iasm"];
+pub const BASELINE: &[&str] = &[
+    "sm",
+    "sm:pcf=3",
+    "sv",
+    "rtw",
+    "notw",
+    "notw-dv",
+    "min-sm",
+    "mdsm",
+    "vsm",
+    "evsm",
+    "msm",
+    "evsm:sd=true",
+    "csm",
+    "iasm",
+    "cube",
+    "cube-notw",
+    "dpsm",
+    "dpsm-notw",
+    "lt",
+    "ltt",
+    "hybrid-pcf",
+];
 
 pub struct RunConfig {
     pub scene: Scene,
