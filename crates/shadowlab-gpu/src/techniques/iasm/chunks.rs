@@ -1,5 +1,7 @@
 //! Culling units of `iasm`: fixed-size chunks of the scene's triangles in vertex order, their
-//! world bounds computed once on the GPU (bounds.wgsl).
+//! world bounds computed once on the GPU (bounds.wgsl). Chunks holding moving triangles
+//! (`GpuScene::dynamic_first..`) get the scene's bounds over the whole animation instead, so
+//! they are never culled from a tile their objects move into.
 
 use glam::Vec3;
 
@@ -10,7 +12,8 @@ use crate::shaders::compose;
 use crate::{binding, Gpu, GpuError};
 
 /// World AABBs of chunks of `chunk` triangles in vertex order, computed once on the GPU (the
-/// lab keeps no CPU copy of the vertices). Returns the boxes.
+/// lab keeps no CPU copy of the vertices). Returns the boxes; a chunk with a moving triangle
+/// gets `scene.bounds` (swept over the animation).
 pub(super) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Vec<(Vec3, Vec3)>, GpuError> {
     let n = scene.triangle_count.div_ceil(chunk).max(1) as usize;
     let d = &gpu.device;
@@ -37,7 +40,11 @@ pub(super) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Ve
     gpu.take_error()?;
     let w: Vec<u32> = gpu.read_buffer_as(&boxes, n * 6);
     Ok(w.chunks_exact(6)
-        .map(|c| {
+        .enumerate()
+        .map(|(i, c)| {
+            if scene.dynamic_first < scene.triangle_count && (i as u32 + 1) * chunk > scene.dynamic_first {
+                return (scene.bounds.min, scene.bounds.max);
+            }
             let lo = Vec3::new(unkey(c[0]), unkey(c[1]), unkey(c[2]));
             let hi = Vec3::new(unkey(c[3]), unkey(c[4]), unkey(c[5]));
             (lo, hi)
