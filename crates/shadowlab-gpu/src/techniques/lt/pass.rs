@@ -240,6 +240,13 @@ impl LeakTracing {
         words[1..1 + words[0] as usize].to_vec()
     }
 
+    /// Layer 0 of the static map and of the dynamic map (linear light depth, `res`^2 texels),
+    /// as last rendered.
+    pub fn maps(&self, gpu: &Gpu) -> (Vec<f32>, Option<Vec<f32>>) {
+        let read = |t: &wgpu::Texture| bytemuck::pod_collect_to_vec(&gpu.read_texture(t, 4));
+        (read(&self.static_map), self.dynamic_map.as_ref().map(read))
+    }
+
     /// The temporal mask written in the last frame: 3 bits per pixel (`shadowlab_core::leak`).
     pub fn mask(&self, gpu: &Gpu) -> Vec<u32> {
         let Some(s) = &self.screen else { return Vec::new() };
