@@ -5,6 +5,7 @@ use std::collections::BTreeSet;
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera};
 use shadowlab_core::leak::{BIT_LTT, BIT_RS};
+use shadowlab_core::light::Light;
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
@@ -424,3 +425,50 @@ fn along_moving(lab: &Lab, scene: &Scene, spec: &str, cams: &[Camera]) -> (Vec<(
 }
 /// Animation time per frame in these tests (the CLI steps 1).
 const TIME_STEP: f32 = 2.0;
+
+/// Point lights: one cube map of six faces (the face by the dominant axis, then the spot's
+/// 2x2 gather): exact with every pixel flagged, and with the moving chair and a still camera
+/// within the still margin of `rt` after a few frames, with a fraction of its rays; every face
+/// receives view samples somewhere in the room.
+#[test]
+fn point_light_uses_a_cube_map() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    assert!(matches!(scene.lights[1], shadowlab_core::light::Light::Point { .. }));
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 1, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let all = lab.run(&v, &TechniqueSpec::parse("lt:force_all=true,res=512").unwrap(), 1).unwrap();
+    assert!((0..v.mask.len()).all(|i| v.mask[i] == 0 || all.visibility[i] == rt.visibility[i]));
+    assert_eq!(all.report.counters["map_levels"], 6.0);
+    assert_eq!(
+        all.report.shadow_data_bytes,
+        2 * 6 * 512 * 512 * 4 + 2 * 256 * 256 + 2 * 256 * 256 * 8,
+        "static + dynamic cube maps, mask, history"
+    );
+    let light = scene.lights[1];
+    let Light::Point { position } = light else { unreachable!() };
+    let faces: BTreeSet<usize> = (0..v.mask.len())
+        .filter(|&i| v.mask[i] != 0)
+        .map(|i| shadowlab_core::leak::cube_face(glam::Vec3::new(v.position[i][0], v.position[i][1], v.position[i][2]) - position))
+        .collect();
+    assert!(faces.len() >= 4, "view samples on faces {faces:?}");
+    for spec in ["lt:res=512", "lt"] {
+        let mut t = make(&lab, spec, &light);
+        let mut rt_inst = lab.instantiate(&shadowlab_gpu::reference::INFO, Default::default(), "rt".into(), &light).unwrap();
+        for f in 0..10 {
+            let time = f as f32 * TIME_STEP;
+            lab.set_time(time, (time - TIME_STEP).max(0.0)).unwrap();
+            let v = lab.view(&scene.camera, &scene.camera, &light, 256, 256).unwrap();
+            let want = lab.step(&v, &mut rt_inst, false, 1).unwrap();
+            let got = frame(&lab, &mut t, &v);
+            let c = compare(&got, &want.visibility, &v.mask);
+            let rays = t.ray_list(&gpu).len() as f64;
+            eprintln!("room point {spec} frame {f}: wrong {:.4} % rays {rays} (rt {})", c.wrong_pct, want.report.counters["rays_traced"]);
+            if f >= 6 {
+                assert!(c.wrong_pct <= LT_MOVING_MARGIN_PCT, "room (point) {spec} frame {f}: lt wrong {:.4} %", c.wrong_pct);
+                assert!(rays < 0.2 * want.report.counters["rays_traced"], "frame {f}: {rays} rays");
+            }
+        }
+    }
+}
