@@ -78,7 +78,7 @@ impl Mode {
 
 /// Hybrid map levels at most (cascades 0-2; a 4th cascade is ray traced, seed 004 section 4).
 pub const MAX_LEVELS: usize = 3;
-/// Map layers at most: a point light's six cube faces.
+/// Map layers at most: a point light's six cube faces (`shadowlab_core::leak::cube_faces`).
 pub const MAX_MAPS: usize = 6;
 
 /// WGSL `Level` (classify.wgsl): one cascade or the whole map.
@@ -149,7 +149,7 @@ const RES: ParamDef = ParamDef {
     min: 16.0,
     max: 16384.0,
     integer: true,
-    doc: "shadow map side (texels, per cascade); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
+    doc: "shadow map side (texels, per cascade / spot map / cube face); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
     source: "seed 004 section 4 (2048 per cascade); shadowlab measurement (docs/bench/lt.md)",
     choices: &[],
 };
