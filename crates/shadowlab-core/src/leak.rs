@@ -2,12 +2,15 @@
 //! (LTT, eq. 3), the 3-bit temporal mask (section 3.1: shadow test ST, LTT, ray result RS), its
 //! Table 1 classes, expand rays (ER, eq. 6), remove rays (RR, eq. 8), the per-pixel decision of
 //! section 3.1.3, the 2x2 jittered neighbourhood that covers 3x3 over 4 frames, and the mask
-//! format chosen by the light count, and the cascade reuse of section 3.3.
+//! format chosen by the light count, the cascade reuse of section 3.3, and the six cube faces
+//! of a point light (one map of six layers, each a perspective face read with the 2x2 gather).
 //! `techniques/lt/classify.wgsl` mirrors the per-pixel functions.
 
 use glam::Vec4Swizzles;
 
+use crate::camera::{look_at, perspective};
 use crate::cascades::CascadeBox;
+use crate::lightspace::LightProjection;
 use crate::scene::Bounds;
 
 /// LTT epsilon: a ray where `eps < s < 1 - eps` (seed 004 eq. 3 and section 4: 0.01). Too low:
@@ -186,6 +189,37 @@ pub fn covers(b: &CascadeBox, p: glam::Vec3) -> bool {
     d.x <= b.half && d.y <= b.half
 }
 
+/// Cube face of a direction from a point light: 2 * axis + (1 if negative), the axis of the
+/// largest component (x before y before z on ties); `classify.wgsl`'s `cube_face` mirrors it.
+pub fn cube_face(d: glam::Vec3) -> usize {
+    let a = d.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    2 * axis + (d[axis] < 0.0) as usize
+}
+
+/// The six faces of a point light's cube map (+x, -x, +y, -y, +z, -z, the order of
+/// [`cube_face`]): perspective frusta of 90 degrees widened by one texel on each side (as a
+/// spot's cone), so the 2x2 gather of a point on a face's border stays inside that face; far =
+/// the farthest bounds corner, near = far / 1000. Depth is linear, along the face's axis.
+pub fn cube_faces(position: glam::Vec3, bounds: &Bounds, res: u32) -> [LightProjection; 6] {
+    use glam::Vec3;
+    let far = bounds.corners().iter().map(|p| (*p - position).length()).fold(0.0f32, f32::max).max(bounds.diagonal() * 1e-3).max(1e-4);
+    let near = (far * 1e-3).max(1e-5);
+    let tan_half = 1.0 + 2.0 / res as f32;
+    let proj = perspective(2.0 * tan_half.atan(), 1.0, near, far);
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    axes.map(|d| {
+        let up = if d.y != 0.0 { Vec3::Z } else { Vec3::Y };
+        LightProjection { view_proj: proj * look_at(position, position + d, up), texel: 2.0 * tan_half / res as f32, perspective: true }
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -341,5 +375,38 @@ mod cascade_tests {
         assert!(!reusable(&kept, &fit2));
         let (fit3, _) = fit_at(0.0, 1.0);
         assert!(!reusable(&kept, &fit3), "a large turn moves the slice out");
+    }
+
+    #[test]
+    fn cube_faces_hold_every_direction_with_a_texel_of_margin() {
+        use glam::Vec3;
+        let b = Bounds { min: Vec3::new(-5.0, 0.0, -3.0), max: Vec3::new(5.0, 4.0, 3.0) };
+        let pos = Vec3::new(1.0, 2.0, 0.5);
+        let res = 256;
+        let faces = cube_faces(pos, &b, res);
+        let far = b.corners().iter().map(|p| (*p - pos).length()).fold(0.0f32, f32::max);
+        let mut seen = [0; 6];
+        for i in 0..2000 {
+            // directions spread over the sphere, plus the axes and the cube's corners
+            let (u, v) = ((i as f32 * 0.618034).fract(), (i as f32 + 0.5) / 2000.0);
+            let (phi, z) = (u * std::f32::consts::TAU, 1.0 - 2.0 * v);
+            let r = (1.0 - z * z).sqrt();
+            let d = Vec3::new(r * phi.cos(), z, r * phi.sin());
+            let p = pos + d * (0.5 + 3.0 * v);
+            let f = cube_face(p - pos);
+            seen[f] += 1;
+            let c = faces[f].view_proj * p.extend(1.0);
+            let ndc = c.xyz() / c.w;
+            // inside the 90 degree part: at least one texel (2 / res in ndc, scaled) from the border
+            let inner = 1.0 / (1.0 + 2.0 / res as f32);
+            assert!(ndc.x.abs() <= inner + 1e-5 && ndc.y.abs() <= inner + 1e-5, "face {f} of {d}: {ndc}");
+            assert!(c.w > 0.0 && c.w <= far, "linear depth {} along the axis, far {far}", c.w);
+            let axis_depth = (p - pos)[f / 2].abs();
+            assert!((c.w - axis_depth).abs() < 1e-4 * far, "w {} = depth along the face axis {axis_depth}", c.w);
+        }
+        assert!(seen.iter().all(|&n| n > 100), "every face is used: {seen:?}");
+        assert_eq!(cube_face(Vec3::new(1.0, 1.0, 1.0)), 0, "ties: x first");
+        assert_eq!(cube_face(Vec3::new(0.0, -1.0, -1.0)), 3, "ties: y before z");
+        assert_eq!(cube_face(-Vec3::Z), 5);
     }
 }

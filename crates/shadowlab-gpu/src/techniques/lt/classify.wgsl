@@ -21,7 +21,8 @@ struct Level {
 }
 
 struct LtParams {
-    levels: array<Level, 3>,
+    // directional: up to 3 cascades; spot: 1; point: the 6 cube faces (+x, -x, +y, -y, +z, -z)
+    levels: array<Level, 6>,
     // x: hybrid levels (map layers), y: 1 if perspective, z: resolution, w: 1 / far
     texel: vec4<f32>,
     // x: technique (0 lt, 1 ltt, 2 hybrid-pcf), y: base (0 vsm, 1 esm, 2 evsm, 3 msm),
@@ -42,6 +43,7 @@ const FLAG_FORCE_ALL: u32 = 4u;
 const FLAG_HISTORY_TEST: u32 = 8u;
 const FLAG_DYNAMIC: u32 = 16u;
 const FLAG_HAS_HISTORY: u32 = 32u;
+const FLAG_POINT: u32 = 64u;
 
 const BIT_ST: u32 = 1u;
 const BIT_LTT: u32 = 2u;
@@ -63,6 +65,18 @@ fn to_map(level: u32, p: vec3<f32>) -> vec3<f32> {
     let ndc = c.xyz / c.w;
     let depth = select(c.z, c.w * lp.texel.w, lp.texel.y > 0.5);
     return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, depth);
+}
+
+// Cube face of direction d (shadowlab_core::leak::cube_face): 2 * dominant axis + negative.
+fn cube_face(d: vec3<f32>) -> u32 {
+    let a = abs(d);
+    if a.x >= a.y && a.x >= a.z {
+        return select(0u, 1u, d.x < 0.0);
+    }
+    if a.y >= a.z {
+        return select(2u, 3u, d.y < 0.0);
+    }
+    return select(4u, 5u, d.z < 0.0);
 }
 
 fn base_visibility(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
@@ -181,12 +195,19 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let depth = textureLoad(g_position, id.xy, 0).w;
     let levels = u32(lp.texel.x);
     var c = 0u;
-    while c < levels && depth > lp.levels[c].info.z {
-        c++;
+    if (lp.mode.w & FLAG_POINT) != 0u {
+        c = cube_face(s.p - light.position.xyz);
+    } else {
+        while c < levels && depth > lp.levels[c].info.z {
+            c++;
+        }
     }
     let level = min(c, levels - 1u);
     var texel = lp.levels[level].info.x;
-    if lp.texel.y > 0.5 {
+    if (lp.mode.w & FLAG_POINT) != 0u {
+        let a = abs(s.p - light.position.xyz);
+        texel *= max(a.x, max(a.y, a.z));
+    } else if lp.texel.y > 0.5 {
         texel *= max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
     }
     let l = to_light(light, s.p);

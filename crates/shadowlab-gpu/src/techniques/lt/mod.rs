@@ -29,6 +29,9 @@
 //! scheme, cascades 0..n-2 hybrid with maps fitted to their slices, enlarged by 15 % and
 //! re-rendered only when this frame's slice leaves the kept box (section 3.3); the last
 //! cascade is ray traced. `cascades=1`: one map fitted to the scene bounds. Spot: one map.
+//! Point: one cube map of six layers (`shadowlab_core::leak::cube_faces`: 90 degree faces
+//! widened by a texel, linear depth along the face axis), the face chosen per pixel by the
+//! dominant axis, then the same 2x2 gather as a spot map (no gather across faces).
 
 mod cascade;
 mod pass;
@@ -75,6 +78,8 @@ impl Mode {
 
 /// Hybrid map levels at most (cascades 0-2; a 4th cascade is ray traced, seed 004 section 4).
 pub const MAX_LEVELS: usize = 3;
+/// Map layers at most: a point light's six cube faces (`shadowlab_core::leak::cube_faces`).
+pub const MAX_MAPS: usize = 6;
 
 /// WGSL `Level` (classify.wgsl): one cascade or the whole map.
 #[repr(C)]
@@ -89,7 +94,7 @@ pub struct LevelU {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct LtParams {
-    pub levels: [LevelU; MAX_LEVELS],
+    pub levels: [LevelU; MAX_MAPS],
     pub texel: [f32; 4],
     pub mode: [u32; 4],
     pub shape: [f32; 4],
@@ -110,6 +115,7 @@ pub const FLAG_FORCE_ALL: u32 = 4;
 pub const FLAG_HISTORY_TEST: u32 = 8;
 pub const FLAG_DYNAMIC: u32 = 16;
 pub const FLAG_HAS_HISTORY: u32 = 32;
+pub const FLAG_POINT: u32 = 64;
 
 /// Reprojection depth tolerance, relative to the view depth. Too low: sloped surfaces seen at
 /// grazing angles fail (the reprojected pixel centre lies elsewhere on the slope) and trace
@@ -143,7 +149,7 @@ const RES: ParamDef = ParamDef {
     min: 16.0,
     max: 16384.0,
     integer: true,
-    doc: "shadow map side (texels, per cascade); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
+    doc: "shadow map side (texels, per cascade / spot map / cube face); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
     source: "seed 004 section 4 (2048 per cascade); shadowlab measurement (docs/bench/lt.md)",
     choices: &[],
 };
@@ -283,7 +289,7 @@ pub const LTT_PARAMS: &[ParamDef] =
     &[RES, CASCADES, LAMBDA, ENLARGE, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
 pub const HYBRID_PARAMS: &[ParamDef] = &[RES, CASCADES, LAMBDA, ENLARGE, REUSE, FORCE_ALL, PCF_BIAS, PCF_NORMAL_OFFSET];
 
-const LIGHTS: &[&str] = &["directional", "spot"];
+const LIGHTS: &[&str] = &["directional", "spot", "point"];
 
 pub const LT_INFO: TechniqueInfo = TechniqueInfo {
     name: "lt",

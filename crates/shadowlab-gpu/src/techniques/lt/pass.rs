@@ -9,8 +9,8 @@ use shadowlab_core::params::ParamValues;
 
 use super::cascade::{single_level, Cascades};
 use super::screen::Screen;
-use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, MAX_LEVELS};
-use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_RR};
+use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, MAX_MAPS};
+use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_POINT, FLAG_RR};
 use crate::scene_gpu::GpuScene;
 use crate::techniques::filtered::{render_source, FilteredParams};
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
@@ -60,10 +60,18 @@ impl LeakTracing {
         let name = mode.name();
         let res = p.get_u32("res");
         gpu.check_size(res, res, "shadow map")?;
-        let lp = lightspace::fit(light, &scene.bounds, res)
-            .ok_or_else(|| GpuError::Invalid(format!("{name} supports directional and spot lights (got a {} light)", light.kind())))?;
+        // point: six cube faces, one layer each (level 0 = the +x face stands for all below)
+        let faces = match *light {
+            Light::Point { position } => Some(leak::cube_faces(position, &scene.bounds, res)),
+            _ => None,
+        };
+        let lp = match &faces {
+            Some(f) => f[0],
+            None => lightspace::fit(light, &scene.bounds, res)
+                .ok_or_else(|| GpuError::Invalid(format!("{name}: unsupported light ({})", light.kind())))?,
+        };
         let inv_far = match *light {
-            Light::Spot { position, .. } => {
+            Light::Spot { position, .. } | Light::Point { position } => {
                 let far = scene.bounds.corners().iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
                 1.0 / far.max(1e-6)
             }
@@ -71,8 +79,11 @@ impl LeakTracing {
         };
         let mask_bits = leak::mask_texel_bits(LIGHTS).map_err(GpuError::Invalid)?;
         let flag = |key: &str, bit: u32| if get(p, key, 0.0) != 0.0 { bit } else { 0 };
-        let flags =
-            flag("rr", FLAG_RR) | flag("full", FLAG_FULL) | flag("force_all", FLAG_FORCE_ALL) | flag("history_test", FLAG_HISTORY_TEST);
+        let flags = flag("rr", FLAG_RR)
+            | flag("full", FLAG_FULL)
+            | flag("force_all", FLAG_FORCE_ALL)
+            | flag("history_test", FLAG_HISTORY_TEST)
+            | if faces.is_some() { FLAG_POINT } else { 0 };
         let (bias, normal_offset) = match mode {
             Mode::HybridPcf => (p.get("bias"), p.get("normal_offset")),
             _ => (0.0, 0.0),
@@ -89,9 +100,12 @@ impl LeakTracing {
             }),
             _ => None,
         };
-        let levels = cascades.as_ref().map_or(1, |c| c.levels());
-        let mut level_u = [LevelU::zeroed(); MAX_LEVELS];
+        let levels = if faces.is_some() { 6 } else { cascades.as_ref().map_or(1, |c| c.levels()) };
+        let mut level_u = [LevelU::zeroed(); MAX_MAPS];
         level_u[0] = single_level(lp.view_proj, lp.texel);
+        for (l, f) in faces.iter().flatten().enumerate() {
+            level_u[l] = single_level(f.view_proj, f.texel);
+        }
         let params = LtParams {
             levels: level_u,
             texel: [levels as f32, lp.perspective as u32 as f32, res as f32, inv_far],
@@ -127,8 +141,10 @@ impl LeakTracing {
         let depth = raster::render_target(gpu, &format!("{name}.raster_depth"), res, res, raster::DEPTH_FORMAT, U::empty());
         let render_layout = binding::layout(d, name, wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
         let map_uniforms = (0..levels)
-            .map(|_| {
-                let u = gpu.uniform(&format!("{name}.map_params"), &map_params);
+            .map(|l| {
+                let mut mp = map_params;
+                mp.light_view_proj = level_u[l].view_proj;
+                let u = gpu.uniform(&format!("{name}.map_params"), &mp);
                 let g = binding::group(d, name, &render_layout, &[u.as_entire_binding()]);
                 (u, g)
             })
@@ -238,6 +254,13 @@ impl LeakTracing {
         let Some(s) = &self.screen else { return Vec::new() };
         let words: Vec<u32> = gpu.read_buffer_as(&s.list, (s.width * s.height + 1) as usize);
         words[1..1 + words[0] as usize].to_vec()
+    }
+
+    /// Layer 0 of the static map and of the dynamic map (linear light depth, `res`^2 texels),
+    /// as last rendered.
+    pub fn maps(&self, gpu: &Gpu) -> (Vec<f32>, Option<Vec<f32>>) {
+        let read = |t: &wgpu::Texture| bytemuck::pod_collect_to_vec(&gpu.read_texture(t, 4));
+        (read(&self.static_map), self.dynamic_map.as_ref().map(read))
     }
 
     /// The temporal mask written in the last frame: 3 bits per pixel (`shadowlab_core::leak`).
