@@ -136,9 +136,10 @@ fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {
 /// NoTW per face on the room's point light (256 x 256 view, 128 per face: the seeds' ratio of
 /// 2 view pixels per texel along each axis; window 64 as res 128 allows). Asserts what NoTW
 /// does (more texels used, a more even count per texel than `cube`), fewer wrong pixels than
-/// `cube` (measured 1.15 % vs 1.28 %) with a bound of 1.5 % (before the per-face clipping it was
-/// ~10 %), and the per-face bookkeeping. At 1024 / 512 it does not beat `cube` on this scene
-/// (docs/bench/point.md).
+/// `cube` by a margin (measured with the defaults blur 4, subdiv 0.25, normal offset 0.25:
+/// 0.936 % vs `cube` 1.279 %, 0.73x; notw's blur 8, subdiv 1, n.o. 0.5 gave 1.146 %, which the
+/// bound of 1.05 % and 0.8x would catch; before the per-face clipping it was ~10 %), and the
+/// per-face bookkeeping. At 1024 / 512 it ties `cube` on this scene (docs/bench/point.md).
 #[test]
 fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_texel() {
     let Some(gpu) = gpu() else { return };
@@ -150,7 +151,7 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     let notw = lab.run(&v, &spec("cube-notw:res=128,window=64"), 1).unwrap();
     let wrong = 100.0 - agreement(&notw.visibility, &rt.visibility, &v.mask);
     let cube_wrong = 100.0 - agreement(&cube.visibility, &rt.visibility, &v.mask);
-    if wrong > 1.5 || wrong >= cube_wrong {
+    if wrong > 1.05 || wrong >= 0.8 * cube_wrong {
         panic!("cube-notw {wrong:.3}% wrong on room (cube {cube_wrong:.3}%); {}", save_images("cube-notw-room", &v, &notw, &rt));
     }
     let (s, c) = (notw.report.sampling.unwrap(), cube.report.sampling.unwrap());
