@@ -136,9 +136,10 @@ fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {
 /// NoTW per face on the room's point light (256 x 256 view, 128 per face: the seeds' ratio of
 /// 2 view pixels per texel along each axis; window 64 as res 128 allows). Asserts what NoTW
 /// does (more texels used, a more even count per texel than `cube`), fewer wrong pixels than
-/// `cube` (measured 1.15 % vs 1.28 %) with a bound of 1.5 % (before the per-face clipping it was
-/// ~10 %), and the per-face bookkeeping. At 1024 / 512 it does not beat `cube` on this scene
-/// (docs/bench/cube.md).
+/// `cube` by a margin (measured with the defaults blur 4, subdiv 0.25, normal offset 0.25:
+/// 0.936 % vs `cube` 1.279 %, 0.73x; notw's blur 8, subdiv 1, n.o. 0.5 gave 1.146 %, which the
+/// bound of 1.05 % and 0.8x would catch; before the per-face clipping it was ~10 %), and the
+/// per-face bookkeeping. At 1024 / 512 it ties `cube` on this scene (docs/bench/point.md).
 #[test]
 fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_texel() {
     let Some(gpu) = gpu() else { return };
@@ -150,7 +151,7 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     let notw = lab.run(&v, &spec("cube-notw:res=128,window=64"), 1).unwrap();
     let wrong = 100.0 - agreement(&notw.visibility, &rt.visibility, &v.mask);
     let cube_wrong = 100.0 - agreement(&cube.visibility, &rt.visibility, &v.mask);
-    if wrong > 1.5 || wrong >= cube_wrong {
+    if wrong > 1.05 || wrong >= 0.8 * cube_wrong {
         panic!("cube-notw {wrong:.3}% wrong on room (cube {cube_wrong:.3}%); {}", save_images("cube-notw-room", &v, &notw, &rt));
     }
     let (s, c) = (notw.report.sampling.unwrap(), cube.report.sampling.unwrap());
@@ -168,6 +169,7 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     assert_eq!(counted, evaluated, "every evaluated sample on exactly one face");
     let with_samples = faces.iter().filter(|f| r[&format!("view_samples_face_{f}")] > 0.0).count();
     assert_eq!(r["faces_rendered"], with_samples as f64);
+    assert_eq!(r["subdiv_pieces_dropped"], 0.0, "subdivision ran out of capacity (holes in a face)");
     assert_eq!(r["warp_bytes"], 6.0 * 8.0 * 128.0 * 128.0);
     // six warped maps (4 bytes a texel), six pairs of warps (8 w^2), 32 bytes of DV each
     assert_eq!(notw.report.shadow_data_bytes, 6 * (128 * 128 * 4 + 8 * 128 * 128 + 32));
@@ -175,13 +177,21 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 }
 
 #[test]
-fn cube_notw_lists_notws_parameters_with_two_defaults_changed() {
+fn cube_notw_lists_notws_parameters_with_four_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
     let (a, b) = (cube::NOTW_PARAMS, warp::NOTW_PARAMS);
     assert_eq!(a.iter().map(|p| p.key).collect::<Vec<_>>(), b.iter().map(|p| p.key).collect::<Vec<_>>());
+    let own = [
+        ("window", cube::DEFAULT_NOTW_WINDOW),
+        ("blur", cube::DEFAULT_NOTW_BLUR),
+        ("subdiv", cube::DEFAULT_NOTW_SUBDIV),
+        ("normal_offset", cube::DEFAULT_NOTW_NORMAL_OFFSET),
+    ];
     for (x, y) in a.iter().zip(b) {
-        let changed = x.default != y.default;
-        assert_eq!(changed, x.key == "window" || x.key == "subdiv", "{}", x.key);
+        match own.iter().find(|(k, _)| *k == x.key) {
+            Some((_, d)) => assert_eq!(x.default, *d, "{}", x.key),
+            None => assert_eq!(x.default, y.default, "{}: notw's default", x.key),
+        }
         assert_eq!((x.min, x.max, x.doc), (y.min, y.max, y.doc));
     }
 }

@@ -48,7 +48,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 }
 
 /// sm's parameters apply unchanged: `res` is per face (the seeds' 512), the bias is in texels of
-/// the face at the sample. sm's bias sweep was on directional/spot lights; see docs/bench/cube.md
+/// the face at the sample. sm's bias sweep was on directional/spot lights; see docs/bench/point.md
 /// for the point-light check.
 pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET];
 
@@ -69,23 +69,40 @@ const W: &[ParamDef] = crate::techniques::warp::NOTW_PARAMS;
 /// room (512 x 512 view, 256 per face: 1.04 % wrong at 16, 0.65 at 128, subdiv 2); too high
 /// and the warp tends to RTW's rectilinear one.
 pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
-/// cube-notw's subdivision threshold (warped texels). Room, same view: 2 -> 1.04 %, 1 -> 0.70,
-/// 0.5 -> 0.60 (with window 128: 0.59 / 0.57); lower costs more pieces (capacity on big scenes).
-pub const DEFAULT_NOTW_SUBDIV: f64 = 1.0;
+/// cube-notw's subdivision threshold (warped texels): the bend a warped edge may keep, i.e. how
+/// far shadow edges shift (the errors of `cube-notw` are runs of false-lit pixels along one side
+/// of floor shadow edges, not seams). 1024x1024 output, 512 per face, room / courtyard lantern /
+/// conference light, wrong %: with notw's n.o. 0.5 and blur 8: 1 -> 0.361 / 0.212 / 0.369,
+/// 0.5 -> 0.316 / 0.204 / 0.325; with n.o. 0.25 and blur 4: 0.5 -> 0.290 / 0.171 / 0.276, 0.25
+/// -> 0.271 / 0.161 / 0.263 (docs/bench/point.md). Pieces 79 k -> 164 k -> 359 k on the room, 0.26 M
+/// -> 0.55 M -> 1.19 M on the courtyard. Lower: more pieces (time, capacity), higher: bent edges.
+pub const DEFAULT_NOTW_SUBDIV: f64 = 0.25;
+/// cube-notw's normal offset (warped texels). notw's 0.5 -> 0.25: room / courtyard lantern /
+/// conference 0.361 -> 0.341 / 0.212 -> 0.201 / 0.369 -> 0.327 % wrong (the same change as
+/// `dpsm-notw`'s). Low: acne (false shadow grows 0.144 -> 0.174 % on the room), high: shifted
+/// shadows (false lit).
+pub const DEFAULT_NOTW_NORMAL_OFFSET: f64 = 0.25;
+/// cube-notw's blur of the counts (half-width, texels). notw's 8 -> 4 alone: 0.361 -> 0.357 /
+/// 0.212 -> 0.209 / 0.369 -> 0.367; with subdiv 0.5 and n.o. 0.25 together the three give
+/// 0.290 / 0.171 / 0.276 (docs/bench/point.md). Too high: the sampling evens out less; too
+/// low: a kink per texel (more pieces).
+pub const DEFAULT_NOTW_BLUR: f64 = 4.0;
+
+const THREE_SETUPS: &str = "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md)";
 
 const fn with_default(p: ParamDef, default: f64, source: &'static str) -> ParamDef {
     ParamDef { default, source, ..p }
 }
 
-/// notw's parameters (same keys, order, ranges and docs), with the window and subdivision
-/// defaults measured for cube faces (tests/cube.rs checks the keys against notw's).
+/// notw's parameters (same keys, order, ranges and docs), with the window, blur, subdivision and
+/// normal offset defaults measured for cube faces (tests/cube.rs checks the keys against notw's).
 pub const NOTW_PARAMS: &[ParamDef] = &[
     W[0],
-    with_default(W[1], DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/cube.md)"),
-    W[2],
+    with_default(W[1], DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"),
+    with_default(W[2], DEFAULT_NOTW_BLUR, THREE_SETUPS),
     W[3],
     W[4],
-    with_default(W[5], DEFAULT_NOTW_SUBDIV, "shadowlab measurement on room's point light (docs/bench/cube.md)"),
+    with_default(W[5], DEFAULT_NOTW_SUBDIV, THREE_SETUPS),
     W[6],
     W[7],
     W[8],
@@ -93,7 +110,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     W[10],
     W[11],
     W[12],
-    W[13],
+    with_default(W[13], DEFAULT_NOTW_NORMAL_OFFSET, THREE_SETUPS),
     W[14],
 ];
 

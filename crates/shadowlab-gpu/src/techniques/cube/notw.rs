@@ -221,7 +221,8 @@ impl Technique for CubeNotw {
             for (k, v) in fr.counters {
                 if k == "fetches_per_pixel" {
                     r.counters.insert(k, v);
-                } else if k == "scratch_bytes" || k == "subdiv_triangles_drawn" {
+                } else if k == "scratch_bytes" || k.starts_with("subdiv_") {
+                    // pieces drawn, dropped (holes: subdivision capacity) and queue-full finishes
                     *r.counters.entry(k).or_default() += v;
                 } else if k.ends_with("fraction") || k.ends_with("warp") {
                     r.counters.insert(format!("{k}_face_{name}"), v);

@@ -30,7 +30,7 @@ pub const DEFAULT_RES: f64 = 512.0;
 /// the lower hemisphere, away from the seam; walls cross it.
 pub const DEFAULT_SPLIT: f64 = 0.0;
 /// Subdivision threshold (texels of bend of an edge under the paraboloid mapping). Room light 1,
-/// 1024x1024 output, 512 maps: 1 -> 0.740 % wrong, 0.5 -> 0.704 %, 0.25 -> 0.692 % (docs/bench/dpsm.md);
+/// 1024x1024 output, 512 maps: 1 -> 0.740 % wrong, 0.5 -> 0.704 %, 0.25 -> 0.692 % (docs/bench/point.md);
 /// lower: more pieces (10 k -> 15 k per hemisphere from 0.5 to 0.25), higher: bent edges
 /// (triangles drawn along chords of the paraboloid: misplaced shadow edges, leaks).
 pub const DEFAULT_SUBDIV: f64 = 0.5;
@@ -42,10 +42,11 @@ pub const DEFAULT_NOTW_SUBDIV: f64 = 0.25;
 /// default) -> 0.570 %, 4 -> 0.556, 2 -> 0.551; 4 halves the pieces of 2. Too high: flatter warp.
 pub const DEFAULT_NOTW_BLUR: f64 = 4.0;
 /// Constant bias (texels). The depth between subdivided vertices is interpolated along chords of
-/// the paraboloid, so acne needs more than `sm`'s 0.5. See docs/bench/dpsm.md.
+/// the paraboloid, so acne needs more than `sm`'s 0.5. See docs/bench/point.md.
 pub const DEFAULT_BIAS: f64 = 1.0;
 /// `dpsm-notw`'s constant bias (warped texels), with `DEFAULT_NOTW_NORMAL_OFFSET` and
-/// `DEFAULT_NOTW_WINDOW`. Room / conference / courtyard lantern (wrong %): bias 0.5 -> 0.470 /
+/// `DEFAULT_NOTW_WINDOW`. Room / conference / courtyard lantern (wrong %; these sweeps used a
+/// lantern at (1.9, 2.6, -6.6), since replaced by setups/point-courtyard.toml's): bias 0.5 -> 0.470 /
 /// 0.587 / 0.760 (acne), 1 -> 0.401 / 0.498 / 0.398, 1.25 -> 0.399 / 0.499 / 0.358, 1.5 ->
 /// 0.400 / 0.507 / 0.339. High: leaks (false lit grows).
 pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
@@ -74,28 +75,28 @@ pub const SPLIT: ParamDef = ParamDef {
 const DPSM_SUBDIV: ParamDef = ParamDef {
     default: DEFAULT_SUBDIV,
     doc: "split triangles until the paraboloid mapping (and warp) bends no edge by more than this many texels from its rasterised chord; 0 = off (big triangles drawn as chords: wrong); low: many pieces",
-    source: "seed 002 section 3.3.2 (tessellation needed); value: shadowlab measurement (docs/bench/dpsm.md)",
+    source: "seed 002 section 3.3.2 (tessellation needed); value: shadowlab measurement (docs/bench/point.md)",
     ..warp::SUBDIV
 };
 const NOTW_SUBDIV: ParamDef =
-    ParamDef { default: DEFAULT_NOTW_SUBDIV, source: "shadowlab measurement on room light 1 (docs/bench/dpsm.md)", ..DPSM_SUBDIV };
+    ParamDef { default: DEFAULT_NOTW_SUBDIV, source: "shadowlab measurement on room light 1 (docs/bench/point.md)", ..DPSM_SUBDIV };
 const NOTW_BLUR: ParamDef =
-    ParamDef { default: DEFAULT_NOTW_BLUR, source: "shadowlab measurement on room light 1 (docs/bench/dpsm.md)", ..warp::NOTW_BLUR };
+    ParamDef { default: DEFAULT_NOTW_BLUR, source: "shadowlab measurement on room light 1 (docs/bench/point.md)", ..warp::NOTW_BLUR };
 const DPSM_BIAS: ParamDef =
-    ParamDef { default: DEFAULT_BIAS, source: "shadowlab sweep on room/conference point lights (docs/bench/dpsm.md)", ..sm::BIAS };
+    ParamDef { default: DEFAULT_BIAS, source: "shadowlab sweep on room/conference point lights (docs/bench/point.md)", ..sm::BIAS };
 const NOTW_BIAS: ParamDef = ParamDef {
     default: DEFAULT_NOTW_BIAS,
-    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)",
     ..sm::BIAS
 };
 const NOTW_WINDOW: ParamDef = ParamDef {
     default: DEFAULT_NOTW_WINDOW,
-    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)",
     ..warp::WINDOW
 };
 const NOTW_NORMAL_OFFSET: ParamDef = ParamDef {
     default: DEFAULT_NOTW_NORMAL_OFFSET,
-    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/dpsm.md)",
+    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)",
     ..sm::NORMAL_OFFSET
 };
 
@@ -103,12 +104,12 @@ const NOTW_NORMAL_OFFSET: ParamDef = ParamDef {
 /// through the inverted warp for `dpsm-notw`) instead of the depth interpolated along the chords
 /// of subdivided pieces. Off: on room light 1 it did not help (dpsm 0.740 -> 0.783 % wrong,
 /// dpsm-notw at subdiv 0.25 0.537 -> 0.543) and it disables early depth tests; with fine
-/// subdivision the chords are short. See docs/bench/dpsm.md.
+/// subdivision the chords are short. See docs/bench/point.md.
 pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
 const EXACT: ParamDef = ParamDef {
     default: DEFAULT_EXACT_DEPTH,
     doc: "write the exact depth per fragment: the distance along the fragment's direction (warp inverted by Newton steps for dpsm-notw) to its triangle's plane; false = depth interpolated between (warped) vertices, off along chords of the paraboloid; disables early depth test",
-    source: "shadowlab (docs/bench/dpsm.md)",
+    source: "shadowlab (docs/bench/point.md)",
     ..warp::EXACT_DEPTH
 };
 
