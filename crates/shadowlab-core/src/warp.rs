@@ -251,33 +251,6 @@ pub fn singular_values(a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
     ((tr - d).max(0.0).sqrt(), (tr + d).max(0.0).sqrt())
 }
 
-/// What the bias of a warped map counts in (`footprint` parameter of `notw`/`rtw`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Footprint {
-    /// Divide by the smallest singular value: the warped texel's longest world extent.
-    MinSv = 0,
-    /// Divide by the largest singular value: its shortest world extent.
-    MaxSv = 1,
-    /// Scale 1: cropped (unwarped) texels, the bias of the map without its warp.
-    Cropped = 2,
-    /// Divide by sqrt(det): the texel's mean extent (square root of its area).
-    MeanSv = 3,
-}
-
-/// The warp's local scale that a warped texel's world size is the cropped texel's size divided
-/// by, for Jacobian columns `jx`, `jy` (d warp / d x, d warp / d y), clamped to [min_scale, 1000]
-/// (a collapsed region would otherwise ask for an unbounded bias). The GPU `footprint_scale`.
-pub fn footprint_scale(mode: Footprint, jx: [f32; 2], jy: [f32; 2], min_scale: f32) -> f32 {
-    let (lo, hi) = singular_values(jx, jy);
-    let s = match mode {
-        Footprint::MinSv => lo,
-        Footprint::MaxSv => hi,
-        Footprint::Cropped => 1.0,
-        Footprint::MeanSv => (lo * hi).sqrt(),
-    };
-    s.clamp(min_scale, 1e3)
-}
-
 #[cfg(test)]
 #[path = "warp_tests.rs"]
 mod tests;

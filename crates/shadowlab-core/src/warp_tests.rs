@@ -228,20 +228,3 @@ fn singular_values_by_hand() {
     // rank one: a collapsed direction
     assert!(close(singular_values([1.0, 1.0], [2.0, 2.0]), (0.0, 10f32.sqrt())));
 }
-
-#[test]
-fn footprint_scale_modes_by_hand() {
-    // a warp that compresses x by 4 and magnifies y by 2
-    let (jx, jy) = ([0.25, 0.0], [0.0, 2.0]);
-    assert_eq!(footprint_scale(Footprint::MinSv, jx, jy, 0.125), 0.25);
-    assert_eq!(footprint_scale(Footprint::MaxSv, jx, jy, 0.125), 2.0);
-    assert_eq!(footprint_scale(Footprint::Cropped, jx, jy, 0.125), 1.0);
-    assert!((footprint_scale(Footprint::MeanSv, jx, jy, 0.125) - 0.5f32.sqrt()).abs() < 1e-6);
-    // the clamp: a collapsed direction counts as min_scale
-    assert_eq!(footprint_scale(Footprint::MinSv, [0.01, 0.0], jy, 0.125), 0.125);
-    assert_eq!(footprint_scale(Footprint::MinSv, [0.01, 0.0], jy, 0.5), 0.5);
-    // the identity warp: every mode is the unwarped bias
-    for m in [Footprint::MinSv, Footprint::MaxSv, Footprint::Cropped, Footprint::MeanSv] {
-        assert!((footprint_scale(m, [1.0, 0.0], [0.0, 1.0], 0.125) - 1.0).abs() < 1e-6);
-    }
-}

@@ -268,7 +268,6 @@ fn warp_struct_layouts_match_rust() {
                 ("imp", offset_of!(WarpParams, imp)),
                 ("ints", offset_of!(WarpParams, ints)),
                 ("flags", offset_of!(WarpParams, flags)),
-                ("look", offset_of!(WarpParams, look)),
             ],
         );
     }

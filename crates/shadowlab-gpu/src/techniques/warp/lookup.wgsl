@@ -78,8 +78,7 @@ fn warped_clip(p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
 // Pulls a warped map coordinate t back through the warp: Newton steps on warp(u) = t from the
 // guess u (forward-difference Jacobian over half a texel), each step capped at UNWARP_MAX_STEP
 // cropped texels; the warp has a kink per texel, so the best iterate is kept. Returns (u,
-// residual in warped texels). Shared by the exact depth pass and the receiver-plane test, so
-// both land on the same preimage of a texel centre.
+// residual in warped texels). The exact depth pass (depth_exact.wgsl) uses it.
 fn unwarp(t: vec2<f32>, guess: vec2<f32>) -> vec3<f32> {
     let res = wp.texel.z;
     let h = 0.5 / res;

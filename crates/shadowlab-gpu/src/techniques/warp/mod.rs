@@ -135,9 +135,6 @@ pub struct WarpParams {
     pub imp: [f32; 4],
     pub ints: [u32; 4],
     pub flags: [u32; 4],
-    /// x: bias footprint (`params::FOOTPRINT_*`), y: smallest warp scale the bias divides by
-    /// (`min_scale`), z: `reach`, w: 1 = receiver-plane test (needs `exact_depth`).
-    pub look: [f32; 4],
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -262,12 +259,6 @@ impl Warped {
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
             ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
             flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, kind],
-            look: [
-                opt("footprint", params::FOOTPRINT_MIN_SV) as f32,
-                opt("min_scale", params::DEFAULT_MIN_SCALE) as f32,
-                opt("reach", 0.5) as f32,
-                (opt("receiver_plane", 0.0) != 0.0 && exact) as u32 as f32,
-            ],
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;

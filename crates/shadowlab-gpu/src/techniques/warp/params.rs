@@ -29,8 +29,13 @@ pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
 /// with 0.3 M pieces. Lower: more pieces (time, capacity), higher: bent depth, more bias
 /// needed. See docs/bench/warp.md.
 pub const DEFAULT_SUBDIV: f64 = 1.0;
-/// NoTW's warp bends more (a function per row and column): 2 keeps the piece count near 0.3 M.
-pub const DEFAULT_NOTW_SUBDIV: f64 = 2.0;
+/// NoTW: 1 warped texel (was 2). A piece's edges are chords of the warped triangle's curved
+/// edges, up to this far off; the texels in between get another surface's depth, which shows as
+/// acne where the light grazes a receiver (a thin sliver in the map). 1024x1024, 512 map
+/// (docs/bench/warp.md): 2 -> 1 cuts `notw`'s false shadows on all six setups (courtyard sun
+/// 0.59 -> 0.37 %, courtyard spot 0.28 -> 0.13, sponza sun 0.31 -> 0.11) for ~2x the pieces
+/// (0.1-1.3 M). 0.5 overflows the piece capacity on sponza (0.49 M pieces dropped).
+pub const DEFAULT_NOTW_SUBDIV: f64 = 1.0;
 /// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
 /// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
 /// tessellation factor of 16 (4 levels); measured too few for the big floor triangles here.
@@ -199,68 +204,6 @@ pub const EXACT_DEPTH: ParamDef = ParamDef {
     choices: shadowlab_core::params::BOOL,
 };
 
-/// Bias footprint modes (`footprint`): what one "warped texel" of bias and normal offset means in
-/// world units, i.e. the local warp scale the cropped texel's world size is divided by
-/// (shadowlab-core `warp::footprint_scale`).
-pub const FOOTPRINT_MIN_SV: f64 = 0.0;
-pub const FOOTPRINT_MAX_SV: f64 = 1.0;
-pub const FOOTPRINT_CROPPED: f64 = 2.0;
-pub const FOOTPRINT_MEAN_SV: f64 = 3.0;
-/// Default footprint: the smallest singular value of the warp's Jacobian (the longest world
-/// extent of a warped texel). See `FOOTPRINT` and docs/bench/warp.md.
-pub const DEFAULT_FOOTPRINT: f64 = FOOTPRINT_MIN_SV;
-pub const FOOTPRINT: ParamDef = ParamDef {
-    key: "footprint",
-    default: DEFAULT_FOOTPRINT,
-    min: 0.0,
-    max: 3.0,
-    integer: true,
-    doc: "world size of the warped texel that bias and normal offset count in: 0 = cropped texel / smallest singular value of the warp's Jacobian (longest extent), 1 = / largest (shortest extent), 2 = the cropped texel (no warp), 3 = / sqrt(det) (mean)",
-    source: "shadowlab measurement (docs/bench/warp.md)",
-    choices: &[],
-};
-/// Smallest warp scale the bias footprint divides by: a warped texel counts as at most
-/// 1 / min_scale cropped texels. Low: huge offsets where the warp collapses unsampled regions
-/// (leaks, peter-panning), high: too little bias where the warp compresses (acne).
-pub const DEFAULT_MIN_SCALE: f64 = 0.125;
-pub const MIN_SCALE: ParamDef = p(
-    "min_scale",
-    DEFAULT_MIN_SCALE,
-    0.001,
-    1.0,
-    false,
-    "clamp on the warp scale the bias footprint divides by (a warped texel counts as at most 1/min_scale cropped texels)",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-
-/// Secant reach of the warp's Jacobian for the bias footprint (cropped texels): the scale is the
-/// smaller of the central differences over +-0.5 and +-reach cropped texels. 0.5 = local only.
-pub const DEFAULT_REACH: f64 = 0.5;
-pub const REACH: ParamDef = p(
-    "reach",
-    DEFAULT_REACH,
-    0.5,
-    64.0,
-    false,
-    "the bias footprint also takes the warp's secants over +-reach cropped texels (the smaller scale): a warped texel reaches back into neighbouring, more compressed texels; 0.5 = the local Jacobian only; high: more bias (leaks)",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-
-/// Receiver-plane depth test (needs `exact_depth`): compare the stored texel's depth with the
-/// receiver's own plane at the same point, the preimage of the texel's centre. See
-/// docs/bench/warp.md.
-pub const DEFAULT_RECEIVER_PLANE: f64 = 0.0;
-pub const RECEIVER_PLANE: ParamDef = ParamDef {
-    key: "receiver_plane",
-    default: DEFAULT_RECEIVER_PLANE,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "compare each texel's exact depth with the receiver's plane (through the biased point, from the G-buffer normal) at the preimage of the texel's centre instead of the point's own depth: no footprint x slope acne on planar receivers; needs exact_depth; one warp inversion (up to 9 lookups) per tap",
-    source: "receiver plane depth bias: Isidoro 2006, here exact through the warp inversion; shadowlab measurement (docs/bench/warp.md)",
-    choices: shadowlab_core::params::BOOL,
-};
-
 const NOTW_EXACT: ParamDef = ParamDef { default: DEFAULT_NOTW_EXACT_DEPTH, ..EXACT_DEPTH };
 
 pub const NOTW_PARAMS: &[ParamDef] = &[
@@ -279,10 +222,6 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     MAX_SLOPE,
     NORMAL_OFFSET,
     DV_MARGIN,
-    FOOTPRINT,
-    MIN_SCALE,
-    REACH,
-    RECEIVER_PLANE,
 ];
 pub const RTW_PARAMS: &[ParamDef] = &[
     RES,
@@ -300,9 +239,5 @@ pub const RTW_PARAMS: &[ParamDef] = &[
     MAX_SLOPE,
     NORMAL_OFFSET,
     DV_MARGIN,
-    FOOTPRINT,
-    MIN_SCALE,
-    REACH,
-    RECEIVER_PLANE,
 ];
 pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];

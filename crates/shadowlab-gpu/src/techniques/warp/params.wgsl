@@ -25,11 +25,6 @@ struct WarpParams {
     // (f32 bits); z: 1 = exact depth per fragment (depth_exact.wgsl); w: projection kind
     // (PLANAR, or PARABOLOID_FRONT / _BACK: one hemisphere of a point light, paraboloid.rs)
     flags: vec4<u32>,
-    // x: bias footprint: 0 = 1 / smallest singular value of the warp's Jacobian, 1 = 1 / largest,
-    // 2 = 1 (cropped, unwarped texels), 3 = 1 / sqrt(det); y: smallest scale divided by;
-    // z: `reach` (cropped texels; > 0.5: also the Jacobian's secants over +-reach, the smaller scale);
-    // w: 1 = receiver-plane depth test (eval.wgsl `receiver_depth`)
-    look: vec4<f32>,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.
