@@ -38,36 +38,6 @@ fn singular_values(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
     return sqrt(max(vec2<f32>(tr - d, tr + d), vec2<f32>(0.0)));
 }
 
-// EXPERIMENT: depth gradient (x, y) over cropped coordinates of the plane through p with normal
-// n; z = 0 when seen edge-on.
-fn receiver_gradient(p: vec3<f32>, n: vec3<f32>, size: f32, r: vec4<f32>) -> vec3<f32> {
-    var a = vec3<f32>(1.0, 0.0, 0.0);
-    if abs(n.x) > 0.8 {
-        a = vec3<f32>(0.0, 1.0, 0.0);
-    }
-    let t1 = normalize(cross(n, a));
-    let t2 = cross(n, t1);
-    let c0 = base_clip(wp, p);
-    let c1 = base_clip(wp, p + t1 * size);
-    let c2 = base_clip(wp, p + t2 * size);
-    if min(min(c0.w, c1.w), c2.w) <= 1e-7 {
-        return vec3<f32>(0.0);
-    }
-    let m0 = clip_to_map(c0);
-    let m1 = clip_to_map(c1);
-    let m2 = clip_to_map(c2);
-    let v0 = to_dv(m0.xy, r);
-    let e1 = to_dv(m1.xy, r) - v0;
-    let e2 = to_dv(m2.xy, r) - v0;
-    let det = e1.x * e2.y - e1.y * e2.x;
-    if det * det <= 1e-6 * dot(e1, e1) * dot(e2, e2) || det == 0.0 {
-        return vec3<f32>(0.0);
-    }
-    let d1 = m1.z - m0.z;
-    let d2 = m2.z - m0.z;
-    return vec3<f32>((d1 * e2.y - d2 * e1.y) / det, (e1.x * d2 - e2.x * d1) / det, 1.0);
-}
-
 // Central-difference Jacobian of the warp at u over +-h: columns d warp / dx, d warp / dy.
 fn jacobian(u: vec2<f32>, h: f32) -> mat2x2<f32> {
     let jx = (warp(u + vec2<f32>(h, 0.0)) - warp(u - vec2<f32>(h, 0.0))) / (2.0 * h);
@@ -107,25 +77,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     if wp.cfg.z > 0.5 {
         let j = jacobian(u0, 0.5 / res);
-        // EXPERIMENT: anisotropic depth bias. The receiver's depth gradient g over cropped
-        // coordinates; its largest deviation over one warped texel is |J^-T g|_1 / res.
-        if !is_paraboloid(wp) && wp.texel.w < 1.5 {
-            let g = receiver_gradient(p, n, texel, r);
-            let det = j[0].x * j[1].y - j[1].x * j[0].y;
-            if g.z != 0.0 && abs(det) > 1e-6 {
-                // solve J^T y = g (J columns j[0], j[1])
-                let y = vec2<f32>(j[1].y * g.x - j[0].y * g.y, -j[1].x * g.x + j[0].x * g.y) / det;
-                let dz = (abs(y.x) + abs(y.y)) / res;
-                let me = clip_to_map(base_clip(wp, p + l * (wp.bias.z * texel)));
-                let z = m0.z - wp.bias.x * dz - abs(me.z - m0.z);
-                if all(c0 >= vec2<f32>(0.0)) && all(c0 <= vec2<f32>(1.0)) && m0.z <= 1.0 {
-                    visibility[s.i] = textureSampleCompareLevel(shadow_map, cmp, c0, z);
-                } else {
-                    visibility[s.i] = 1.0;
-                }
-                return;
-            }
-        }
         // clamped: a collapsed (unsampled) region would ask for an unbounded bias
         texel /= clamp(singular_values(j[0], j[1]).x, MIN_WARP_SCALE, 1e3);
     }
