@@ -239,6 +239,18 @@ pub fn grow_rect(lo: [f32; 2], hi: [f32; 2], res: usize, margin: f32) -> ([f32; 
     (a, b)
 }
 
+/// Singular values (smallest, largest) of the 2x2 matrix with columns `a` and `b` (the warp's
+/// Jacobian from finite differences; the GPU `singular_values` in eval.wgsl).
+pub fn singular_values(a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
+    let e = a[0] * a[0] + a[1] * a[1];
+    let g = b[0] * b[0] + b[1] * b[1];
+    let f = a[0] * b[0] + a[1] * b[1];
+    let tr = 0.5 * (e + g);
+    let det = e * g - f * f;
+    let d = (tr * tr - det).max(0.0).sqrt();
+    ((tr - d).max(0.0).sqrt(), (tr + d).max(0.0).sqrt())
+}
+
 #[cfg(test)]
 #[path = "warp_tests.rs"]
 mod tests;

@@ -214,3 +214,17 @@ fn interpolated_warp_is_continuous_across_rows() {
     let (b, _) = e.warp.apply(0.4, 0.5 + 1e-5);
     assert!((a - b).abs() > 1e-3, "rows 7 and 8 happen to agree: the test needs other points");
 }
+
+#[test]
+fn singular_values_by_hand() {
+    // identity, a diagonal scale, a rotation (both 1) and a shear [[1, 1], [0, 1]] (golden ratio)
+    let close = |a: (f32, f32), b: (f32, f32)| (a.0 - b.0).abs() < 1e-5 && (a.1 - b.1).abs() < 1e-5;
+    assert!(close(singular_values([1.0, 0.0], [0.0, 1.0]), (1.0, 1.0)));
+    assert!(close(singular_values([0.25, 0.0], [0.0, 3.0]), (0.25, 3.0)));
+    let (c, s) = (0.6f32, 0.8f32);
+    assert!(close(singular_values([2.0 * c, 2.0 * s], [-0.5 * s, 0.5 * c]), (0.5, 2.0)));
+    let phi = (1.0 + 5f32.sqrt()) / 2.0;
+    assert!(close(singular_values([1.0, 0.0], [1.0, 1.0]), (1.0 / phi, phi)));
+    // rank one: a collapsed direction
+    assert!(close(singular_values([1.0, 1.0], [2.0, 2.0]), (0.0, 10f32.sqrt())));
+}

@@ -212,14 +212,13 @@ fn wrong_pixel_ordering_on_courtyard() {
         compare(&run.visibility, &rt.visibility, &v.mask).wrong_pct
     };
     let (sm, rtw, notw, dv) = (wrong("sm"), wrong("rtw"), wrong("notw"), wrong("notw-dv"));
-    let interp = wrong("notw:exact_depth=false,bias=2");
-    eprintln!("courtyard 512: sm {sm:.3} rtw {rtw:.3} notw {notw:.3} (interpolated depth {interp:.3}) notw-dv {dv:.3}");
-    // The issue asks for notw < rtw < sm. Measured 2026-11-22 (docs/bench/warp.md): sm 1.45,
-    // rtw 0.57, notw 1.08 (exact depth, bias 1.5; interpolated depth at bias 2: 1.23), notw-dv
-    // 0.85: rtw beats notw here, so that part is not asserted.
+    eprintln!("courtyard 512: sm {sm:.3} rtw {rtw:.3} notw {notw:.3} notw-dv {dv:.3}");
+    // The issue asks for notw < rtw < sm. Measured 2026-11-22 (docs/bench/warp.md): sm 1.445,
+    // rtw 0.573, notw 0.860 (exact depth, bias 1.5, subdiv 1; subdiv 2: 1.08), notw-dv 0.847:
+    // rtw beats notw here, so that part is not asserted. (At subdiv 1 the interpolated depth,
+    // `exact_depth=false,bias=2`, gives 0.857: exact depth is checked by the next test.)
     assert!(rtw < 0.6 * sm, "rtw {rtw:.3} vs sm {sm:.3}");
-    assert!(notw < 0.8 * sm, "notw {notw:.3} vs sm {sm:.3}");
-    assert!(notw < 0.95 * interp, "notw {notw:.3} vs interpolated depth {interp:.3}");
+    assert!(notw < 0.7 * sm, "notw {notw:.3} vs sm {sm:.3}");
     assert!(dv < 0.8 * sm, "notw-dv {dv:.3} vs sm {sm:.3}");
 }
 
@@ -267,4 +266,30 @@ fn triangles_behind_a_spot_light_are_clipped_before_warping() {
     if clipped > 4.0 * sm.max(0.5) {
         panic!("clipped notw {clipped:.2} % vs sm {sm:.2} %; {}", save_images("notw_room_spot", &v, &run, &rt));
     }
+}
+
+/// The subdivision threshold: a piece's edges are chords of the warped triangle's curved edges,
+/// up to `subdiv` warped texels off, and the texels in between get another surface's depth.
+/// Receivers that the light sees at a grazing angle are thin slivers in the map, so that error
+/// shows as acne there (false shadows); halving the threshold must remove much of it.
+#[test]
+fn finer_subdivision_removes_grazing_acne_on_courtyard() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 512);
+    let rt = lab.reference(&v, 1).unwrap();
+    let errors = |spec: &str| {
+        let run = lab.run(&v, &TechniqueSpec::parse(spec).unwrap(), 1).unwrap();
+        compare(&run.visibility, &rt.visibility, &v.mask)
+    };
+    let fine = errors("notw");
+    let coarse = errors("notw:subdiv=2");
+    eprintln!(
+        "courtyard 512: notw (subdiv 1) {:.3} % (false shadow {:.3}), subdiv 2 {:.3} (false shadow {:.3})",
+        fine.wrong_pct, fine.false_shadow_pct, coarse.wrong_pct, coarse.false_shadow_pct
+    );
+    // Measured 2026-11-22: subdiv 1 0.860 % (false shadow 0.357), subdiv 2 1.084 (0.559).
+    assert!(fine.false_shadow_pct < 0.8 * coarse.false_shadow_pct, "subdiv 1 {fine:?} vs subdiv 2 {coarse:?}");
+    assert!(fine.wrong_pct < 0.9 * coarse.wrong_pct, "subdiv 1 {fine:?} vs subdiv 2 {coarse:?}");
 }

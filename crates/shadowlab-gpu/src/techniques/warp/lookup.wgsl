@@ -74,3 +74,47 @@ fn warped_clip(p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
     let u = warp(to_dv(clip_to_map(a).xy, r));
     return vec4<f32>((u.x * 2.0 - 1.0) * a.w, (1.0 - 2.0 * u.y) * a.w, a.z, a.w);
 }
+
+// Pulls a warped map coordinate t back through the warp: Newton steps on warp(u) = t from the
+// guess u (forward-difference Jacobian over half a texel), each step capped at UNWARP_MAX_STEP
+// cropped texels; the warp has a kink per texel, so the best iterate is kept. Returns (u,
+// residual in warped texels). The exact depth pass (depth_exact.wgsl) uses it.
+fn unwarp(t: vec2<f32>, guess: vec2<f32>) -> vec3<f32> {
+    let res = wp.texel.z;
+    let h = 0.5 / res;
+    var u = guess;
+    var best = u;
+    var best_e = 1e30;
+    for (var i = 0; i <= UNWARP_STEPS; i++) {
+        let w = warp(u);
+        let f = w - t;
+        let e = dot(f, f);
+        if e < best_e {
+            best_e = e;
+            best = u;
+        }
+        if i == UNWARP_STEPS || e < UNWARP_TOLERANCE * UNWARP_TOLERANCE / (res * res) {
+            break;
+        }
+        let jx = (warp(u + vec2<f32>(h, 0.0)) - w) / h;
+        let jy = (warp(u + vec2<f32>(0.0, h)) - w) / h;
+        let det = jx.x * jy.y - jy.x * jx.y;
+        if abs(det) < 1e-6 {
+            break;
+        }
+        var s = vec2<f32>(jy.y * f.x - jy.x * f.y, jx.x * f.y - jx.y * f.x) / det;
+        let len = length(s);
+        if len > UNWARP_MAX_STEP / res {
+            s *= UNWARP_MAX_STEP / res / len;
+        }
+        u -= s;
+    }
+    return vec3<f32>(best, sqrt(best_e) * res);
+}
+
+// Newton steps: the screen-linear guess is within the bend threshold (1-2 texels) of the answer.
+const UNWARP_STEPS: i32 = 3;
+// Converged when the warped point is this close to the target (warped texels).
+const UNWARP_TOLERANCE: f32 = 0.01;
+// Largest Newton step (cropped texels).
+const UNWARP_MAX_STEP: f32 = 4.0;

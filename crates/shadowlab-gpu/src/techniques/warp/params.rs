@@ -29,8 +29,13 @@ pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
 /// with 0.3 M pieces. Lower: more pieces (time, capacity), higher: bent depth, more bias
 /// needed. See docs/bench/warp.md.
 pub const DEFAULT_SUBDIV: f64 = 1.0;
-/// NoTW's warp bends more (a function per row and column): 2 keeps the piece count near 0.3 M.
-pub const DEFAULT_NOTW_SUBDIV: f64 = 2.0;
+/// NoTW: 1 warped texel (was 2). A piece's edges are chords of the warped triangle's curved
+/// edges, up to this far off; the texels in between get another surface's depth, which shows as
+/// acne where the light grazes a receiver (a thin sliver in the map). 1024x1024, 512 map
+/// (docs/bench/warp.md): 2 -> 1 cuts `notw`'s false shadows on all six setups (courtyard sun
+/// 0.59 -> 0.37 %, courtyard spot 0.28 -> 0.13, sponza sun 0.31 -> 0.11) for ~2x the pieces
+/// (0.1-1.3 M). 0.5 overflows the piece capacity on sponza (0.49 M pieces dropped).
+pub const DEFAULT_NOTW_SUBDIV: f64 = 1.0;
 /// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
 /// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
 /// tessellation factor of 16 (4 levels); measured too few for the big floor triangles here.
