@@ -173,15 +173,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    let o = s.p + s.n * light.eps;
-    var d = -light.direction.xyz;
-    var tmax = 1e30;
-    if light.kind != LIGHT_DIRECTIONAL {
-        let to = light.position.xyz - o;
-        tmax = length(to);
-        d = to / tmax;
-    }
-    hits[s.i] = select(0u, 1u, occluded_static(o, d, tmax)) | select(0u, 2u, occluded_dynamic(o, d, tmax));
+    let r = shadow_ray(s.p, s.n);
+    hits[s.i] = select(0u, 1u, occluded_static(r.o, r.d, r.tmax)) | select(0u, 2u, occluded_dynamic(r.o, r.d, r.tmax));
 }
 "#;
 

@@ -104,16 +104,29 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> bool {
     return occluded_static(o, d, tmax) || occluded_dynamic(o, d, tmax);
 }
 
-// True where the light is blocked for a surface point `p` with geometric normal `n` (the ray
-// starts `light.eps` off the surface, as in `shadowlab_core::bvh::shadow_ray`).
-fn sample_shadowed(p: vec3<f32>, n: vec3<f32>) -> bool {
-    let o = p + n * light.eps;
-    var d = -light.direction.xyz;
-    var tmax = 1e30;
+struct ShadowRay {
+    o: vec3<f32>,
+    d: vec3<f32>,
+    tmax: f32,
+}
+
+// The shadow ray of a surface point `p` with geometric normal `n`: it starts `light.eps` off the
+// surface and ends at the light (as `shadowlab_core::bvh::shadow_ray`).
+fn shadow_ray(p: vec3<f32>, n: vec3<f32>) -> ShadowRay {
+    var r: ShadowRay;
+    r.o = p + n * light.eps;
+    r.d = -light.direction.xyz;
+    r.tmax = 1e30;
     if light.kind != LIGHT_DIRECTIONAL {
-        let to = light.position.xyz - o;
-        tmax = length(to);
-        d = to / tmax;
+        let to = light.position.xyz - r.o;
+        r.tmax = length(to);
+        r.d = to / r.tmax;
     }
-    return occluded(o, d, tmax);
+    return r;
+}
+
+// True where the light is blocked for a surface point `p` with geometric normal `n`.
+fn sample_shadowed(p: vec3<f32>, n: vec3<f32>) -> bool {
+    let r = shadow_ray(p, n);
+    return occluded(r.o, r.d, r.tmax);
 }
