@@ -40,12 +40,25 @@ pub fn scene_pipeline(
     })
 }
 
-/// Begins a render pass that clears `colors` (to transparent) and `depth` (to 1).
+/// Begins a render pass that clears `colors` (to transparent) and `depth` (to 1), both stored.
 pub fn begin_pass<'e>(
     enc: &'e mut wgpu::CommandEncoder,
     label: &str,
     colors: &[&wgpu::TextureView],
     depth: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    begin_pass_with(enc, label, colors, wgpu::Color::TRANSPARENT, depth, wgpu::StoreOp::Store)
+}
+
+/// Begins a render pass that clears `colors` to `clear` and `depth` to 1; `depth_store`
+/// `Discard` for passes whose depth only resolves visibility (maps written as colour).
+pub fn begin_pass_with<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    colors: &[&wgpu::TextureView],
+    clear: wgpu::Color,
+    depth: &wgpu::TextureView,
+    depth_store: wgpu::StoreOp,
 ) -> wgpu::RenderPass<'e> {
     let atts: Vec<Option<wgpu::RenderPassColorAttachment>> = colors
         .iter()
@@ -54,7 +67,7 @@ pub fn begin_pass<'e>(
                 view: v,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
             })
         })
         .collect();
@@ -63,7 +76,7 @@ pub fn begin_pass<'e>(
         color_attachments: &atts,
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: depth,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: depth_store }),
             stencil_ops: None,
         }),
         timestamp_writes: None,

@@ -45,20 +45,7 @@ fn visibility_of(m: vec4<f32>, d: f32) -> f32 {
 }
 
 fn visibility_gather(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
-    switch fp.mode.x {
-        case 0u: {
-            return vsm_visibility_gather(z, w, d, fp.shape.x);
-        }
-        case 1u: {
-            return esm_visibility_gather(z, w, d, fp.shape.y);
-        }
-        case 2u: {
-            return evsm_visibility_gather(z, w, d, fp.shape.z, fp.shape.w, fp.shape.x);
-        }
-        default: {
-            return msm_visibility_gather(z, w, d, fp.bias.x);
-        }
-    }
+    return visibility_gather_of(fp.mode.x, z, w, d, fp.shape, fp.bias.x);
 }
 
 // The 2x2 texels around uv on mip `level`, interpolated bilinearly (same texels and weights

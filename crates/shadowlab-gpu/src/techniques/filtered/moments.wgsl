@@ -117,6 +117,26 @@ fn msm_visibility_gather(z: vec4<f32>, w: vec4<f32>, d: f32, bias: f32) -> f32 {
     return msm_visibility(m, d, bias);
 }
 
+// The visibility of representation `mode` (0 VSM, 1 ESM, 2 EVSM, else MSM) rebuilt from a 2x2
+// gather `z` with bilinear weights `w`, for receiver depth `d`. `shape`: (minimum variance, ESM
+// c, EVSM c+, EVSM c-); `moment_bias`: MSM's.
+fn visibility_gather_of(mode: u32, z: vec4<f32>, w: vec4<f32>, d: f32, shape: vec4<f32>, moment_bias: f32) -> f32 {
+    switch mode {
+        case 0u: {
+            return vsm_visibility_gather(z, w, d, shape.x);
+        }
+        case 1u: {
+            return esm_visibility_gather(z, w, d, shape.y);
+        }
+        case 2u: {
+            return evsm_visibility_gather(z, w, d, shape.z, shape.w, shape.x);
+        }
+        default: {
+            return msm_visibility_gather(z, w, d, moment_bias);
+        }
+    }
+}
+
 // Bilinear weights in gather order for uv on a res x res map.
 fn gather_weights(uv: vec2<f32>, res: f32) -> vec4<f32> {
     let f = fract(uv * res - 0.5);

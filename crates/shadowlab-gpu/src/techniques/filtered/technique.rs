@@ -168,23 +168,8 @@ impl Technique for Filtered {
         let map_view = mip0(&self.map);
         let depth_view = self.depth.create_view(&Default::default());
         timer.stage(gpu, &format!("{name}.render"), |enc| {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&format!("{name}.render")),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &map_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(self.clear), store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let label = format!("{name}.render");
+            let mut pass = raster::begin_pass_with(enc, &label, &[&map_view], self.clear, &depth_view, wgpu::StoreOp::Discard);
             pass.set_pipeline(&self.render_pipeline);
             pass.set_bind_group(0, &self.render_group, &[]);
             pass.set_bind_group(1, &f.scene.group, &[]);

@@ -80,20 +80,7 @@ fn cube_face(d: vec3<f32>) -> u32 {
 }
 
 fn base_visibility(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
-    switch lp.mode.y {
-        case 0u: {
-            return vsm_visibility_gather(z, w, d, lp.shape.x);
-        }
-        case 1u: {
-            return esm_visibility_gather(z, w, d, lp.shape.y);
-        }
-        case 2u: {
-            return evsm_visibility_gather(z, w, d, lp.shape.z, lp.shape.w, lp.shape.x);
-        }
-        default: {
-            return msm_visibility_gather(z, w, d, lp.bias.x);
-        }
-    }
+    return visibility_gather_of(lp.mode.y, z, w, d, lp.shape, lp.bias.x);
 }
 
 // Mask bits of pixel i (one light in the low 3 bits of a `history.z`-bit texel, packed in words).

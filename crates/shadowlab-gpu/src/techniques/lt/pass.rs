@@ -218,24 +218,8 @@ impl LeakTracing {
             ..Default::default()
         });
         let depth_view = self.depth.create_view(&Default::default());
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(label),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &view,
-                depth_slice: None,
-                resolve_target: None,
-                // the farthest depth where nothing is drawn
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::WHITE), store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        // cleared to the farthest depth where nothing is drawn
+        let mut pass = raster::begin_pass_with(enc, label, &[&view], wgpu::Color::WHITE, &depth_view, wgpu::StoreOp::Discard);
         pass.set_pipeline(&self.render_pipeline);
         pass.set_bind_group(0, &self.map_uniforms[layer].1, &[]);
         pass.set_bind_group(1, &f.scene.group, &[]);
