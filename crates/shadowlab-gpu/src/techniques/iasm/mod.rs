@@ -33,15 +33,16 @@ const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
 const PROBE_WGSL: &str = include_str!("probe.wgsl");
 const ATLAS_WGSL: &str = include_str!("atlas.wgsl");
 const EVAL_ATLAS_WGSL: &str = include_str!("eval_atlas.wgsl");
+const EVAL_MAIN_WGSL: &str = include_str!("eval_main.wgsl");
 
 fn analysis_src() -> String {
     compose_view(&format!("{PARAMS_WGSL}{ANALYSIS_WGSL}"), false)
 }
 fn eval_src() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{EVAL_WGSL}"), false)
+    compose_view(&format!("{PARAMS_WGSL}{EVAL_WGSL}{EVAL_MAIN_WGSL}"), false)
 }
 fn eval_atlas_src() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{EVAL_ATLAS_WGSL}"), false)
+    compose_view(&format!("{PARAMS_WGSL}{EVAL_ATLAS_WGSL}{EVAL_MAIN_WGSL}"), false)
 }
 fn probe_src() -> String {
     compose(&format!("{PARAMS_WGSL}{PROBE_WGSL}"), false)
