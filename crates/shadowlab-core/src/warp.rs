@@ -251,6 +251,23 @@ pub fn singular_values(a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
     ((tr - d).max(0.0).sqrt(), (tr + d).max(0.0).sqrt())
 }
 
+/// World extent along the unit direction `m` of one warped texel (eval.wgsl
+/// `gradient_footprint`, bias mode 2). `a1`, `a2`: cropped texels per metre along two
+/// orthonormal world directions across the light (the columns of A); `j0`, `j1`: the warp's
+/// Jacobian columns (warped per cropped); `m`: the receiver's depth-gradient direction in that
+/// world basis. One warped texel spans the columns of M = A^-1 J^-1 metres; its extent along m
+/// is |M^T m| = |J^-T A^-T m|. None when A or J is singular.
+pub fn gradient_footprint(a1: [f32; 2], a2: [f32; 2], j0: [f32; 2], j1: [f32; 2], m: [f32; 2]) -> Option<f32> {
+    // solve X^T y = v for the 2x2 matrix X with columns c0, c1
+    let solve_t = |c0: [f32; 2], c1: [f32; 2], v: [f32; 2]| {
+        let det = c0[0] * c1[1] - c1[0] * c0[1];
+        (det.abs() > 1e-12).then(|| [(c1[1] * v[0] - c0[1] * v[1]) / det, (-c1[0] * v[0] + c0[0] * v[1]) / det])
+    };
+    let y = solve_t(a1, a2, m)?;
+    let z = solve_t(j0, j1, y)?;
+    Some((z[0] * z[0] + z[1] * z[1]).sqrt())
+}
+
 #[cfg(test)]
 #[path = "warp_tests.rs"]
 mod tests;

@@ -228,3 +228,26 @@ fn singular_values_by_hand() {
     // rank one: a collapsed direction
     assert!(close(singular_values([1.0, 1.0], [2.0, 2.0]), (0.0, 10f32.sqrt())));
 }
+
+#[test]
+fn gradient_footprint_by_hand() {
+    let close = |a: Option<f32>, b: f32| (a.unwrap() - b).abs() < 1e-5;
+    // texels of 0.1 m (10 texels per metre), no warp: 0.1 m in every direction
+    let (a1, a2) = ([10.0, 0.0], [0.0, 10.0]);
+    let id = ([1.0, 0.0], [0.0, 1.0]);
+    assert!(close(gradient_footprint(a1, a2, id.0, id.1, [1.0, 0.0]), 0.1));
+    assert!(close(gradient_footprint(a1, a2, id.0, id.1, [0.6, 0.8]), 0.1));
+    // the warp magnifies x 4x and compresses y 2x: along x 0.025 m, along y 0.2 m, whereas the
+    // isotropic mode 0 takes 0.1 / (smallest singular value 0.5) = 0.2 m for both
+    let (j0, j1) = ([4.0, 0.0], [0.0, 0.5]);
+    assert!(close(gradient_footprint(a1, a2, j0, j1, [1.0, 0.0]), 0.025));
+    assert!(close(gradient_footprint(a1, a2, j0, j1, [0.0, 1.0]), 0.2));
+    // a rotated crop (A a rotation by 90 degrees): the magnified map axis is world y
+    assert!(close(gradient_footprint([0.0, 10.0], [-10.0, 0.0], j0, j1, [0.0, 1.0]), 0.025));
+    // a shear [[1, 1], [0, 1]]: a warped texel spans (1, 0) and (-1, 1) cropped texels, extent
+    // along x sqrt(1 + 1) = 1.414 texels (|J^-T m| with J^-T = [[1, 0], [-1, 1]])
+    assert!(close(gradient_footprint(a1, a2, [1.0, 0.0], [1.0, 1.0], [1.0, 0.0]), 0.1 * 2f32.sqrt()));
+    // singular warp or projection
+    assert!(gradient_footprint(a1, a2, [1.0, 1.0], [2.0, 2.0], [1.0, 0.0]).is_none());
+    assert!(gradient_footprint([1.0, 0.0], [2.0, 0.0], id.0, id.1, [1.0, 0.0]).is_none());
+}

@@ -268,6 +268,7 @@ fn warp_struct_layouts_match_rust() {
                 ("imp", offset_of!(WarpParams, imp)),
                 ("ints", offset_of!(WarpParams, ints)),
                 ("flags", offset_of!(WarpParams, flags)),
+                ("ext", offset_of!(WarpParams, ext)),
             ],
         );
     }

@@ -111,7 +111,13 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
         }
         o.plane = plane;
         if plane.w != 0.0 {
-            let z = vec3<f32>(clip_to_map(pc[0]).z, clip_to_map(pc[1]).z, clip_to_map(pc[2]).z);
+            var z = vec3<f32>(clip_to_map(pc[0]).z, clip_to_map(pc[1]).z, clip_to_map(pc[2]).z);
+            if wp.ext.w > 0.5 {
+                // the whole triangle's corners: a piece's chords cover up to `subdiv` warped
+                // texels of its curved neighbours, whose plane depth lies outside its own range
+                z = vec3<f32>(clip_to_map(base_clip(wp, vertices[3u * t].pos)).z,
+                    clip_to_map(base_clip(wp, vertices[3u * t + 1u].pos)).z, clip_to_map(base_clip(wp, vertices[3u * t + 2u].pos)).z);
+            }
             o.zrange = vec2<f32>(min(min(z.x, z.y), z.z), max(max(z.x, z.y), z.z));
         }
     }

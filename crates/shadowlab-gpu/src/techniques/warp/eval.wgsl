@@ -1,11 +1,13 @@
 // Warped shadow-map evaluation: each evaluated sample is offset (normal offset, constant and
 // slope-scaled bias) in world units of one *warped* texel at the sample, projected, cropped to
 // the desired view, warped through the same function as the depth pass, and compared with an
-// NxN kernel of warped texels. The warped texel's world size is the cropped texel divided by
-// the smallest singular value of the warp's Jacobian (finite differences over one texel):
-// where the warp magnifies, texels shrink and so does the bias (docs/bench/warp.md compares
-// the largest singular value, sqrt(det) and no division: all worse overall). Also counts the samples per
-// warped texel (sampling statistics after warping).
+// NxN kernel of warped texels. The warped texel's world size (`bias_mode`, ext.y) comes from the
+// warp's Jacobian J (finite differences over one texel): mode 0, the cropped texel divided by
+// the smallest singular value of J (isotropic: the largest footprint, which leaks where the
+// warp compresses one direction); mode 1, divided only where J magnifies every direction; mode
+// 2 (notw's default), the footprint along the receiver's depth-gradient direction,
+// `gradient_footprint` (docs/bench/warp_bias.md). Also counts the samples per warped texel
+// (sampling statistics after warping).
 
 @group(0) @binding(10) var shadow_map: texture_depth_2d;
 @group(0) @binding(11) var cmp: sampler_comparison;
@@ -36,6 +38,47 @@ fn singular_values(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
     let det = e * g - f * f;
     let d = sqrt(max(tr * tr - det, 0.0));
     return sqrt(max(vec2<f32>(tr - d, tr + d), vec2<f32>(0.0)));
+}
+
+// World footprint of one warped texel along the receiver's depth-gradient direction (bias mode
+// 2): m = the unit direction, across the light, in which the receiver's depth changes (the
+// normal's part across l); A = d(cropped texels)/d(metres) across the light at p (two projected
+// steps); J = the warp's Jacobian. One warped texel spans M = A^-1 J^-1 metres, so its extent
+// along m is |M^T m| = |J^-T A^-T m|. Where the receiver faces the light (no gradient), the
+// geometric mean T / sqrt(det J). Capped at `ext.z` cropped texels (0: 1 / MIN_WARP_SCALE).
+// `t`: world size of one cropped texel at p.
+fn gradient_footprint(p: vec3<f32>, n: vec3<f32>, l: vec3<f32>, r: vec4<f32>, j: mat2x2<f32>, t: f32) -> f32 {
+    let res = wp.texel.z;
+    let cap = select(1.0 / MIN_WARP_SCALE, wp.ext.z, wp.ext.z > 0.0) * t;
+    let detj = j[0].x * j[1].y - j[1].x * j[0].y;
+    let geo = t / sqrt(max(abs(detj), 1e-12));
+    var a = vec3<f32>(1.0, 0.0, 0.0);
+    if abs(l.x) > 0.8 {
+        a = vec3<f32>(0.0, 1.0, 0.0);
+    }
+    let e1 = normalize(cross(l, a));
+    let e2 = cross(l, e1);
+    let lat = vec2<f32>(dot(n, e1), dot(n, e2));
+    let c0 = base_clip(wp, p);
+    let c1 = base_clip(wp, p + e1 * t);
+    let c2 = base_clip(wp, p + e2 * t);
+    if length(lat) < 1e-3 || min(min(c0.w, c1.w), c2.w) <= 1e-7 || abs(detj) < 1e-12 {
+        return min(geo, cap);
+    }
+    let m = lat / length(lat);
+    let v0 = to_dv(clip_to_map(c0).xy, r) * res;
+    // columns: cropped texels per metre along e1, e2
+    let a1 = (to_dv(clip_to_map(c1).xy, r) * res - v0) / t;
+    let a2 = (to_dv(clip_to_map(c2).xy, r) * res - v0) / t;
+    let deta = a1.x * a2.y - a2.x * a1.y;
+    if abs(deta) < 1e-12 {
+        return min(geo, cap);
+    }
+    // y = A^-T m: solve A^T y = m (rows of A^T: a1, a2)
+    let y = vec2<f32>(a2.y * m.x - a1.y * m.y, -a2.x * m.x + a1.x * m.y) / deta;
+    // z = J^-T y: solve J^T z = y (rows of J^T: j[0], j[1])
+    let z = vec2<f32>(j[1].y * y.x - j[0].y * y.y, -j[1].x * y.x + j[0].x * y.y) / detj;
+    return min(length(z), cap);
 }
 
 // Central-difference Jacobian of the warp at u over +-h: columns d warp / dx, d warp / dy.
@@ -77,8 +120,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     if wp.cfg.z > 0.5 {
         let j = jacobian(u0, 0.5 / res);
-        // clamped: a collapsed (unsampled) region would ask for an unbounded bias
-        texel /= clamp(singular_values(j[0], j[1]).x, MIN_WARP_SCALE, 1e3);
+        let sv = singular_values(j[0], j[1]);
+        if wp.ext.y > 1.5 {
+            texel = gradient_footprint(p, n, l, r, j, texel);
+        } else if wp.ext.y > 0.5 {
+            // the cropped texel, shrunk only where the warp magnifies in every direction
+            texel /= clamp(sv.x, 1.0, 1e3);
+        } else {
+            // clamped: a collapsed (unsampled) region would ask for an unbounded bias
+            texel /= clamp(sv.x, MIN_WARP_SCALE, 1e3);
+        }
     }
     let cos_t = clamp(dot(n, l), 1e-4, 1.0);
     let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, wp.bias.w);

@@ -49,7 +49,8 @@ fn offset_y(j: u32, y: f32) -> f32 {
 }
 
 // Seed 000 eq. 6: (x + o_x^(i)(x), y + o_y^(j)(y)), i = floor(y w), j = floor(x' w); with
-// `flags.x` the offsets are interpolated between the two nearest functions instead.
+// `flags.x` the offsets are interpolated between the two nearest functions instead. The offsets
+// are scaled by the warp strength `ext.x` (1 = the seeds' warp; 0 = the identity, i.e. DV only).
 fn warp(u: vec2<f32>) -> vec2<f32> {
     if wp.cfg.z < 0.5 {
         return u;
@@ -57,9 +58,10 @@ fn warp(u: vec2<f32>) -> vec2<f32> {
     let res = u32(wp.texel.z);
     let interp = wp.flags.x != 0u;
     let a = neighbours(u.y, res, interp);
-    let xw = u.x + mix(offset_x(u32(a.x), u.x), offset_x(u32(a.y), u.x), a.z);
+    let alpha = wp.ext.x;
+    let xw = u.x + alpha * mix(offset_x(u32(a.x), u.x), offset_x(u32(a.y), u.x), a.z);
     let b = neighbours(xw, res, interp);
-    return vec2<f32>(xw, u.y + mix(offset_y(u32(b.x), u.y), offset_y(u32(b.y), u.y), b.z));
+    return vec2<f32>(xw, u.y + alpha * mix(offset_y(u32(b.x), u.y), offset_y(u32(b.y), u.y), b.z));
 }
 
 // Clip position of a world point in the warped map (Algorithm 1 of seed 000): crop to the DV,

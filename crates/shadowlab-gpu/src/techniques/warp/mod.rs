@@ -81,7 +81,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     quality: "samples spread evenly over the map; long triangles bend unless subdivided",
     source: "seed 000 section 3, seed 002 chapter 4 (Navratil et al.)",
     lights: LIGHTS,
-    params: NOTW_PARAMS,
+    params: NOTW_OWN_PARAMS,
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Notw)?)),
 };
 
@@ -135,6 +135,7 @@ pub struct WarpParams {
     pub imp: [f32; 4],
     pub ints: [u32; 4],
     pub flags: [u32; 4],
+    pub ext: [f32; 4],
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -259,6 +260,12 @@ impl Warped {
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
             ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
             flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, kind],
+            ext: [
+                opt("strength", 1.0) as f32,
+                opt("bias_mode", 0.0) as f32,
+                opt("footprint_cap", 0.0) as f32,
+                opt("depth_clamp", 0.0) as f32,
+            ],
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;

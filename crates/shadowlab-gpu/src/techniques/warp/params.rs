@@ -206,6 +206,91 @@ pub const EXACT_DEPTH: ParamDef = ParamDef {
 
 const NOTW_EXACT: ParamDef = ParamDef { default: DEFAULT_NOTW_EXACT_DEPTH, ..EXACT_DEPTH };
 
+/// Warp strength alpha: warp(u) = u + alpha * offsets (lookup.wgsl). 1 = the seeds' warp;
+/// 0 = the identity (the DV crop only, `notw-dv` through the warped pipeline). A diagnostic
+/// (docs/bench/warp_bias.md); not in the seeds.
+pub const DEFAULT_STRENGTH: f64 = 1.0;
+pub const STRENGTH: ParamDef = p(
+    "strength",
+    DEFAULT_STRENGTH,
+    0.0,
+    1.0,
+    false,
+    "warp strength: offsets scaled by this (1 = the computed warp, 0 = identity, i.e. the DV crop only); low: less even sampling",
+    "shadowlab diagnostic (docs/bench/warp_bias.md)",
+);
+/// Bias footprint: how one warped texel's world size, which scales the constant bias and the
+/// normal offset, is taken from the warp's Jacobian J at the sample (eval.wgsl). 0: cropped
+/// texel / smallest singular value of J (isotropic, the largest footprint); 1: cropped texel,
+/// divided only by a smallest singular value above 1; 2: the footprint along the receiver's
+/// depth-gradient direction, |J^-T A^-T m| (capped by `footprint_cap`). notw: 2. 1024x1024,
+/// 512 map, six setups, bias 1.5 (docs/bench/warp_bias.md): wrong % sum 7.042 (mode 0) ->
+/// 5.303 (mode 2), lower on every setup (conference sun 0.437 -> 0.282, sponza sun 1.717 ->
+/// 1.166); mode 1 sits between. Mode 0 leaks: where the warp compresses one direction its
+/// bias grows in all directions, up to 8 cropped texels (the ceiling/wall line and the
+/// whiteboard streaks of conference sun). `cube-notw`/`dpsm-notw` keep mode 0 (not measured).
+pub const DEFAULT_BIAS_MODE: f64 = 2.0;
+pub const BIAS_MODE: ParamDef = ParamDef {
+    key: "bias_mode",
+    default: DEFAULT_BIAS_MODE,
+    min: 0.0,
+    max: 2.0,
+    integer: true,
+    doc: "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped",
+    source: "shadowlab measurement (docs/bench/warp_bias.md)",
+    choices: &[],
+};
+/// Cap of bias mode 2's footprint, in cropped texels; 0 = 1 / MIN_WARP_SCALE (8, as mode 0).
+pub const DEFAULT_FOOTPRINT_CAP: f64 = 0.0;
+pub const FOOTPRINT_CAP: ParamDef = p(
+    "footprint_cap",
+    DEFAULT_FOOTPRINT_CAP,
+    0.0,
+    64.0,
+    false,
+    "bias_mode 2: largest footprint in cropped texels (0 = 8); high: leaks under contacts where the warp compresses, low: acne there",
+    "shadowlab measurement (docs/bench/warp_bias.md)",
+);
+
+/// Exact depth clamp: 0 = the piece's corner depths, 1 = the whole triangle's. A piece's edges
+/// are chords of its curved warped edges, so it rasterises fragments up to `subdiv` warped
+/// texels inside its neighbours, whose exact (plane) depth may lie outside the piece's own range.
+pub const DEFAULT_DEPTH_CLAMP: f64 = 0.0;
+pub const DEPTH_CLAMP: ParamDef = ParamDef {
+    key: "depth_clamp",
+    default: DEFAULT_DEPTH_CLAMP,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "exact_depth: clamp the plane depth to the corner depths of 0 = the piece, 1 = the whole triangle",
+    source: "shadowlab measurement (docs/bench/warp_bias.md)",
+    choices: &[],
+};
+
+/// notw's own list: `NOTW_PARAMS` (which `cube-notw` and `dpsm-notw` inherit) plus the bias
+/// footprint parameters. Defaults that differ from `NOTW_PARAMS` are notw's alone.
+pub const NOTW_OWN_PARAMS: &[ParamDef] = &[
+    RES,
+    WINDOW,
+    NOTW_BLUR,
+    MIX,
+    INTERP,
+    NOTW_SUBDIV,
+    SUBDIV_LEVELS,
+    CLOSE_CRACKS,
+    NOTW_EXACT,
+    PCF,
+    NOTW_BIASP,
+    SLOPE,
+    MAX_SLOPE,
+    NORMAL_OFFSET,
+    DV_MARGIN,
+    STRENGTH,
+    BIAS_MODE,
+    FOOTPRINT_CAP,
+    DEPTH_CLAMP,
+];
+
 pub const NOTW_PARAMS: &[ParamDef] = &[
     RES,
     WINDOW,

@@ -25,6 +25,11 @@ struct WarpParams {
     // (f32 bits); z: 1 = exact depth per fragment (depth_exact.wgsl); w: projection kind
     // (PLANAR, or PARABOLOID_FRONT / _BACK: one hemisphere of a point light, paraboloid.rs)
     flags: vec4<u32>,
+    // x: warp strength alpha (warp(u) = u + alpha * offsets; 1 = the computed warp), y: bias
+    // footprint mode (0: isotropic, world texel / smallest singular value; see eval.wgsl), z:
+    // cap of mode 2's footprint (cropped texels; 0 = 1 / MIN_WARP_SCALE), w: 1 = exact depth
+    // clamped to the whole triangle's corner depths (0: the piece's corners)
+    ext: vec4<f32>,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.
