@@ -217,8 +217,9 @@ fn wrong_pixel_ordering_on_courtyard() {
     // rtw 0.573, notw 0.860 (exact depth, bias 1.5, subdiv 1; subdiv 2: 1.08), notw-dv 0.847:
     // rtw beats notw here, so that part is not asserted. (At subdiv 1 the interpolated depth,
     // `exact_depth=false,bias=2`, gives 0.857: exact depth is checked by the next test.)
+    // With the gradient bias footprint (bias_mode 2, docs/bench/warp_bias.md): notw 0.813.
     assert!(rtw < 0.6 * sm, "rtw {rtw:.3} vs sm {sm:.3}");
-    assert!(notw < 0.7 * sm, "notw {notw:.3} vs sm {sm:.3}");
+    assert!(notw < 0.6 * sm, "notw {notw:.3} vs sm {sm:.3}");
     assert!(dv < 0.8 * sm, "notw-dv {dv:.3} vs sm {sm:.3}");
 }
 
