@@ -22,6 +22,8 @@ pub const DEFAULT_MIX: f64 = 2.0;
 /// grazing the light (courtyard spot 1.92 % at 0.5), high: leaks (conference sun 0.24 % at
 /// 0.5, 0.63 at 2). With `exact_depth=false` the interpolated depth is off by up to the
 /// subdivision threshold and 2 is better (courtyard sun 1 -> 1.78 %, 2 -> 1.25, 512 view).
+/// Re-measured with `bias_mode=2` (docs/bench/warp_bias.md): 0.5 / 1 / 1.25 / 1.5 sum to
+/// 6.453 / 5.558 / 5.393 / 5.303 % (subdiv 1): 1.5 kept (also `cube-notw`'s inherited default).
 pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
 /// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
 /// texels); 0 = off. Courtyard 512 view: off -> 70 % wrong (rtw and notw: the floor is two
