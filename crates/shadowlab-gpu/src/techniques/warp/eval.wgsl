@@ -121,7 +121,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if wp.cfg.z > 0.5 {
         let j = jacobian(u0, 0.5 / res);
         let sv = singular_values(j[0], j[1]);
-        if wp.ext.y > 1.5 {
+        if wp.ext.y > 2.5 {
+            // mode 3: the largest gradient footprint at u0 and one texel to each side (the
+            // warp's kinks: the Jacobian changes within a texel)
+            var f = gradient_footprint(p, n, l, r, j, texel);
+            for (var k = 0; k < 4; k++) {
+                let o = select(vec2<f32>(f32(2 * (k & 1) - 1), 0.0), vec2<f32>(0.0, f32(2 * (k & 1) - 1)), k >= 2) / res;
+                f = max(f, gradient_footprint(p, n, l, r, jacobian(u0 + o, 0.5 / res), texel));
+            }
+            texel = f;
+        } else if wp.ext.y > 1.5 {
             texel = gradient_footprint(p, n, l, r, j, texel);
         } else if wp.ext.y > 0.5 {
             // the cropped texel, shrunk only where the warp magnifies in every direction

@@ -236,9 +236,9 @@ pub const BIAS_MODE: ParamDef = ParamDef {
     key: "bias_mode",
     default: DEFAULT_BIAS_MODE,
     min: 0.0,
-    max: 2.0,
+    max: 3.0,
     integer: true,
-    doc: "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped",
+    doc: "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side",
     source: "shadowlab measurement (docs/bench/warp_bias.md)",
     choices: &[],
 };
