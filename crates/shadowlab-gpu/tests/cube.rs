@@ -177,13 +177,14 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 }
 
 #[test]
-fn cube_notw_lists_notws_parameters_with_four_defaults_of_its_own() {
+fn cube_notw_lists_notws_parameters_with_five_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
     let (a, b) = (cube::NOTW_PARAMS, warp::NOTW_PARAMS);
     assert_eq!(a.iter().map(|p| p.key).collect::<Vec<_>>(), b.iter().map(|p| p.key).collect::<Vec<_>>());
     let own = [
         ("window", cube::DEFAULT_NOTW_WINDOW),
         ("blur", cube::DEFAULT_NOTW_BLUR),
+        ("mix", cube::DEFAULT_NOTW_MIX),
         ("subdiv", cube::DEFAULT_NOTW_SUBDIV),
         ("normal_offset", cube::DEFAULT_NOTW_NORMAL_OFFSET),
     ];
