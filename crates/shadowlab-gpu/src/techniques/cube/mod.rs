@@ -84,23 +84,33 @@ pub const DEFAULT_NOTW_SUBDIV: f64 = 0.25;
 pub const DEFAULT_NOTW_NORMAL_OFFSET: f64 = 0.25;
 /// cube-notw's blur of the counts (half-width, texels). notw's 8 -> 4 alone: 0.361 -> 0.357 /
 /// 0.212 -> 0.209 / 0.369 -> 0.367; with subdiv 0.5 and n.o. 0.25 together the three give
-/// 0.290 / 0.171 / 0.276 (docs/bench/point.md). Too high: the sampling evens out less; too
-/// low: a kink per texel (more pieces).
-pub const DEFAULT_NOTW_BLUR: f64 = 4.0;
+/// 0.290 / 0.171 / 0.276 (docs/bench/point.md). With mix 1 (`DEFAULT_NOTW_MIX`), 4 -> 2:
+/// see there (docs/bench/point_quality.md). Too high: the sampling evens out less; too low: a
+/// kink per texel (more pieces).
+pub const DEFAULT_NOTW_BLUR: f64 = 2.0;
+/// cube-notw's uniform floor of the counts (fraction of the mean count per texel). A cube face
+/// holds fairly even samples (CV 0.56-0.75 on the room's faces), so notw's floor of 2 x the mean
+/// leaves the warp almost flat. Room / courtyard lantern / conference light 1, wrong %
+/// (1024x1024, 512 per face, subdiv 0.25, n.o. 0.25): mix 2 blur 4 (before) 0.271 / 0.161 /
+/// 0.263, mix 1 blur 2 0.239 / 0.152 / 0.248, mix 0.5 blur 2 0.241 / 0.159 / 0.249; on the room
+/// mix 0 0.285, 0.25 0.264 (blur 4) (docs/bench/point_quality.md). Too low: rows with few
+/// samples magnify wildly (bends); too high: the warp fades to the identity.
+pub const DEFAULT_NOTW_MIX: f64 = 1.0;
 
-const THREE_SETUPS: &str = "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md)";
+const THREE_SETUPS: &str =
+    "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md, point_quality.md)";
 
 const fn with_default(p: ParamDef, default: f64, source: &'static str) -> ParamDef {
     ParamDef { default, source, ..p }
 }
 
-/// notw's parameters (same keys, order, ranges and docs), with the window, blur, subdivision and
-/// normal offset defaults measured for cube faces (tests/cube.rs checks the keys against notw's).
+/// notw's parameters (same keys, order, ranges and docs), with the window, blur, mix, subdivision
+/// and normal offset defaults measured for cube faces (tests/cube.rs checks the keys against notw's).
 pub const NOTW_PARAMS: &[ParamDef] = &[
     W[0],
     with_default(W[1], DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"),
     with_default(W[2], DEFAULT_NOTW_BLUR, THREE_SETUPS),
-    W[3],
+    with_default(W[3], DEFAULT_NOTW_MIX, THREE_SETUPS),
     W[4],
     with_default(W[5], DEFAULT_NOTW_SUBDIV, THREE_SETUPS),
     W[6],

@@ -36,11 +36,17 @@ pub const DEFAULT_SPLIT: f64 = 0.0;
 pub const DEFAULT_SUBDIV: f64 = 0.5;
 /// `dpsm-notw`: the paraboloid and the warp bend together; room light 1: 2 (warp's default for
 /// notw) -> 1.13 % wrong (worse than dpsm), 1 -> 0.72, 0.5 -> 0.556, 0.25 -> 0.508 (with
-/// blur 4), at 0.2 M -> 0.5 M pieces in the lower hemisphere.
-pub const DEFAULT_NOTW_SUBDIV: f64 = 0.25;
+/// blur 4), at 0.2 M -> 0.5 M pieces in the lower hemisphere. 0.25 -> 0.125 (room / courtyard
+/// lantern / conference light 1, 1024x1024): 0.400 -> 0.391 / 0.297 -> 0.284 / 0.507 -> 0.487 %
+/// for ~2x the pieces (room 81 k -> 163 k, courtyard 0.31 M -> 0.58 M; none dropped)
+/// (docs/bench/point_quality.md).
+pub const DEFAULT_NOTW_SUBDIV: f64 = 0.125;
 /// `dpsm-notw`'s blur of the counts (half-width, texels). Room light 1 (subdiv 0.5): 8 (warp's
-/// default) -> 0.570 %, 4 -> 0.556, 2 -> 0.551; 4 halves the pieces of 2. Too high: flatter warp.
-pub const DEFAULT_NOTW_BLUR: f64 = 4.0;
+/// default) -> 0.570 %, 4 -> 0.556, 2 -> 0.551; 4 halves the pieces of 2. At subdiv 0.125,
+/// 4 -> 2: room 0.391 -> 0.382, courtyard lantern 0.284 -> 0.268, conference light 1 0.487 ->
+/// 0.483 % wrong, the same pieces (163 k / 583 k / 600 k) (docs/bench/point_quality.md).
+/// Too high: flatter warp; too low: a kink per texel (more pieces).
+pub const DEFAULT_NOTW_BLUR: f64 = 2.0;
 /// Constant bias (texels). The depth between subdivided vertices is interpolated along chords of
 /// the paraboloid, so acne needs more than `sm`'s 0.5. See docs/bench/point.md.
 pub const DEFAULT_BIAS: f64 = 1.0;
@@ -78,10 +84,16 @@ const DPSM_SUBDIV: ParamDef = ParamDef {
     source: "seed 002 section 3.3.2 (tessellation needed); value: shadowlab measurement (docs/bench/point.md)",
     ..warp::SUBDIV
 };
-const NOTW_SUBDIV: ParamDef =
-    ParamDef { default: DEFAULT_NOTW_SUBDIV, source: "shadowlab measurement on room light 1 (docs/bench/point.md)", ..DPSM_SUBDIV };
-const NOTW_BLUR: ParamDef =
-    ParamDef { default: DEFAULT_NOTW_BLUR, source: "shadowlab measurement on room light 1 (docs/bench/point.md)", ..warp::NOTW_BLUR };
+const NOTW_SUBDIV: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_SUBDIV,
+    source: "shadowlab measurement on room, courtyard lantern, conference point lights (docs/bench/point.md, point_quality.md)",
+    ..DPSM_SUBDIV
+};
+const NOTW_BLUR: ParamDef = ParamDef {
+    default: DEFAULT_NOTW_BLUR,
+    source: "shadowlab measurement on room, courtyard lantern, conference point lights (docs/bench/point.md, point_quality.md)",
+    ..warp::NOTW_BLUR
+};
 const DPSM_BIAS: ParamDef =
     ParamDef { default: DEFAULT_BIAS, source: "shadowlab sweep on room/conference point lights (docs/bench/point.md)", ..sm::BIAS };
 const NOTW_BIAS: ParamDef = ParamDef {
