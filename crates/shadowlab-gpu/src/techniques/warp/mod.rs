@@ -124,6 +124,9 @@ impl Variant {
     }
 }
 
+/// `WarpParams::ints[3]` bit: cull subdivision pieces that cover no texel centre (subdiv.wgsl).
+pub(crate) const CULL: u32 = 2;
+
 /// WGSL `WarpParams` (params.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -257,7 +260,14 @@ impl Warped {
                 window as f32,
             ],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
-            ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
+            // w: bit 0 = RTW importance, bit 1 = cull pieces that cover no texel centre (exact only
+            // for a continuous warp: interpolated offsets)
+            ints: [
+                tris,
+                opt("subdiv_levels", 1.0) as u32,
+                extra,
+                (variant == Variant::Rtw) as u32 | (opt("interp", 1.0) != 0.0) as u32 * CULL,
+            ],
             flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, kind],
         };
         let d = &gpu.device;

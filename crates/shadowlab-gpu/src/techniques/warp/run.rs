@@ -3,7 +3,7 @@
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::warp::Warp2D;
 
-use super::{Variant, Warped};
+use super::{Variant, Warped, CULL};
 use crate::prefix_sum::ScanParams;
 use crate::techniques::sm::{count_image, depth_image};
 use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueReport};
@@ -91,6 +91,19 @@ impl Warped {
             oy,
             interp: self.params.flags[0] != 0,
         }
+    }
+
+    /// Switches the exact culling of subdivision pieces that cover no texel centre (on by default
+    /// with interpolated offsets; subdiv.wgsl `covers_no_texel`). Off: every finished piece is
+    /// drawn, as before the culling existed (to check that culling changes nothing).
+    pub fn set_cull(&mut self, gpu: &Gpu, on: bool) {
+        self.params.ints[3] = (self.params.ints[3] & !CULL) | on as u32 * CULL;
+        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+    }
+
+    /// The warped depth map of the last frame (res x res, row-major).
+    pub fn read_map(&self, gpu: &Gpu) -> Vec<f32> {
+        bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4))
     }
 
     /// Bytes of the warps kept per light.
@@ -251,7 +264,7 @@ impl Technique for Warped {
         let res = self.res;
         let n = (res * res) as usize;
         let after: Vec<u32> = gpu.read_buffer_as(&self.counts, n);
-        let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4));
+        let depth = self.read_map(gpu);
         let map_bytes = n as u64 * 4;
         let mut r = TechniqueReport {
             shadow_data_bytes: map_bytes + self.warp_bytes() + 32,
@@ -273,6 +286,7 @@ impl Technique for Warped {
             let a: Vec<u32> = gpu.read_buffer_as(&self.counters, 8);
             c.insert("subdiv_triangles_drawn".into(), (a[4] / 3) as f64);
             c.insert("subdiv_pieces_dropped".into(), a[1] as f64);
+            c.insert("subdiv_pieces_culled".into(), a[3] as f64);
             c.insert("subdiv_queue_full_finishes".into(), a[2] as f64);
         }
         if self.variant != Variant::Dv {
