@@ -6,7 +6,7 @@ use shadowlab_core::builtin::builtin;
 use shadowlab_core::light::Light;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, View};
-use shadowlab_gpu::techniques::warp::{Variant, Warped};
+use shadowlab_gpu::techniques::warp::{Cull, Variant, Warped};
 use shadowlab_gpu::techniques::{self, Technique};
 use shadowlab_gpu::timing::StageTimer;
 
@@ -21,7 +21,7 @@ struct Out {
     dropped: f64,
 }
 
-fn run(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant: Variant, cull: bool) -> Out {
+fn run(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant: Variant, cull: Cull) -> Out {
     let (_, params) = techniques::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
     let mut t = Warped::new(gpu, &lab.gscene, &params, &v.light, variant).unwrap();
     t.set_cull(gpu, cull);
@@ -35,9 +35,10 @@ fn run(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant: Varia
     Out { visibility, map, drawn: c("subdiv_triangles_drawn"), culled: c("subdiv_pieces_culled"), dropped: c("subdiv_pieces_dropped") }
 }
 
-/// Courtyard, sun (orthographic) and spot (perspective, near-plane clipping), notw (exact depth)
-/// and rtw: the same map and visibility with and without culling; the culled pieces are exactly
-/// the pieces no longer drawn, and there are some.
+/// Courtyard, sun (orthographic) and spot (perspective, near-plane clipping), notw (exact and
+/// interpolated depth) and rtw: the same map and visibility without culling, culling the pieces
+/// outside the cropped map (the default) and also those covering no texel centre; the culled
+/// pieces are exactly the pieces no longer drawn, and each culling removes some.
 #[test]
 fn culling_pieces_that_cover_no_texel_changes_nothing() {
     let Some(gpu) = gpu() else { return };
@@ -50,18 +51,23 @@ fn culling_pieces_that_cover_no_texel_changes_nothing() {
         for (spec, variant) in
             [("notw:res=256", Variant::Notw), ("rtw:res=256", Variant::Rtw), ("notw:res=256,exact_depth=false", Variant::Notw)]
         {
-            let off = run(&gpu, &lab, &v, spec, variant, false);
-            let on = run(&gpu, &lab, &v, spec, variant, true);
+            let off = run(&gpu, &lab, &v, spec, variant, Cull::Off);
             let what = format!("{spec}, light {light}");
             assert_eq!(off.culled, 0.0, "{what}: culling off culls nothing");
-            assert_eq!((off.dropped, on.dropped), (0.0, 0.0), "{what}: no piece dropped");
-            assert!(on.culled > 0.0, "{what}: nothing culled");
-            assert_eq!(on.drawn + on.culled, off.drawn, "{what}: drawn {} + culled {} vs drawn without culling", on.drawn, on.culled);
-            let maps = off.map.iter().zip(&on.map).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
-            assert_eq!(maps, 0, "{what}: {maps} map texels differ with culling");
-            let vis = off.visibility.iter().zip(&on.visibility).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
-            assert_eq!(vis, 0, "{what}: {vis} pixels' visibility differ with culling");
-            eprintln!("{what}: {} pieces, {} culled ({:.1} %)", off.drawn, on.culled, 100.0 * on.culled / off.drawn);
+            let mut culled = 0.0;
+            for cull in [Cull::Outside, Cull::Empty] {
+                let on = run(&gpu, &lab, &v, spec, variant, cull);
+                let what = format!("{what}, {cull:?}");
+                assert_eq!((off.dropped, on.dropped), (0.0, 0.0), "{what}: no piece dropped");
+                assert!(on.culled > culled, "{what}: culled {} (the weaker culling: {culled})", on.culled);
+                culled = on.culled;
+                assert_eq!(on.drawn + on.culled, off.drawn, "{what}: drawn {} + culled {} vs drawn without culling", on.drawn, on.culled);
+                let maps = off.map.iter().zip(&on.map).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+                assert_eq!(maps, 0, "{what}: {maps} map texels differ with culling");
+                let vis = off.visibility.iter().zip(&on.visibility).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+                assert_eq!(vis, 0, "{what}: {vis} pixels' visibility differ with culling");
+                eprintln!("{what}: {} pieces, {} culled ({:.1} %)", off.drawn, on.culled, 100.0 * on.culled / off.drawn);
+            }
         }
     }
 }

@@ -124,8 +124,19 @@ impl Variant {
     }
 }
 
-/// `WarpParams::ints[3]` bit: cull subdivision pieces that cover no texel centre (subdiv.wgsl).
-pub(crate) const CULL: u32 = 2;
+/// Which subdivision pieces are culled instead of drawn (subdiv.wgsl `covers_no_texel`; both
+/// exact: the map is the same bit for bit, tests/warp_cost.rs). `WarpParams::ints[3]` bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cull {
+    /// Every finished piece is drawn.
+    Off = 0,
+    /// Pieces beyond one side of the cropped map (the default: a cheap test on the unwarped
+    /// corners; see docs/bench/warp_cost.md).
+    Outside = 2,
+    /// Also the pieces inside the map that cover no texel centre (three more warps per piece:
+    /// measured slower on lavapipe than drawing them, docs/bench/warp_cost.md). Needs `interp`.
+    Empty = 6,
+}
 
 /// WGSL `WarpParams` (params.wgsl).
 #[repr(C)]
@@ -260,14 +271,8 @@ impl Warped {
                 window as f32,
             ],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
-            // w: bit 0 = RTW importance, bit 1 = cull pieces that cover no texel centre (exact only
-            // for a continuous warp: interpolated offsets)
-            ints: [
-                tris,
-                opt("subdiv_levels", 1.0) as u32,
-                extra,
-                (variant == Variant::Rtw) as u32 | (opt("interp", 1.0) != 0.0) as u32 * CULL,
-            ],
+            // w: bit 0 = RTW importance, bits 1-2: `Cull`
+            ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32 | Cull::Outside as u32],
             flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, kind],
         };
         let d = &gpu.device;

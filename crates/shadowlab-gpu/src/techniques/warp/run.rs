@@ -3,7 +3,7 @@
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::warp::Warp2D;
 
-use super::{Variant, Warped, CULL};
+use super::{Cull, Variant, Warped};
 use crate::prefix_sum::ScanParams;
 use crate::techniques::sm::{count_image, depth_image};
 use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueReport};
@@ -93,11 +93,11 @@ impl Warped {
         }
     }
 
-    /// Switches the exact culling of subdivision pieces that cover no texel centre (on by default
-    /// with interpolated offsets; subdiv.wgsl `covers_no_texel`). Off: every finished piece is
-    /// drawn, as before the culling existed (to check that culling changes nothing).
-    pub fn set_cull(&mut self, gpu: &Gpu, on: bool) {
-        self.params.ints[3] = (self.params.ints[3] & !CULL) | on as u32 * CULL;
+    /// Sets which subdivision pieces are culled (default [`Cull::Outside`]); [`Cull::Empty`]
+    /// needs a continuous warp (`interp`), without it [`Cull::Outside`] is used.
+    pub fn set_cull(&mut self, gpu: &Gpu, cull: Cull) {
+        let cull = if cull == Cull::Empty && self.params.flags[0] == 0 { Cull::Outside } else { cull };
+        self.params.ints[3] = (self.params.ints[3] & !(Cull::Empty as u32)) | cull as u32;
         gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
     }
 

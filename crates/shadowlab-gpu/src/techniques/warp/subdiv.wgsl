@@ -143,7 +143,7 @@ fn split_mask(p: vec4<u32>) -> u32 {
 }
 
 fn finish(p: vec4<u32>) {
-    if (wp.ints.w & CULL_BIT) != 0u && covers_no_texel(p) {
+    if (wp.ints.w & (CULL_OUTSIDE | CULL_EMPTY)) != 0u && covers_no_texel(p) {
         atomicAdd(&counters[3], 1u);
         return;
     }
@@ -328,11 +328,12 @@ const BIG_PIECE: f32 = 0.125;
 
 // Whether a piece can produce no fragment in the depth pass: no texel centre (k + 0.5, in
 // warped texels) of the map lies in the triangle of its warped corners grown by CULL_MARGIN.
-// Checked on the corners' bounding box, then, when it holds at most 3 x 3 centres, on each
-// centre against the three edges (either orientation: the pass draws both). Conservative:
-// corners behind a spot light keep the piece; the margin covers the rounding between these
-// corners and the vertex stage's (piece_vertex) and the rasteriser's sub-pixel snapping.
-// Needs a continuous warp (interp): the caller sets CULL_BIT only then.
+// CULL_OUTSIDE: the piece lies beyond one side of the cropped map (the warp is the identity
+// outside it, so no warp is evaluated). CULL_EMPTY also: the warped corners' bounding box holds
+// no centre, or at most 3 x 3 centres of which none lies inside the triangle (either
+// orientation: the pass draws both). Conservative: corners behind a spot light keep the piece;
+// the margin covers the rounding between these corners and the vertex stage's (piece_vertex)
+// and the rasteriser's sub-pixel snapping. CULL_EMPTY needs a continuous warp (interp).
 fn covers_no_texel(p: vec4<u32>) -> bool {
     let r = dv_rect();
     let res = wp.texel.z;
@@ -343,7 +344,17 @@ fn covers_no_texel(p: vec4<u32>) -> bool {
         if c.w <= 1e-7 {
             return false;
         }
-        v[i] = warp(to_dv(clip_to_map(c).xy, r)) * res;
+        v[i] = to_dv(clip_to_map(c).xy, r) * res;
+    }
+    let m = CULL_MARGIN;
+    if any(max(max(v[0], v[1]), v[2]) < vec2<f32>(-m)) || any(min(min(v[0], v[1]), v[2]) > vec2<f32>(res + m)) {
+        return true;
+    }
+    if (wp.ints.w & CULL_EMPTY) == 0u {
+        return false;
+    }
+    for (var i = 0u; i < 3u; i++) {
+        v[i] = warp(v[i] / res) * res;
     }
     let k0 = max(ceil(min(min(v[0], v[1]), v[2]) - CULL_MARGIN - 0.5), vec2<f32>(0.0));
     let k1 = min(floor(max(max(v[0], v[1]), v[2]) + CULL_MARGIN - 0.5), vec2<f32>(res - 1.0));
@@ -378,8 +389,10 @@ fn covers_no_texel(p: vec4<u32>) -> bool {
     return true;
 }
 
-// wp.ints.w bit 1: cull pieces that cover no texel centre (mod.rs `Warped::set_cull`).
-const CULL_BIT: u32 = 2u;
+// wp.ints.w bits (mod.rs `Cull`): cull the pieces outside the cropped map; also the pieces
+// that cover no texel centre inside it.
+const CULL_OUTSIDE: u32 = 2u;
+const CULL_EMPTY: u32 = 4u;
 // Margin of the culling test (warped texels): float rounding between the corners computed here
 // and in the vertex stage is ~1e-3 texel, lavapipe snaps vertices to 1/256 texel.
 const CULL_MARGIN: f32 = 0.0625;
