@@ -36,8 +36,8 @@ fn run(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant: Varia
 }
 
 /// Courtyard, sun (orthographic) and spot (perspective, near-plane clipping), notw (exact and
-/// interpolated depth) and rtw: the same map and visibility without culling, culling the pieces
-/// outside the cropped map (the default) and also those covering no texel centre; the culled
+/// interpolated depth) and rtw: the same map and visibility without culling (the default),
+/// culling the pieces outside the cropped map and also those covering no texel centre; the culled
 /// pieces are exactly the pieces no longer drawn, and each culling removes some.
 #[test]
 fn culling_pieces_that_cover_no_texel_changes_nothing() {

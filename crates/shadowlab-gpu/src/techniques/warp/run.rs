@@ -93,7 +93,7 @@ impl Warped {
         }
     }
 
-    /// Sets which subdivision pieces are culled (default [`Cull::Outside`]); [`Cull::Empty`]
+    /// Sets which subdivision pieces are culled (default [`Cull::Off`]); [`Cull::Empty`]
     /// needs a continuous warp (`interp`), without it [`Cull::Outside`] is used.
     pub fn set_cull(&mut self, gpu: &Gpu, cull: Cull) {
         let cull = if cull == Cull::Empty && self.params.flags[0] == 0 { Cull::Outside } else { cull };
