@@ -131,10 +131,11 @@ pub enum Cull {
     /// Every finished piece is drawn (the default: neither culling was measurably faster on
     /// lavapipe, docs/bench/warp_cost.md).
     Off = 0,
-    /// Pieces beyond one side of the cropped map (a cheap test on the unwarped corners; 0.6 % of
-    /// notw's pieces on courtyard sun, 15-35 % of rtw's).
+    /// Pieces beyond one side of the cropped map (a cheap test on the unwarped corners; 0.6-28 %
+    /// of notw's pieces, 6.5-52 % of rtw's on the six warp setups).
     Outside = 2,
-    /// Also the pieces inside the map that cover no texel centre (three more warps per piece:
+    /// Also the pieces inside the map that cover no texel centre (12-41 % of notw's pieces; three
+    /// more warps per piece:
     /// measured slower on lavapipe than drawing them, docs/bench/warp_cost.md). Needs `interp`.
     Empty = 6,
 }
