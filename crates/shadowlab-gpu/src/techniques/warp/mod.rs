@@ -135,8 +135,8 @@ pub enum Cull {
     /// of notw's pieces, 6.5-52 % of rtw's on the six warp setups).
     Outside = 2,
     /// Also the pieces inside the map that cover no texel centre (12-41 % of notw's pieces; three
-    /// more warps per piece:
-    /// measured slower on lavapipe than drawing them, docs/bench/warp_cost.md). Needs `interp`.
+    /// more warps per piece: measured slower on lavapipe than drawing them,
+    /// docs/bench/warp_cost.md). Needs `interp`.
     Empty = 6,
 }
 
