@@ -180,6 +180,11 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 fn cube_notw_lists_notws_parameters_with_five_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
     let (a, b) = (cube::NOTW_PARAMS, warp::NOTW_PARAMS);
+    // notw's shared list, then the bias footprint choice (notw's own list has it too)
+    assert_eq!(a.len(), b.len() + 1);
+    assert_eq!(a.last().map(|p| p.key), Some(warp::BIAS_MODE.key));
+    assert_eq!(a.last().map(|p| p.default), Some(cube::DEFAULT_NOTW_BIAS_MODE));
+    let a = &a[..b.len()];
     assert_eq!(a.iter().map(|p| p.key).collect::<Vec<_>>(), b.iter().map(|p| p.key).collect::<Vec<_>>());
     let own = [
         ("window", cube::DEFAULT_NOTW_WINDOW),

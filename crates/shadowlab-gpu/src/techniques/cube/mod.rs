@@ -97,6 +97,14 @@ pub const DEFAULT_NOTW_BLUR: f64 = 2.0;
 /// samples magnify wildly (bends); too high: the warp fades to the identity.
 pub const DEFAULT_NOTW_MIX: f64 = 1.0;
 
+/// cube-notw's bias footprint (`bias_mode`, warp::BIAS_MODE): 0 (isotropic), not `notw`'s 2.
+/// Room / courtyard lantern / conference light 1, wrong % (1024x1024, 512 per face, bias 1.5):
+/// mode 0 0.239 / 0.152 / 0.248, mode 2 0.568 / 1.522 / 0.393 (acne: false shadow 0.468 /
+/// 1.469 / 0.266); on the room mode 2 with bias 3 0.266, 4.5 0.278, mode 1 0.240
+/// (docs/bench/point_quality.md). The gradient footprint is smaller where the face projection
+/// is steep, so the bias tuned with mode 0 no longer covers the depth slope there.
+pub const DEFAULT_NOTW_BIAS_MODE: f64 = 0.0;
+
 const THREE_SETUPS: &str =
     "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md, point_quality.md)";
 
@@ -122,6 +130,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     W[12],
     with_default(W[13], DEFAULT_NOTW_NORMAL_OFFSET, THREE_SETUPS),
     W[14],
+    with_default(crate::techniques::warp::BIAS_MODE, DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS),
 ];
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {

@@ -65,6 +65,11 @@ pub const DEFAULT_NOTW_NORMAL_OFFSET: f64 = 0.25;
 /// (bias 2) 16 -> 0.508 / 0.743 / 0.633 % wrong, 32 -> 0.516 / 0.725 / 0.416, 64 -> 0.455 /
 /// 0.704 / 0.375, 128 -> 0.448 / 0.641 / 0.392, 256 -> 0.459 / 0.621 / 0.400, 511 -> 0.502 /
 /// 0.618 / 0.426. Low: neighbouring rows warp apart, edges bend; high: RTW-like, less even.
+/// `dpsm-notw`'s bias footprint (`bias_mode`, warp::BIAS_MODE): 0 (isotropic), not `notw`'s 2.
+/// Room / courtyard lantern / conference light 1, wrong % (1024x1024, 512 per hemisphere):
+/// mode 0 0.382 / 0.268 / 0.483, mode 2 0.385 / 1.086 / 0.489 (acne on the lantern: false
+/// shadow 0.153 -> 0.988) (docs/bench/point_quality.md).
+pub const DEFAULT_NOTW_BIAS_MODE: f64 = 0.0;
 pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
 
 pub const RES: ParamDef = ParamDef { default: DEFAULT_RES, doc: "side of each hemisphere's map (texels); two maps", ..sm::RES };
@@ -143,6 +148,11 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     sm::MAX_SLOPE,
     NOTW_NORMAL_OFFSET,
     warp::DV_MARGIN,
+    ParamDef {
+        default: DEFAULT_NOTW_BIAS_MODE,
+        source: "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point_quality.md)",
+        ..warp::BIAS_MODE
+    },
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
