@@ -171,6 +171,10 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     assert_eq!(r["faces_rendered"], with_samples as f64);
     assert_eq!(r["subdiv_pieces_dropped"], 0.0, "subdivision ran out of capacity (holes in a face)");
     assert_eq!(r["warp_bytes"], 6.0 * 8.0 * 128.0 * 128.0);
+    // the faces share one set of subdivision buffers (at least 2^21 pieces + two queues of 2^20,
+    // 16 bytes each = 64 MiB): counted once, not six times
+    let set = ((1u64 << 21) * 16 + 2 * (1u64 << 20) * 16) as f64;
+    assert!(r["scratch_bytes"] >= set && r["scratch_bytes"] < 2.0 * set, "scratch {} bytes", r["scratch_bytes"]);
     // six warped maps (4 bytes a texel), six pairs of warps (8 w^2), 32 bytes of DV each
     assert_eq!(notw.report.shadow_data_bytes, 6 * (128 * 128 * 4 + 8 * 128 * 128 + 32));
     assert!(notw.report.images.iter().any(|i| i.name.starts_with("face -y: count map after warping")));

@@ -63,25 +63,32 @@ impl CubeNotw {
         let far = scene.bounds.corners().iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
         let near = (far * 1e-3).max(1e-4);
         let scenes = clip::face_scenes(gpu, scene, position, 2.0 * near, 1.0 + 8.0 / res as f32);
-        let faces = FACES
-            .iter()
-            .zip(scenes)
-            .enumerate()
-            .map(|(f, (fc, face_scene))| {
-                // one face = a spot light along the axis whose fitted frustum is the face's square
-                let light = Light::Spot { position, direction: fc.n, cone_deg: 45.0 };
-                Ok(Face {
-                    warped: Warped::new(gpu, &face_scene, p, &light, Variant::Notw)?,
-                    scene: face_scene,
-                    light,
-                    light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
-                    sel: gpu.uniform(&format!("cube-notw.face{f}"), &[f as u32, 0, 0, 0]),
-                    mask: None,
-                    vis: None,
-                    samples: 0,
-                })
-            })
-            .collect::<Result<Vec<_>, GpuError>>()?;
+        // the faces render one after another, so they share one set of subdivision buffers
+        // (warp::SubdivScratch): the face with the most triangles is built first and lends its
+        // set, large enough for all (about 330 MB less than six sets)
+        let mut order: Vec<usize> = (0..6).collect();
+        order.sort_by_key(|&f| std::cmp::Reverse(scenes[f].triangle_count));
+        let mut scenes: Vec<Option<GpuScene>> = scenes.into_iter().map(Some).collect();
+        let mut built: Vec<Option<Face>> = (0..6).map(|_| None).collect();
+        let mut shared = None;
+        for f in order {
+            let face_scene = scenes[f].take().expect("each face once");
+            // one face = a spot light along the axis whose fitted frustum is the face's square
+            let light = Light::Spot { position, direction: FACES[f].n, cone_deg: 45.0 };
+            let warped = Warped::new_sharing(gpu, &face_scene, p, &light, Variant::Notw, shared.as_ref())?;
+            shared.get_or_insert_with(|| warped.subdiv_scratch());
+            built[f] = Some(Face {
+                warped,
+                scene: face_scene,
+                light,
+                light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
+                sel: gpu.uniform(&format!("cube-notw.face{f}"), &[f as u32, 0, 0, 0]),
+                mask: None,
+                vis: None,
+                samples: 0,
+            });
+        }
+        let faces: Vec<Face> = built.into_iter().map(|f| f.expect("all six built")).collect();
         let rw = binding::storage(false);
         let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw, rw, rw]);
         let src = split_src();
@@ -221,7 +228,7 @@ impl Technique for CubeNotw {
             for (k, v) in fr.counters {
                 if k == "fetches_per_pixel" {
                     r.counters.insert(k, v);
-                } else if k == "scratch_bytes" || k.starts_with("subdiv_") {
+                } else if k.starts_with("subdiv_") {
                     // pieces drawn, dropped (holes: subdivision capacity) and queue-full finishes
                     *r.counters.entry(k).or_default() += v;
                 } else if k.ends_with("fraction") || k.ends_with("warp") {
@@ -233,6 +240,8 @@ impl Technique for CubeNotw {
             }
         }
         r.counters.insert("faces_rendered".into(), active as f64);
+        // every face's buffers, rendered this frame or not (the subdivision set once: shared)
+        r.counters.insert("scratch_bytes".into(), self.faces.iter().map(|f| f.warped.scratch_bytes()).sum::<u64>() as f64);
         r.counters.insert("warp_bytes_per_face".into(), 8.0 * n as f64);
         r.counters.insert("warp_bytes".into(), 6.0 * 8.0 * n as f64);
         r.counters.insert("shadow_map_texels".into(), 6.0 * n as f64);

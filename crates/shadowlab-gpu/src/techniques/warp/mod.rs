@@ -175,6 +175,8 @@ pub struct Warped {
     pieces: wgpu::Buffer,
     counters: wgpu::Buffer,
     queues: [wgpu::Buffer; 2],
+    /// Whether `pieces` and `queues` were allocated here (false: lent by another map).
+    owns_subdiv: bool,
     /// Indirect dispatch args of the current level (copied from `counters`).
     dispatch: wgpu::Buffer,
     level_uniforms: Vec<wgpu::Buffer>,
@@ -209,6 +211,17 @@ fn r32_texture(gpu: &Gpu, label: &str, w: u32, h: u32) -> wgpu::Texture {
     })
 }
 
+/// The subdivision buffers of a warped map (finished pieces and the two level queues), its
+/// largest scratch: 66 MB at the minimum capacity of 2^21 pieces. Maps whose passes run one after
+/// another (`cube-notw`'s faces: each face subdivides and draws before the next starts) can share
+/// one set: `Warped::subdiv_scratch` lends it, `Warped::new_sharing` borrows it when it is large
+/// enough for the borrower's triangles (otherwise the borrower allocates its own).
+#[derive(Clone)]
+pub struct SubdivScratch {
+    pieces: wgpu::Buffer,
+    queues: [wgpu::Buffer; 2],
+}
+
 /// How a warped map projects the world before the desired view and the warp.
 #[derive(Clone, Copy, Debug)]
 pub enum Projection {
@@ -223,13 +236,51 @@ pub enum Projection {
 
 impl Warped {
     pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, variant: Variant) -> Result<Warped, GpuError> {
+        Warped::new_sharing(gpu, scene, p, light, variant, None)
+    }
+
+    /// `new`, borrowing `shared`'s subdivision buffers when they are large enough.
+    pub fn new_sharing(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        p: &ParamValues,
+        light: &Light,
+        variant: Variant,
+        shared: Option<&SubdivScratch>,
+    ) -> Result<Warped, GpuError> {
         let name = variant.name();
         let res = p.get_u32("res");
         gpu.check_size(res, res, "shadow map")?;
         let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
             GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
         })?;
-        Warped::with_projection(gpu, scene, p, variant, Projection::Planar(lp), name, true)
+        let mut w = Warped::with_projection(gpu, scene, p, variant, Projection::Planar(lp), name, true)?;
+        if let Some(s) = shared {
+            w.borrow_subdiv(s);
+        }
+        Ok(w)
+    }
+
+    /// This map's subdivision buffers, to lend to maps rendered after it.
+    pub fn subdiv_scratch(&self) -> SubdivScratch {
+        SubdivScratch { pieces: self.pieces.clone(), queues: self.queues.clone() }
+    }
+
+    /// Uses `s`'s subdivision buffers instead of this map's own (dropped) if they are at least as
+    /// large; bind groups are made per frame, so nothing else refers to the old ones.
+    fn borrow_subdiv(&mut self, s: &SubdivScratch) {
+        if s.pieces.size() >= self.pieces.size() && s.queues.iter().zip(&self.queues).all(|(a, b)| a.size() >= b.size()) {
+            self.pieces = s.pieces.clone();
+            self.queues = s.queues.clone();
+            self.owns_subdiv = false;
+        }
+    }
+
+    /// Bytes of scratch this map allocated (work buffers, counts, and the subdivision buffers
+    /// unless borrowed).
+    pub fn scratch_bytes(&self) -> u64 {
+        let subdiv = if self.owns_subdiv { self.pieces.size() + 2 * self.queues[0].size() } else { 0 };
+        self.work.size() + self.fwork.size() + self.counts.size() + subdiv
     }
 
     /// A warped map over `proj`, labelled `name` (wgpu labels, stage names `{name}.<stage>`);
@@ -381,6 +432,7 @@ impl Warped {
             pieces,
             counters,
             queues,
+            owns_subdiv: true,
             dispatch: d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{name}.dispatch")),
                 size: 12,

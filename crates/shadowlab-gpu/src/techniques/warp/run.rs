@@ -276,10 +276,7 @@ impl Technique for Warped {
         c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64 * per_tap);
         c.insert("shadow_map_texels".into(), n as f64);
         c.insert("warp_bytes".into(), self.warp_bytes() as f64);
-        c.insert(
-            "scratch_bytes".into(),
-            (self.work.size() + self.fwork.size() + self.counts.size() + self.pieces.size() + 2 * self.queues[0].size()) as f64,
-        );
+        c.insert("scratch_bytes".into(), self.scratch_bytes() as f64);
         let dv = self.read_dv_rect(gpu);
         c.insert("dv_area_fraction".into(), ((dv[2] - dv[0]) * (dv[3] - dv[1])) as f64);
         if self.params.imp[3] > 0.0 {
