@@ -39,6 +39,10 @@ fn dpsm_at_high_resolution_agrees_with_rt_on_planebox_point() {
         for h in ["front", "back"] {
             assert_eq!(c[&format!("{h}.subdiv_pieces_dropped")], 0.0, "{spec}");
         }
+        // both hemispheres share one set of subdivision buffers (>= 2^21 pieces + two queues of
+        // 2^20, 16 bytes each): counted once
+        let set = ((1u64 << 21) * 16 + 2 * (1u64 << 20) * 16) as f64;
+        assert!(c["scratch_bytes"] >= set && c["scratch_bytes"] < 2.0 * set, "{spec}: scratch {}", c["scratch_bytes"]);
         let front = c["front.sample_fraction"];
         if spec.contains("split=x") {
             assert!(front > 0.2 && front < 0.8, "{spec}: front hemisphere holds {front} of the samples");

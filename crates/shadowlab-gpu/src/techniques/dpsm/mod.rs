@@ -205,7 +205,11 @@ impl Dpsm {
             let h = Hemisphere::BOTH[i];
             Warped::with_projection(gpu, scene, p, variant, Projection::Paraboloid { view: dp.view(h), hemisphere: h }, labels[i], warped)
         };
-        Ok(Dpsm { maps: [make(0)?, make(1)?], warped, res, pcf: p.get_u32("pcf") })
+        // the hemispheres render one after another: one set of subdivision buffers for both
+        let front = make(0)?;
+        let mut back = make(1)?;
+        back.borrow_subdiv(&front.subdiv_scratch());
+        Ok(Dpsm { maps: [front, back], warped, res, pcf: p.get_u32("pcf") })
     }
 }
 
@@ -270,6 +274,8 @@ impl Technique for Dpsm {
         c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
         c.insert("shadow_map_texels".into(), 2.0 * n as f64);
         c.insert("warp_bytes".into(), warp_bytes as f64);
+        // work buffers of both maps + the one shared set of subdivision buffers
+        c.insert("scratch_bytes".into(), self.maps.iter().map(|m| m.scratch_bytes()).sum::<u64>() as f64);
         let sum = (total_samples[0] + total_samples[1]).max(1) as f64;
         c.insert("front.sample_fraction".into(), total_samples[0] as f64 / sum);
         r

@@ -268,7 +268,7 @@ impl Warped {
 
     /// Uses `s`'s subdivision buffers instead of this map's own (dropped) if they are at least as
     /// large; bind groups are made per frame, so nothing else refers to the old ones.
-    fn borrow_subdiv(&mut self, s: &SubdivScratch) {
+    pub fn borrow_subdiv(&mut self, s: &SubdivScratch) {
         if s.pieces.size() >= self.pieces.size() && s.queues.iter().zip(&self.queues).all(|(a, b)| a.size() >= b.size()) {
             self.pieces = s.pieces.clone();
             self.queues = s.queues.clone();
