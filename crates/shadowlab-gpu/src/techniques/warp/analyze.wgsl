@@ -84,7 +84,7 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = res_u();
     let t = texel_of(u.y, w) * w + texel_of(u.x, w);
     atomicAdd(&work[t], 1u);
-    if (wp.ints.w & 1u) != 0u {
+    if wp.ints.w != 0u {
         let maxd = bitcast<f32>(atomicLoad(&dv[4]));
         let d = distance(s.p, frame.camera_pos.xyz);
         let imp = wp.imp.x + wp.imp.y * clamp((maxd - d) / max(maxd, 1e-20), 0.0, 1.0);

@@ -124,22 +124,6 @@ impl Variant {
     }
 }
 
-/// Which subdivision pieces are culled instead of drawn (subdiv.wgsl `covers_no_texel`; both
-/// exact: the map is the same bit for bit, tests/warp_cost.rs). `WarpParams::ints[3]` bits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Cull {
-    /// Every finished piece is drawn (the default: neither culling was measurably faster on
-    /// lavapipe, docs/bench/warp_cost.md).
-    Off = 0,
-    /// Pieces beyond one side of the cropped map (a cheap test on the unwarped corners; 0.6-28 %
-    /// of notw's pieces, 6.5-52 % of rtw's on the six warp setups).
-    Outside = 2,
-    /// Also the pieces inside the map that cover no texel centre (12-41 % of notw's pieces; three
-    /// more warps per piece: measured slower on lavapipe than drawing them,
-    /// docs/bench/warp_cost.md). Needs `interp`.
-    Empty = 6,
-}
-
 /// WGSL `WarpParams` (params.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -325,8 +309,7 @@ impl Warped {
                 window as f32,
             ],
             imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
-            // w: bit 0 = RTW importance, bits 1-2: `Cull`
-            ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32 | Cull::Off as u32],
+            ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
             flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, kind],
             ext: [
                 opt("strength", 1.0) as f32,

@@ -3,7 +3,7 @@
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::warp::Warp2D;
 
-use super::{Cull, Variant, Warped};
+use super::{Variant, Warped};
 use crate::prefix_sum::ScanParams;
 use crate::techniques::sm::{count_image, depth_image};
 use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueReport};
@@ -91,19 +91,6 @@ impl Warped {
             oy,
             interp: self.params.flags[0] != 0,
         }
-    }
-
-    /// Sets which subdivision pieces are culled (default [`Cull::Off`]); [`Cull::Empty`]
-    /// needs a continuous warp (`interp`), without it [`Cull::Outside`] is used.
-    pub fn set_cull(&mut self, gpu: &Gpu, cull: Cull) {
-        let cull = if cull == Cull::Empty && self.params.flags[0] == 0 { Cull::Outside } else { cull };
-        self.params.ints[3] = (self.params.ints[3] & !(Cull::Empty as u32)) | cull as u32;
-        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
-    }
-
-    /// The warped depth map of the last frame (res x res, row-major).
-    pub fn read_map(&self, gpu: &Gpu) -> Vec<f32> {
-        bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4))
     }
 
     /// Bytes of the warps kept per light.
@@ -264,7 +251,7 @@ impl Technique for Warped {
         let res = self.res;
         let n = (res * res) as usize;
         let after: Vec<u32> = gpu.read_buffer_as(&self.counts, n);
-        let depth = self.read_map(gpu);
+        let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4));
         let map_bytes = n as u64 * 4;
         let mut r = TechniqueReport {
             shadow_data_bytes: map_bytes + self.warp_bytes() + 32,
@@ -283,7 +270,6 @@ impl Technique for Warped {
             let a: Vec<u32> = gpu.read_buffer_as(&self.counters, 8);
             c.insert("subdiv_triangles_drawn".into(), (a[4] / 3) as f64);
             c.insert("subdiv_pieces_dropped".into(), a[1] as f64);
-            c.insert("subdiv_pieces_culled".into(), a[3] as f64);
             c.insert("subdiv_queue_full_finishes".into(), a[2] as f64);
         }
         if self.variant != Variant::Dv {

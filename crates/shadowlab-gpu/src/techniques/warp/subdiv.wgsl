@@ -4,16 +4,14 @@
 // threshold: the distance, in warped texels, between the warped image of points on it and
 // where linear rasterisation puts them. The decision depends on the edge alone and only the
 // edges that need it are split (bisection patterns with 2, 3 or 4 children), so neighbours
-// agree and no T-junction cracks appear (up to the level cap). split_root sorts the scene's
-// triangles: finished whole, or queued. Each split_level pass halves the queued pieces' edges
-// (4 children), appends the finished ones to `pieces` and queues the rest (queue in/out
-// ping-pong, indirect dispatch). The last level finishes everything. Full queues finish early;
-// a full piece list drops pieces (counted: holes in the map). A finished piece that cannot
-// cover a texel centre of the map is culled instead of appended (`covers_no_texel`; exact, so
-// the map is the same bit for bit): outside the cropped map, or a sliver between centres.
+// agree and no T-junction cracks appear (up to the level cap). split_root sorts the scene's triangles: kept whole
+// in their own slot of `pieces`, or queued. Each split_level pass halves the queued pieces'
+// edges (4 children), appends the finished ones after the triangles and queues the rest
+// (queue in/out ping-pong, indirect dispatch). The last level finishes everything. Full
+// queues finish early; a full piece list drops pieces (counted: holes in the map).
 //
-// counters: [appended, dropped, queue-full finishes, culled, draw args (4), queue 0: count,
-// groups x, y, z, queue 1: count, groups x, y, z].
+// counters: [appended, dropped, queue-full finishes, -, draw args (4), queue 0: count, groups
+// x, y, z, queue 1: count, groups x, y, z].
 
 struct Level {
     // x: level (1..), y: 1 on the last level, z: input queue (0 or 1), w: capacity per queue
@@ -143,16 +141,12 @@ fn split_mask(p: vec4<u32>) -> u32 {
 }
 
 fn finish(p: vec4<u32>) {
-    if (wp.ints.w & (CULL_OUTSIDE | CULL_EMPTY)) != 0u && covers_no_texel(p) {
-        atomicAdd(&counters[3], 1u);
-        return;
-    }
     let i = atomicAdd(&counters[0], 1u);
-    if i >= wp.ints.x + wp.ints.z {
+    if i >= wp.ints.z {
         atomicAdd(&counters[1], 1u);
         return;
     }
-    pieces[i] = p;
+    pieces[wp.ints.x + i] = p;
 }
 
 fn enqueue(p: vec4<u32>, q: u32) {
@@ -165,12 +159,13 @@ fn enqueue(p: vec4<u32>, q: u32) {
     q_out[i] = p;
 }
 
-// A root piece: finished whole, or queued.
-fn place_root(p: vec4<u32>) {
+// A root piece in the triangle's own slot: kept, or queued (the slot then holds nothing).
+fn place_root(tri: u32, p: vec4<u32>) {
     if split_mask(p) != 0u {
+        pieces[tri] = vec4<u32>(tri, 0u, 0u, 0u);
         enqueue(p, 0u);
     } else {
-        finish(p);
+        pieces[tri] = p;
     }
 }
 
@@ -183,7 +178,7 @@ fn mix_corner(a: u32, b: u32, t: f32) -> u32 {
 // warping, because the warp of a vertex behind a spot light is meaningless (its projection
 // flips) and one such vertex spreads its triangle across the whole map. Clip space is affine in
 // world space, so the cut corners are exact barycentric mixes. Wholly behind: nothing drawn;
-// a cut leaving a quad: its second half is placed like another root.
+// a cut leaving a quad: its second half is appended like a finished piece.
 @compute @workgroup_size(64)
 fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
@@ -192,7 +187,7 @@ fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     }
     let c = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
     if is_paraboloid(wp) {
-        place_root(vec4<u32>(tri, c[0], c[1], c[2]));
+        place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
         return;
     }
     var z: array<f32, 3>;
@@ -200,7 +195,7 @@ fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
         z[i] = base_clip(wp, corner_pos(tri, c[i])).z;
     }
     if min(min(z[0], z[1]), z[2]) >= 0.0 {
-        place_root(vec4<u32>(tri, c[0], c[1], c[2]));
+        place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
         return;
     }
     var poly: array<u32, 4>;
@@ -217,11 +212,17 @@ fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
         }
     }
     if n < 3u {
+        pieces[tri] = vec4<u32>(tri, 0u, 0u, 0u);
         return;
     }
-    place_root(vec4<u32>(tri, poly[0], poly[1], poly[2]));
+    place_root(tri, vec4<u32>(tri, poly[0], poly[1], poly[2]));
     if n == 4u {
-        place_root(vec4<u32>(tri, poly[0], poly[2], poly[3]));
+        let q = vec4<u32>(tri, poly[0], poly[2], poly[3]);
+        if split_mask(q) != 0u {
+            enqueue(q, 0u);
+        } else {
+            finish(q);
+        }
     }
 }
 
@@ -316,8 +317,8 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
 
 @compute @workgroup_size(1)
 fn draw_args() {
-    let appended = min(atomicLoad(&counters[0]), wp.ints.x + wp.ints.z);
-    atomicStore(&counters[4], 3u * appended);
+    let appended = min(atomicLoad(&counters[0]), wp.ints.z);
+    atomicStore(&counters[4], 3u * (wp.ints.x + appended));
     atomicStore(&counters[5], 1u);
     atomicStore(&counters[6], 0u);
     atomicStore(&counters[7], 0u);
@@ -325,74 +326,3 @@ fn draw_args() {
 
 // Pieces wider than this fraction of the cropped map split all edges (see interior_needs_split).
 const BIG_PIECE: f32 = 0.125;
-
-// Whether a piece can produce no fragment in the depth pass: no texel centre (k + 0.5, in
-// warped texels) of the map lies in the triangle of its warped corners grown by CULL_MARGIN.
-// CULL_OUTSIDE: the piece lies beyond one side of the cropped map (the warp is the identity
-// outside it, so no warp is evaluated). CULL_EMPTY also: the warped corners' bounding box holds
-// no centre, or at most 3 x 3 centres of which none lies inside the triangle (either
-// orientation: the pass draws both). Conservative: corners behind a spot light keep the piece;
-// the margin covers the rounding between these corners and the vertex stage's (piece_vertex)
-// and the rasteriser's sub-pixel snapping. CULL_EMPTY needs a continuous warp (interp).
-fn covers_no_texel(p: vec4<u32>) -> bool {
-    let r = dv_rect();
-    let res = wp.texel.z;
-    let cs = array<u32, 3>(p.y, p.z, p.w);
-    var v: array<vec2<f32>, 3>;
-    for (var i = 0u; i < 3u; i++) {
-        let c = base_clip(wp, corner_pos(p.x, cs[i]));
-        if c.w <= 1e-7 {
-            return false;
-        }
-        v[i] = to_dv(clip_to_map(c).xy, r) * res;
-    }
-    let m = CULL_MARGIN;
-    if any(max(max(v[0], v[1]), v[2]) < vec2<f32>(-m)) || any(min(min(v[0], v[1]), v[2]) > vec2<f32>(res + m)) {
-        return true;
-    }
-    if (wp.ints.w & CULL_EMPTY) == 0u {
-        return false;
-    }
-    for (var i = 0u; i < 3u; i++) {
-        v[i] = warp(v[i] / res) * res;
-    }
-    let k0 = max(ceil(min(min(v[0], v[1]), v[2]) - CULL_MARGIN - 0.5), vec2<f32>(0.0));
-    let k1 = min(floor(max(max(v[0], v[1]), v[2]) + CULL_MARGIN - 0.5), vec2<f32>(res - 1.0));
-    if any(k0 > k1) {
-        return true;
-    }
-    if any(k1 - k0 > vec2<f32>(2.0)) {
-        return false;
-    }
-    // edge directions normalised: the edge functions are signed distances (texels)
-    var e: array<vec2<f32>, 3>;
-    for (var i = 0u; i < 3u; i++) {
-        let d = v[(i + 1u) % 3u] - v[i];
-        let len = length(d);
-        e[i] = select(vec2<f32>(0.0), d / len, len > 1e-6);
-    }
-    for (var y = k0.y; y <= k1.y; y += 1.0) {
-        for (var x = k0.x; x <= k1.x; x += 1.0) {
-            let q = vec2<f32>(x, y) + 0.5;
-            var lo = 1e30;
-            var hi = -1e30;
-            for (var i = 0u; i < 3u; i++) {
-                let f = e[i].x * (q.y - v[i].y) - e[i].y * (q.x - v[i].x);
-                lo = min(lo, f);
-                hi = max(hi, f);
-            }
-            if lo >= -CULL_MARGIN || hi <= CULL_MARGIN {
-                return false;
-            }
-        }
-    }
-    return true;
-}
-
-// wp.ints.w bits (mod.rs `Cull`): cull the pieces outside the cropped map; also the pieces
-// that cover no texel centre inside it.
-const CULL_OUTSIDE: u32 = 2u;
-const CULL_EMPTY: u32 = 4u;
-// Margin of the culling test (warped texels): float rounding between the corners computed here
-// and in the vertex stage is ~1e-3 texel, lavapipe snaps vertices to 1/256 texel.
-const CULL_MARGIN: f32 = 0.0625;
