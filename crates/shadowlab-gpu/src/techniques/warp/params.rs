@@ -230,18 +230,18 @@ pub const STRENGTH: ParamDef = p(
 /// 5.303 (mode 2), lower on every setup (conference sun 0.437 -> 0.282, sponza sun 1.717 ->
 /// 1.166); mode 1 sits between. Mode 0 leaks: where the warp compresses one direction its
 /// bias grows in all directions, up to 8 cropped texels (the ceiling/wall line and the
-/// whiteboard streaks of conference sun). `cube-notw`/`dpsm-notw` keep mode 0 (not measured).
+/// whiteboard streaks of conference sun). `cube-notw`/`dpsm-notw` keep mode 0: mode 2 brings
+/// acne to them (docs/bench/point_quality.md).
 pub const DEFAULT_BIAS_MODE: f64 = 2.0;
-pub const BIAS_MODE: ParamDef = ParamDef {
-    key: "bias_mode",
-    default: DEFAULT_BIAS_MODE,
-    min: 0.0,
-    max: 3.0,
-    integer: true,
-    doc: "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side",
-    source: "shadowlab measurement (docs/bench/warp_bias.md)",
-    choices: &[],
-};
+pub const BIAS_MODE: ParamDef = p(
+    "bias_mode",
+    DEFAULT_BIAS_MODE,
+    0.0,
+    3.0,
+    true,
+    "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side",
+    "shadowlab measurement (docs/bench/warp_bias.md)",
+);
 /// Cap of bias mode 2's footprint, in cropped texels; 0 = 1 / MIN_WARP_SCALE (8, as mode 0).
 pub const DEFAULT_FOOTPRINT_CAP: f64 = 0.0;
 pub const FOOTPRINT_CAP: ParamDef = p(
@@ -258,42 +258,18 @@ pub const FOOTPRINT_CAP: ParamDef = p(
 /// are chords of its curved warped edges, so it rasterises fragments up to `subdiv` warped
 /// texels inside its neighbours, whose exact (plane) depth may lie outside the piece's own range.
 pub const DEFAULT_DEPTH_CLAMP: f64 = 0.0;
-pub const DEPTH_CLAMP: ParamDef = ParamDef {
-    key: "depth_clamp",
-    default: DEFAULT_DEPTH_CLAMP,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "exact_depth: clamp the plane depth to the corner depths of 0 = the piece, 1 = the whole triangle",
-    source: "shadowlab measurement (docs/bench/warp_bias.md)",
-    choices: &[],
-};
+pub const DEPTH_CLAMP: ParamDef = p(
+    "depth_clamp",
+    DEFAULT_DEPTH_CLAMP,
+    0.0,
+    1.0,
+    true,
+    "exact_depth: clamp the plane depth to the corner depths of 0 = the piece, 1 = the whole triangle",
+    "shadowlab measurement (docs/bench/warp_bias.md)",
+);
 
-/// notw's own list: `NOTW_PARAMS` (which `cube-notw` and `dpsm-notw` inherit) plus the bias
-/// footprint parameters. Defaults that differ from `NOTW_PARAMS` are notw's alone.
-pub const NOTW_OWN_PARAMS: &[ParamDef] = &[
-    RES,
-    WINDOW,
-    NOTW_BLUR,
-    MIX,
-    INTERP,
-    NOTW_SUBDIV,
-    SUBDIV_LEVELS,
-    CLOSE_CRACKS,
-    NOTW_EXACT,
-    PCF,
-    NOTW_BIASP,
-    SLOPE,
-    MAX_SLOPE,
-    NORMAL_OFFSET,
-    DV_MARGIN,
-    STRENGTH,
-    BIAS_MODE,
-    FOOTPRINT_CAP,
-    DEPTH_CLAMP,
-];
-
-pub const NOTW_PARAMS: &[ParamDef] = &[
+/// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
+const NOTW_SHARED: [ParamDef; 15] = [
     RES,
     WINDOW,
     NOTW_BLUR,
@@ -310,6 +286,23 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     NORMAL_OFFSET,
     DV_MARGIN,
 ];
+pub const NOTW_PARAMS: &[ParamDef] = &NOTW_SHARED;
+
+/// `a` then `b` (N = A + B).
+const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A], b: [ParamDef; B]) -> [ParamDef; N] {
+    assert!(A + B == N && A > 0);
+    let mut out = [a[0]; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = if i < A { a[i] } else { b[i - A] };
+        i += 1;
+    }
+    out
+}
+
+/// notw's own list: `NOTW_PARAMS` plus the warp strength and the bias footprint parameters.
+pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<15, 4, 19>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP]);
+
 pub const RTW_PARAMS: &[ParamDef] = &[
     RES,
     W_DV,
