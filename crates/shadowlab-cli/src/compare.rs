@@ -94,8 +94,10 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
             "evaluated_pixels": m.evaluated_pixels,
             "flicker_pct": m.flicker_pct,
             "shadow_data_bytes": run.report.shadow_data_bytes,
-            "stages_ms": m.stages_ms,
+            "stages_ms": if gpu.gpu_timestamps { &m.stages_ms } else { &t.breakdown_ms },
             "total_ms": m.total_ms,
+            "submits_per_frame": run.submits_per_frame,
+            "stalls": run.stalls,
             "setup_ms": run.setup_ms,
             "counters": run.report.counters,
             "sampling": run.report.sampling,
@@ -120,9 +122,11 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         "height": h,
         "adapter": gpu.adapter_summary(),
         "timer": gpu.timer_name(),
+        "stages_timer": gpu.stages_timer_name(),
         "repeat": args.repeat,
         "animation": animation_json(&cfg, &lab),
         "bvh": {"gpu_bytes": lab.gscene.bvh_bytes, "nodes": lab.bvh.nodes.len(), "bytes": lab.bvh.bytes(), "bytes_per_triangle": lab.bvh.bytes() as f64 / cfg.scene.triangle_count() as f64, "depth": lab.bvh.depth, "build_ms": lab.bvh.build_ms},
+        "gbuffer_ms": view.frame_ms,
         "gbuffer_stages_ms": view.stages_ms,
         "frames": frames,
         "cameras": path.cameras,
@@ -130,7 +134,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
             "label": "rt",
             "evaluated_pixels": view.mask.iter().filter(|m| **m != 0).count(),
             "edge_pixels": edges,
-            "stages_ms": rt.stages_ms,
+            "stages_ms": if gpu.gpu_timestamps { &rt.stages_ms } else { &path.rt_breakdown_ms },
             "total_ms": rt_total,
             "counters": rt.report.counters,
             "frames": path.reference,
@@ -235,4 +239,10 @@ fn summary(cfg: &RunConfig, m: &serde_json::Value) {
         );
     }
     println!("times: median of {} frames, {}", m["repeat"], m["timer"].as_str().unwrap_or(""));
+    for t in m["techniques"].as_array().into_iter().flatten() {
+        if let Some(s) = t["stalls"].as_array().filter(|s| !s.is_empty()) {
+            let names: Vec<&str> = s.iter().filter_map(|v| v.as_str()).collect();
+            println!("  {} stalls mid-frame: {}", t["label"].as_str().unwrap_or(""), names.join(", "));
+        }
+    }
 }

@@ -57,6 +57,9 @@ pub struct TechniqueFrames {
     /// The last frame's run (its pictures and report go to the outputs).
     pub last: Run,
     pub frames: Vec<FrameRecord>,
+    /// Per-stage ms of one profiled frame (a wait per stage) after the last frame, on adapters
+    /// without sane timestamps; empty on the others (their timed frames carry stage times).
+    pub breakdown_ms: BTreeMap<String, f64>,
 }
 
 pub struct PathRun {
@@ -65,6 +68,8 @@ pub struct PathRun {
     pub view: View,
     pub rt: Run,
     pub reference: Vec<ReferenceFrame>,
+    /// `rt`'s profiled breakdown (see [`TechniqueFrames::breakdown_ms`]).
+    pub rt_breakdown_ms: BTreeMap<String, f64>,
     pub techniques: Vec<TechniqueFrames>,
 }
 
@@ -134,8 +139,18 @@ pub fn run(lab: &Lab, cfg: &RunConfig, frames: usize, repeat: usize, pb: &Progre
         last = Some((view, rt, runs));
     }
     let (view, rt, runs) = last.expect("at least one frame");
-    let techniques = runs.into_iter().zip(records).map(|(last, frames)| TechniqueFrames { last, frames }).collect();
-    Ok(PathRun { cameras, view, rt, reference, techniques })
+    // the breakdown: one more frame each, profiled, after the measured ones (it advances
+    // techniques with history by a frame, so it comes last)
+    let timestamps = lab.gpu.gpu_timestamps;
+    let mut profile = |inst: &mut Instance| if timestamps { Ok(BTreeMap::new()) } else { lab.profile(&view, inst) };
+    pb.set_message("profiled breakdown");
+    let rt_breakdown_ms = profile(&mut rt_inst)?;
+    let mut techniques = Vec::new();
+    for ((last, frames), inst) in runs.into_iter().zip(records).zip(insts.iter_mut()) {
+        let breakdown_ms = profile(inst).with_context(|| format!("technique '{}', profiled frame", inst.label))?;
+        techniques.push(TechniqueFrames { last, frames, breakdown_ms });
+    }
+    Ok(PathRun { cameras, view, rt, reference, rt_breakdown_ms, techniques })
 }
 
 /// Top-level figures of a technique over its frames.

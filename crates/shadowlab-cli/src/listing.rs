@@ -31,6 +31,8 @@ pub fn techniques() -> Result<()> {
         println!("  cost:    {}", t.cost);
         println!("  quality: {}", t.quality);
         println!("  source:  {}", t.source);
+        println!("  stalls:  {}", if t.stalls.is_empty() { "none: a frame records into one submit" } else { t.stalls });
+        println!("  needs:   {}", if t.needs.is_empty() { "WebGPU's default features and limits" } else { t.needs });
         if t.params.is_empty() {
             println!("  parameters: none");
         }

@@ -23,6 +23,14 @@ pub fn texture_depth() -> BindingType {
         multisampled: false,
     }
 }
+/// A write-only R32Float storage texture (the host's visibility texture).
+pub fn storage_texture_r32f() -> BindingType {
+    BindingType::StorageTexture {
+        access: wgpu::StorageTextureAccess::WriteOnly,
+        format: wgpu::TextureFormat::R32Float,
+        view_dimension: wgpu::TextureViewDimension::D2,
+    }
+}
 pub fn comparison_sampler() -> BindingType {
     BindingType::Sampler(wgpu::SamplerBindingType::Comparison)
 }

@@ -14,6 +14,9 @@ pub enum GpuError {
     Validation(String),
 }
 
+/// Pipeline constants of a technique's analysis variant of its evaluation (`view.wgsl`).
+pub const COUNTING: &[(&str, f64)] = &[("COUNT_SAMPLES", 1.0)];
+
 pub struct Gpu {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
@@ -22,6 +25,8 @@ pub struct Gpu {
     /// Stage times come from GPU timestamps (else wall clock with a device wait); see `timing`.
     pub gpu_timestamps: bool,
     errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+    /// Queue submissions made through [`Gpu::submit`] (tests count a frame's submits).
+    submits: std::sync::atomic::AtomicU64,
 }
 
 impl Gpu {
@@ -39,7 +44,6 @@ impl Gpu {
         let limits = adapter.limits();
         let ts = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let has_ts = adapter.features().contains(ts);
-        let gpu_timestamps = has_ts && crate::timing::want_timestamps(&info)?;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("shadowlab"),
             // sv: unclipped depth (infinite extrusion) and a float depth-stencil target, where offered
@@ -51,10 +55,34 @@ impl Gpu {
             trace: wgpu::Trace::Off,
         }))
         .map_err(|e| GpuError::Device(e.to_string()))?;
+        Gpu::from_device(device, queue, info)
+    }
+
+    /// Wraps a device the host application already opened (the library seam). shadowlab keeps
+    /// no state outside this struct; it installs an uncaptured-error handler on the device so
+    /// that [`Gpu::take_error`] can report validation errors. Stage timing uses GPU timestamps
+    /// when the device was opened with `TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS` and
+    /// the adapter is not a CPU one (`SHADOWLAB_TIMER` overrides). What each technique needs
+    /// beyond WebGPU's defaults is listed by `shadowlab techniques` (`TechniqueInfo::needs`).
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Result<Gpu, GpuError> {
+        let limits = device.limits();
+        let ts = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let gpu_timestamps = device.features().contains(ts) && crate::timing::want_timestamps(&info)?;
         let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(e.to_string())));
-        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors })
+        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors, submits: Default::default() })
+    }
+
+    /// Submits one command buffer (every submit of shadowlab goes through here and is counted).
+    pub fn submit(&self, cmd: wgpu::CommandBuffer) {
+        self.submits.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.queue.submit([cmd]);
+    }
+
+    /// Submits made through [`Gpu::submit`] so far.
+    pub fn submit_count(&self) -> u64 {
+        self.submits.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Returns the first GPU validation/out-of-memory error raised since the last call.
@@ -77,6 +105,15 @@ impl Gpu {
             crate::timing::TIMESTAMP_TIMER
         } else {
             crate::timing::WALL_TIMER
+        }
+    }
+
+    /// Which timer the per-stage times come from.
+    pub fn stages_timer_name(&self) -> &'static str {
+        if self.gpu_timestamps {
+            crate::timing::TIMESTAMP_TIMER
+        } else {
+            crate::timing::PROFILE_TIMER
         }
     }
 
@@ -123,8 +160,14 @@ impl Gpu {
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
-        self.queue.submit([enc.finish()]);
+        self.submit(enc.finish());
         self.map_and_take(&staging)
+    }
+
+    /// Maps a `MAP_READ` buffer whose copy was already submitted, and reads `count` values.
+    pub fn map_read_as<T: bytemuck::Pod>(&self, staging: &wgpu::Buffer, count: usize) -> Vec<T> {
+        let bytes = self.map_and_take(staging);
+        bytemuck::pod_collect_to_vec(&bytes[..count * std::mem::size_of::<T>()])
     }
 
     pub fn read_buffer_as<T: bytemuck::Pod>(&self, src: &wgpu::Buffer, count: usize) -> Vec<T> {
@@ -152,7 +195,7 @@ impl Gpu {
             },
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
-        self.queue.submit([enc.finish()]);
+        self.submit(enc.finish());
         let data = self.map_and_take(&staging);
         let mut out = Vec::with_capacity((row * h) as usize);
         for y in 0..h as usize {
@@ -181,6 +224,19 @@ impl Gpu {
 
     /// A compute pipeline with explicit bind group layouts.
     pub fn compute_pipeline(&self, label: &str, source: &str, entry: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::ComputePipeline {
+        self.compute_pipeline_with(label, source, entry, layouts, &[])
+    }
+
+    /// [`Gpu::compute_pipeline`] with WGSL `override` constants set (e.g. `COUNT_SAMPLES` for a
+    /// technique's analysis variant of its evaluation).
+    pub fn compute_pipeline_with(
+        &self,
+        label: &str,
+        source: &str,
+        entry: &str,
+        layouts: &[&wgpu::BindGroupLayout],
+        constants: &[(&str, f64)],
+    ) -> wgpu::ComputePipeline {
         let module = self.shader(label, source);
         let layout = self.pipeline_layout(label, layouts);
         self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -188,7 +244,7 @@ impl Gpu {
             layout: Some(&layout),
             module: &module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: None,
         })
     }

@@ -12,10 +12,11 @@ use shadowlab_core::scene::Scene;
 
 use crate::frame::{FrameUniform, LightUniform};
 use crate::gbuffer::{GBuffer, GBufferPass};
+use crate::record::{FrameStamps, Recorded, Recorder};
 use crate::scene_gpu::GpuScene;
 use crate::shade::ShadePass;
 use crate::techniques::{self, FrameInputs, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
+use crate::timing::median;
 use crate::{Gpu, GpuError};
 
 pub struct Lab<'a> {
@@ -53,8 +54,11 @@ pub struct View {
     pub position: Vec<[f32; 4]>,
     pub normal: Vec<[f32; 4]>,
     pub mask: Vec<u32>,
-    /// G-buffer and mask stage times (ms).
+    /// G-buffer and mask stage times (ms): GPU timestamps of the timed frame, or the profiled
+    /// breakdown (see [`Gpu::stages_timer_name`]); with `scene.animate` when objects move.
     pub stages_ms: BTreeMap<String, f64>,
+    /// The G-buffer + mask frame: one submit, one wait (ms; see [`Gpu::timer_name`]).
+    pub frame_ms: f64,
 }
 
 /// A technique created for one light, kept across the views of a path.
@@ -92,9 +96,17 @@ pub struct Run {
     /// RGBA8 shaded picture.
     pub shaded: Vec<u8>,
     pub report: TechniqueReport,
-    /// Median per stage over the timed repetitions.
+    /// Per-stage ms: the timed frames' GPU timestamps (median per stage) on adapters with sane
+    /// timestamps; else the profiled breakdown (a wait per stage) when one was run
+    /// ([`Lab::profile`]), else empty. Never the sum that makes `total_ms`.
     pub stages_ms: BTreeMap<String, f64>,
+    /// The timed frame (median over the timed repetitions): one recorded frame, one submit and
+    /// one wait (ms; [`Gpu::timer_name`] says which clock).
     pub total_ms: f64,
+    /// Submits of one timed frame (1 without mid-frame readbacks).
+    pub submits_per_frame: u64,
+    /// Mid-frame readbacks of one timed frame, by stage name.
+    pub stalls: Vec<String>,
     /// Pipeline and resource creation (not part of total_ms).
     pub setup_ms: f64,
 }
@@ -144,9 +156,21 @@ impl<'a> Lab<'a> {
         let g = GBuffer::new(gpu, width, height);
         let frame = gpu.uniform("frame", &FrameUniform::new(camera, prev, width, height));
         let light_buf = gpu.uniform("light", &LightUniform::new(light, self.gscene.eps));
-        let mut timer = StageTimer::default();
-        self.gbuffer_pass.render(gpu, &mut timer, &self.gscene, &frame, &g);
-        self.gbuffer_pass.mask(gpu, &mut timer, &frame, &light_buf, &g);
+        let record = |rec: &mut Recorder| {
+            self.gbuffer_pass.render(gpu, rec, &self.gscene, &frame, &g);
+            self.gbuffer_pass.mask(gpu, rec, &frame, &light_buf, &g);
+        };
+        let (frame_ms, stamped) = self.timed_frame(|rec| {
+            record(rec);
+            Ok(())
+        })?;
+        let mut stages_ms = match stamped {
+            Some(s) => s,
+            None => self.profiled_frame(|rec| {
+                record(rec);
+                Ok(())
+            })?,
+        };
         gpu.take_error()?;
         let position: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&g.position, 16));
         let normal: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&g.normal, 16));
@@ -154,7 +178,6 @@ impl<'a> Lab<'a> {
         let visibility = gpu.storage("visibility", g.pixels() as u64 * 4);
         let color = ShadePass::output(gpu, &g);
         let (time, prev_time) = self.time.get();
-        let mut stages_ms = timer.medians();
         if self.gscene.is_animated() {
             // CPU transform + dynamic BVH rebuild + upload of the last `set_time`
             stages_ms.insert("scene.animate".into(), self.animate_ms.get());
@@ -176,7 +199,39 @@ impl<'a> Lab<'a> {
             normal,
             mask,
             stages_ms,
+            frame_ms,
         })
+    }
+
+    /// Records one frame with `f`, submits it once and waits: (wall ms, per-stage GPU ms when
+    /// the adapter has sane timestamps). Mid-frame syncs inside `f` add their submits.
+    fn timed_frame(&self, f: impl FnOnce(&mut Recorder) -> Result<(), GpuError>) -> Result<(f64, Option<BTreeMap<String, f64>>), GpuError> {
+        let gpu = self.gpu;
+        let stamps = gpu.gpu_timestamps.then(|| FrameStamps::new(gpu));
+        let t0 = std::time::Instant::now();
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut rec = match &stamps {
+            Some(s) => Recorder::with_stamps(gpu, &mut enc, s),
+            None => Recorder::new(gpu, &mut enc),
+        };
+        f(&mut rec)?;
+        let done: Recorded = rec.finish();
+        gpu.submit(enc.finish());
+        gpu.wait();
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok((ms, stamps.map(|s| done.read_stamps(gpu, &s))))
+    }
+
+    /// One profiled frame of `f`: each stage submitted and waited for alone (the breakdown).
+    fn profiled_frame(&self, f: impl FnOnce(&mut Recorder) -> Result<(), GpuError>) -> Result<BTreeMap<String, f64>, GpuError> {
+        let gpu = self.gpu;
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("profiled frame") });
+        let mut rec = Recorder::profiled(gpu, &mut enc);
+        f(&mut rec)?;
+        let done = rec.finish();
+        gpu.submit(enc.finish());
+        gpu.wait();
+        Ok(done.profile_ms)
     }
 
     /// Resolves `spec`, creates the technique, runs it once to warm up and `repeat` more times
@@ -195,7 +250,25 @@ impl<'a> Lab<'a> {
         repeat: usize,
     ) -> Result<Run, GpuError> {
         let mut inst = self.instantiate(info, params, label, &view.light)?;
-        self.step(view, &mut inst, true, repeat)
+        let mut run = self.step(view, &mut inst, true, repeat)?;
+        let breakdown = self.profile(view, &mut inst)?;
+        if !self.gpu.gpu_timestamps {
+            run.stages_ms = breakdown;
+        }
+        Ok(run)
+    }
+
+    /// One more frame of `inst` on `view`, profiled: each stage submitted and waited for alone,
+    /// timed by the wall clock. The breakdown of where a frame's time goes on adapters without
+    /// sane timestamps; never added up as the frame's time. It advances `inst` by one frame
+    /// (techniques with history see it), so callers run it after the frames they measure.
+    pub fn profile(&self, view: &View, inst: &mut Instance) -> Result<BTreeMap<String, f64>, GpuError> {
+        self.set_time(view.time, view.prev_time)?;
+        let inputs = view.inputs(&self.gscene);
+        let tech = inst.tech.as_mut();
+        let ms = self.profiled_frame(|rec| techniques::run_frame(tech, self.gpu, &inputs, rec))?;
+        self.gpu.take_error()?;
+        Ok(ms)
     }
 
     /// Creates a technique for `light` once, to be run on a sequence of views with
@@ -222,20 +295,44 @@ impl<'a> Lab<'a> {
         let inputs = view.inputs(&self.gscene);
         let tech = inst.tech.as_mut();
         if warm_up {
-            techniques::run_frame(tech, gpu, &inputs, &mut StageTimer::default())?;
+            techniques::submit_frame(tech, gpu, &inputs)?;
+            gpu.wait();
             gpu.take_error()?;
         }
-        let mut timer = StageTimer::default();
+        let mut totals = Vec::new();
+        let mut stamped: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+        let mut stalls = Vec::new();
+        let mut submits = 0;
         for _ in 0..repeat.max(1) {
-            techniques::run_frame(tech, gpu, &inputs, &mut timer)?;
+            let before = gpu.submit_count();
+            let mut frame_stalls = Vec::new();
+            let (ms, stages) = self.timed_frame(|rec| {
+                techniques::run_frame(tech, gpu, &inputs, rec)?;
+                frame_stalls = rec.stalls().to_vec();
+                Ok(())
+            })?;
+            submits = gpu.submit_count() - before;
+            stalls = frame_stalls;
+            // a timestamped frame's time is the sum of its stages' GPU time
+            totals.push(stages.as_ref().map_or(ms, |s| s.values().sum()));
+            for (k, v) in stages.unwrap_or_default() {
+                stamped.entry(k).or_default().push(v);
+            }
         }
         gpu.take_error()?;
-        let stages_ms = timer.medians();
-        let total_ms = stages_ms.values().sum();
+        let stages_ms: BTreeMap<String, f64> = stamped.iter().map(|(k, v)| (k.clone(), median(v))).collect();
+        let total_ms = median(&totals);
         let visibility: Vec<f32> = gpu.read_buffer_as(&view.visibility, view.gbuffer.pixels());
+        // lab-only analysis passes, after the timed frames
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("analysis") });
+        let mut rec = Recorder::new(gpu, &mut enc);
+        tech.analyze(gpu, &inputs, &mut rec)?;
+        rec.finish();
+        gpu.submit(enc.finish());
+        gpu.wait();
+        gpu.take_error()?;
         let report = tech.report(gpu);
-        let mut shade_timer = StageTimer::default();
-        let shaded = self.shade_pass.shade(gpu, &mut shade_timer, &inputs, &view.color);
+        let shaded = self.shade_pass.shade(gpu, &inputs, &view.color);
         gpu.take_error()?;
         Ok(Run {
             label: inst.label.clone(),
@@ -246,6 +343,8 @@ impl<'a> Lab<'a> {
             report,
             stages_ms,
             total_ms,
+            submits_per_frame: submits,
+            stalls,
             setup_ms: inst.setup_ms,
         })
     }

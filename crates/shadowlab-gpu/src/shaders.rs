@@ -26,6 +26,7 @@ pub fn compose_depth(body: &str) -> String {
 pub fn all() -> Vec<(&'static str, String)> {
     let mut v = vec![];
     v.extend(crate::gbuffer::shaders());
+    v.extend(crate::host::shaders());
     v.extend(crate::reference::shaders());
     v.extend(crate::shade::shaders());
     v.extend(crate::reduce::shaders());

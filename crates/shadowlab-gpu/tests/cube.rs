@@ -8,8 +8,7 @@ use shadowlab_core::light::Light;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::techniques::cube::CubeMap;
-use shadowlab_gpu::techniques::{self, run_frame};
-use shadowlab_gpu::timing::StageTimer;
+use shadowlab_gpu::techniques::{self, submit_frame};
 use shadowlab_gpu::GpuError;
 
 mod common;
@@ -74,7 +73,7 @@ fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {
     let v = view(&lab, &scene, ROOM_POINT, 256);
     let (_, p) = techniques::resolve(&spec("cube:res=64,pcf=3"), Some(&light)).unwrap();
     let mut cube = CubeMap::new(&gpu, &lab.gscene, &p, &light).unwrap();
-    run_frame(&mut cube, &gpu, &v.inputs(&lab.gscene), &mut StageTimer::default()).unwrap();
+    submit_frame(&mut cube, &gpu, &v.inputs(&lab.gscene)).unwrap();
     let gpu_vis: Vec<f32> = gpu.read_buffer_as(&v.visibility, v.mask.len());
     let faces = cube.read_faces(&gpu);
     let (res, far) = (64u32, cube.far());

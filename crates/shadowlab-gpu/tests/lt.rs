@@ -11,8 +11,7 @@ use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::techniques::lt::{LeakTracing, Mode};
-use shadowlab_gpu::techniques::{self, run_frame, Technique};
-use shadowlab_gpu::timing::StageTimer;
+use shadowlab_gpu::techniques::{self, submit_frame, Technique};
 
 mod common;
 use common::*;
@@ -29,7 +28,7 @@ fn make(lab: &Lab, spec: &str, light: &shadowlab_core::light::Light) -> LeakTrac
 }
 
 fn frame(lab: &Lab, t: &mut LeakTracing, v: &View) -> Vec<f32> {
-    run_frame(t, lab.gpu, &v.inputs(&lab.gscene), &mut StageTimer::default()).unwrap();
+    submit_frame(t, lab.gpu, &v.inputs(&lab.gscene)).unwrap();
     lab.gpu.take_error().unwrap();
     lab.gpu.read_buffer_as(&v.visibility, v.gbuffer.pixels())
 }

@@ -8,8 +8,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::techniques::mdsm::{MultiDepthMap, INFO};
-use shadowlab_gpu::techniques::run_frame;
-use shadowlab_gpu::timing::StageTimer;
+use shadowlab_gpu::techniques::submit_frame;
 use shadowlab_gpu::Gpu;
 
 mod common;
@@ -25,7 +24,7 @@ fn run_direct(gpu: &Gpu, lab: &Lab, v: &View, args: &str) -> (MultiDepthMap, Vec
     let params = spec(&format!("mdsm:{args}")).resolve(INFO.params).unwrap();
     let mut t = MultiDepthMap::new(gpu, &lab.gscene, &params, &v.light).unwrap();
     let inputs = v.inputs(&lab.gscene);
-    run_frame(&mut t, gpu, &inputs, &mut StageTimer::default()).unwrap();
+    submit_frame(&mut t, gpu, &inputs).unwrap();
     gpu.take_error().unwrap();
     let vis = gpu.read_buffer_as(&v.visibility, v.gbuffer.pixels());
     (t, vis)

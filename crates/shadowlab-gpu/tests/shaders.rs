@@ -347,3 +347,38 @@ fn lt_params_layout_matches_wgsl() {
         check(&get(n), "TraceParams", size_of::<TraceParams>(), &[("cfg", offset_of!(TraceParams, cfg))]);
     }
 }
+
+/// WebGPU's default limit of storage buffers per shader stage; `TechniqueInfo::needs` must
+/// declare more where a technique's entry point uses more.
+const DEFAULT_STORAGE_BUFFERS: usize = 8;
+
+#[test]
+fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {
+    let mut over = std::collections::BTreeSet::new();
+    for (name, src) in shadowlab_gpu::shaders::all() {
+        let module = naga::front::wgsl::parse_str(&src).unwrap();
+        let info = Validator::new(ValidationFlags::all(), Capabilities::empty()).validate(&module).unwrap();
+        for (i, ep) in module.entry_points.iter().enumerate() {
+            let fi = info.get_entry_point(i);
+            let used = module
+                .global_variables
+                .iter()
+                .filter(|(h, g)| matches!(g.space, naga::AddressSpace::Storage { .. }) && !fi[*h].is_empty())
+                .count();
+            if used > DEFAULT_STORAGE_BUFFERS {
+                eprintln!("{name} {}: {used} storage buffers", ep.name);
+                over.insert(name.split('/').next().unwrap().to_string());
+            }
+        }
+    }
+    // the folders whose shaders go beyond the default, and the techniques built from them
+    let folders: Vec<&str> = over.iter().map(|s| s.as_str()).collect();
+    assert_eq!(
+        folders,
+        ["lt"],
+        "a new folder needs more than {DEFAULT_STORAGE_BUFFERS} storage buffers: declare it in its TechniqueInfo::needs"
+    );
+    for t in shadowlab_gpu::techniques::REGISTRY.iter().filter(|t| ["lt", "ltt", "hybrid-pcf"].contains(&t.name)) {
+        assert!(t.needs.contains("storage buffers"), "{} must declare its storage buffers", t.name);
+    }
+}

@@ -10,7 +10,6 @@ use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::prefix_sum::{PrefixSum, ScanParams};
 use shadowlab_gpu::techniques;
 use shadowlab_gpu::techniques::warp::{Variant, Warped};
-use shadowlab_gpu::timing::StageTimer;
 use wgpu::BufferUsages;
 
 mod common;
@@ -70,7 +69,7 @@ fn run_direct(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant
     let (_, params) = techniques::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
     let mut t = Warped::new(gpu, &lab.gscene, &params, &v.light, variant).unwrap();
     let f = v.inputs(&lab.gscene);
-    techniques::run_frame(&mut t, gpu, &f, &mut StageTimer::default()).unwrap();
+    techniques::submit_frame(&mut t, gpu, &f).unwrap();
     gpu.take_error().unwrap();
     t
 }

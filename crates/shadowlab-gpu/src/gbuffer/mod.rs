@@ -3,9 +3,9 @@
 
 use wgpu::TextureFormat as F;
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu};
 
 const GBUFFER_WGSL: &str = include_str!("gbuffer.wgsl");
@@ -80,12 +80,12 @@ impl GBufferPass {
     }
 
     /// Rasterises the scene into `g` (stage `gbuffer`).
-    pub fn render(&self, gpu: &Gpu, timer: &mut StageTimer, scene: &GpuScene, frame: &wgpu::Buffer, g: &GBuffer) {
+    pub fn render(&self, gpu: &Gpu, rec: &mut Recorder, scene: &GpuScene, frame: &wgpu::Buffer, g: &GBuffer) {
         let group = binding::group(&gpu.device, "gbuffer.frame", &self.frame_layout, &[frame.as_entire_binding()]);
         let views: Vec<wgpu::TextureView> =
             [&g.position, &g.normal, &g.albedo, &g.motion].iter().map(|t| t.create_view(&Default::default())).collect();
         let depth = g.depth.create_view(&Default::default());
-        timer.stage(gpu, "gbuffer", |enc| {
+        rec.stage("gbuffer", |enc| {
             let colors: Vec<&wgpu::TextureView> = views.iter().collect();
             let mut pass = raster::begin_pass(enc, "gbuffer", &colors, &depth);
             pass.set_pipeline(&self.raster);
@@ -96,7 +96,7 @@ impl GBufferPass {
     }
 
     /// Writes `g.mask` for one light (stage `mask`).
-    pub fn mask(&self, gpu: &Gpu, timer: &mut StageTimer, frame: &wgpu::Buffer, light: &wgpu::Buffer, g: &GBuffer) {
+    pub fn mask(&self, gpu: &Gpu, rec: &mut Recorder, frame: &wgpu::Buffer, light: &wgpu::Buffer, g: &GBuffer) {
         let pv = g.position.create_view(&Default::default());
         let nv = g.normal.create_view(&Default::default());
         let group = binding::group(
@@ -111,6 +111,6 @@ impl GBufferPass {
                 g.mask.as_entire_binding(),
             ],
         );
-        timer.stage(gpu, "mask", |enc| gpu.dispatch_2d(enc, "mask", &self.mask, &[&group], g.width, g.height));
+        rec.stage("mask", |enc| gpu.dispatch_2d(enc, "mask", &self.mask, &[&group], g.width, g.height));
     }
 }

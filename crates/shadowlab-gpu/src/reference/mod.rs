@@ -4,9 +4,9 @@
 
 use shadowlab_core::params::ParamDef;
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
 /// The shadow-ray library (`occluded`, `sample_shadowed`): needs `scene.wgsl` and the view
@@ -31,6 +31,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "Whitted 1980; BVH by obvhs (PLOC + SAH reinsertion)",
     lights: &["directional", "spot", "point"],
     params: &[] as &[ParamDef],
+    stalls: "",
+    needs: "",
     create: |gpu, scene, _params, _light| Ok(Box::new(RayTraced::new(gpu, scene))),
 };
 
@@ -51,13 +53,13 @@ impl RayTraced {
 
 impl Technique for RayTraced {
     /// The BVH is built and uploaded with the scene: nothing to render per frame.
-    fn render(&mut self, _gpu: &Gpu, _f: &FrameInputs, _timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, _gpu: &Gpu, _f: &FrameInputs, _rec: &mut Recorder) -> Result<(), GpuError> {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let group = f.view_group(gpu, "rt", &self.layout, &[self.rays.as_entire_binding()]);
-        timer.stage(gpu, "rt.trace", |enc| {
+        rec.stage("rt.trace", |enc| {
             enc.clear_buffer(&self.rays, 0, None);
             gpu.dispatch_2d(enc, "rt.trace", &self.pipeline, &[&group, &f.scene.group], f.gbuffer.width, f.gbuffer.height)
         });

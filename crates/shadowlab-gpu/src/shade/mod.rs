@@ -3,7 +3,6 @@
 use crate::gbuffer::GBuffer;
 use crate::shaders::compose;
 use crate::techniques::FrameInputs;
-use crate::timing::StageTimer;
 use crate::{binding, Gpu};
 
 const SHADE_WGSL: &str = include_str!("shade.wgsl");
@@ -37,7 +36,7 @@ impl ShadePass {
     }
 
     /// Shades `visibility` into `out` (see [`ShadePass::output`]) and returns RGBA8 pixels (stage `shade`).
-    pub fn shade(&self, gpu: &Gpu, timer: &mut StageTimer, f: &FrameInputs, out: &wgpu::Buffer) -> Vec<u8> {
+    pub fn shade(&self, gpu: &Gpu, f: &FrameInputs, out: &wgpu::Buffer) -> Vec<u8> {
         let g = f.gbuffer;
         let views: Vec<_> = [&g.position, &g.normal, &g.albedo].iter().map(|t| t.create_view(&Default::default())).collect();
         let group = binding::group(
@@ -55,7 +54,9 @@ impl ShadePass {
                 out.as_entire_binding(),
             ],
         );
-        timer.stage(gpu, "shade", |enc| gpu.dispatch_2d(enc, "shade", &self.pipeline, &[&group], g.width, g.height));
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shade") });
+        gpu.dispatch_2d(&mut enc, "shade", &self.pipeline, &[&group], g.width, g.height);
+        gpu.submit(enc.finish());
         gpu.read_buffer(out)[..g.pixels() * 4].to_vec()
     }
 }

@@ -22,8 +22,8 @@ use shadowlab_core::metrics::SamplingStats;
 use shadowlab_core::params::{ParamDef, ParamValues, TechniqueSpec};
 
 use crate::gbuffer::GBuffer;
+use crate::record::{Recorded, Recorder};
 use crate::scene_gpu::GpuScene;
-use crate::timing::StageTimer;
 use crate::{Gpu, GpuError};
 
 /// Everything a technique reads for one view and one light; it writes `visibility`
@@ -100,28 +100,50 @@ pub struct TechniqueReport {
     pub images: Vec<NamedImage>,
 }
 
-/// One shadow technique for one light. The lab calls, per frame: [`prepare`](Technique::prepare)
-/// (analysis of the view samples, e.g. a warp), [`render`](Technique::render) (the shadow data),
-/// [`evaluate`](Technique::evaluate) (the visibility buffer); then [`report`](Technique::report).
-/// Each records its GPU work through `timer` under pass names (`<technique>.<stage>`).
+/// One shadow technique for one light. Per frame the caller calls [`prepare`](Technique::prepare)
+/// (analysis of the view samples, e.g. a warp), [`render`](Technique::render) (the shadow data)
+/// and [`evaluate`](Technique::evaluate) (the visibility buffer), each recording its passes into
+/// the caller's encoder through `rec` under stage names `<technique>.<stage>`; none of them
+/// submits or waits, except at the mid-frame readbacks the technique declares in
+/// [`TechniqueInfo::stalls`] ([`Recorder::sync`]). The caller submits the frame.
+///
+/// The lab then, outside the timed frame, calls [`analyze`](Technique::analyze) (the analysis
+/// passes only the lab needs: view samples counted per texel) and [`report`](Technique::report).
 pub trait Technique {
     /// Per-frame analysis of the view before the shadow data is rendered (default: none).
-    fn prepare(&mut self, _gpu: &Gpu, _f: &FrameInputs, _timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, _gpu: &Gpu, _f: &FrameInputs, _rec: &mut Recorder) -> Result<(), GpuError> {
         Ok(())
     }
     /// Renders the shadow data (maps, warps, tiles...) for this frame.
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError>;
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError>;
     /// Writes `f.visibility` for every evaluated pixel.
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError>;
-    /// Memory, counters, sampling statistics and pictures of the last frame.
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError>;
+    /// Lab-only instrumentation of the last frame (sampling statistics, counters), recorded
+    /// after the frame and outside its timing. It reads the frame's shadow data and must not
+    /// change the visibility (tests check it bit for bit). Default: none.
+    fn analyze(&mut self, _gpu: &Gpu, _f: &FrameInputs, _rec: &mut Recorder) -> Result<(), GpuError> {
+        Ok(())
+    }
+    /// Memory, counters, sampling statistics and pictures of the last frame (after `analyze`).
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport;
 }
 
-/// prepare, render, evaluate.
-pub fn run_frame(t: &mut dyn Technique, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-    t.prepare(gpu, f, timer)?;
-    t.render(gpu, f, timer)?;
-    t.evaluate(gpu, f, timer)
+/// prepare, render, evaluate: one frame, recorded.
+pub fn run_frame(t: &mut dyn Technique, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+    t.prepare(gpu, f, rec)?;
+    t.render(gpu, f, rec)?;
+    t.evaluate(gpu, f, rec)
+}
+
+/// Records one frame of `t` into a fresh encoder and submits it once, without waiting; for
+/// tests and simple callers. Returns the recorded frame's stalls.
+pub fn submit_frame(t: &mut dyn Technique, gpu: &Gpu, f: &FrameInputs) -> Result<Recorded, GpuError> {
+    let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+    let mut rec = Recorder::new(gpu, &mut enc);
+    run_frame(t, gpu, f, &mut rec)?;
+    let done = rec.finish();
+    gpu.submit(enc.finish());
+    Ok(done)
 }
 
 pub type CreateFn = fn(&Gpu, &GpuScene, &ParamValues, &Light) -> Result<Box<dyn Technique>, GpuError>;
@@ -136,6 +158,11 @@ pub struct TechniqueInfo {
     /// Light types it supports.
     pub lights: &'static [&'static str],
     pub params: &'static [ParamDef],
+    /// Mid-frame readbacks (the frame is submitted and waited for at that point), and any
+    /// delayed mode that avoids them; empty when a frame records without a stall.
+    pub stalls: &'static str,
+    /// Device features and limits needed beyond WebGPU's defaults (empty: none).
+    pub needs: &'static str,
     pub create: CreateFn,
 }
 

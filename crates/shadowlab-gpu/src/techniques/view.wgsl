@@ -1,6 +1,11 @@
 // The view inputs every visibility pass reads, bind group 0 bindings 0-5 (techniques/mod.rs
 // `view_bindings`); a technique's own bindings follow from 6.
 
+// Lab-only instrumentation (view samples counted per shadow texel): false in the timed
+// evaluation, true in the analysis pipeline of the same shader (`Technique::analyze`), which the
+// lab runs after the timed frame.
+override COUNT_SAMPLES: bool = false;
+
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> light: LightU;
 @group(0) @binding(2) var g_position: texture_2d<f32>;

@@ -90,7 +90,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // sampling statistics: the texel of the chosen cascade this sample lands in
     let res = u32(csm.cfg.y);
     let m0 = to_map(c, s.p);
-    if all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
+    if COUNT_SAMPLES && all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
         let t = vec2<u32>(m0.xy * f32(res));
         atomicAdd(&counts[(c * res + t.y) * res + t.x], 1u);
     }

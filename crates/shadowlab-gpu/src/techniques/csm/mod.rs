@@ -21,11 +21,11 @@ use shadowlab_core::params::ParamValues;
 
 pub use params::*;
 
+use crate::record::Recorder;
 use crate::reduce::{decode, MinMax};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
@@ -43,6 +43,9 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "Engel 2006; Zhang et al. 2006 (practical splits); seed 001 chapter 2.3 and 4; SDSM (Lauritzen 2011) for tightening",
     lights: &["directional"],
     params: PARAMS,
+    stalls:
+        "with tighten=true (default): csm.readback, the view depth range read back before the fit; tighten=false records without a stall",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, p, light)?)),
 };
 
@@ -91,6 +94,8 @@ pub struct Cascaded {
     depth_groups: Vec<wgpu::BindGroup>,
     depth_pipeline: wgpu::RenderPipeline,
     eval_pipeline: wgpu::ComputePipeline,
+    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
+    count_pipeline: wgpu::ComputePipeline,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     reduce: MinMax,
@@ -140,6 +145,8 @@ impl Cascaded {
             &[binding::uniform(), texture_depth_array(), binding::comparison_sampler(), binding::storage(false), binding::storage(false)],
         );
         let eval_pipeline = gpu.compute_pipeline("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
+        let count_pipeline =
+            gpu.compute_pipeline_with("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout], crate::context::COUNTING);
         let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {
@@ -163,6 +170,7 @@ impl Cascaded {
             depth_groups,
             depth_pipeline,
             eval_pipeline,
+            count_pipeline,
             eval_layout,
             sampler,
             reduce: MinMax::new(gpu, "csm.reduce", 3),
@@ -187,16 +195,16 @@ impl Cascaded {
 
 impl Technique for Cascaded {
     /// Depth reduction on the GPU and one readback (with `tighten`), the fit on the CPU.
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.depth_range = None;
         if self.tighten {
-            timer.stage(gpu, "csm.analyze", |enc| {
+            rec.stage("csm.analyze", |enc| {
                 self.reduce.record(gpu, enc, "csm.reduce", &f.gbuffer.position, &f.gbuffer.mask);
                 enc.copy_buffer_to_buffer(&self.reduce.result, 0, &self.probe, 0, PROBE_BYTES);
             });
             let t0 = std::time::Instant::now();
-            let words: Vec<u32> = gpu.read_buffer_as(&self.probe, 2);
-            timer.add("csm.readback", t0.elapsed().as_secs_f64() * 1e3);
+            let words: Vec<u32> = rec.read_buffer_as(&self.probe, 2, "csm.readback");
+            rec.cpu("csm.readback", t0.elapsed().as_secs_f64() * 1e3);
             self.depth_range = decode([words[0], words[1]]);
         }
 
@@ -213,16 +221,16 @@ impl Technique for Cascaded {
         self.boxes = cascades::fit_cascades(&frustum, self.dir, &f.scene.bounds, &splits, self.res, self.snap, self.fit);
         for (i, b) in self.boxes.iter().enumerate() {
             self.params.cascades[i] = CascadeU { view_proj: b.view_proj.to_cols_array_2d(), info: [b.texel, b.d0, b.d1, 0.0] };
-            gpu.queue.write_buffer(&self.depth_uniforms[i], 0, bytemuck::bytes_of(&b.view_proj.to_cols_array_2d()));
+            rec.write_buffer(&self.depth_uniforms[i], 0, bytemuck::bytes_of(&b.view_proj.to_cols_array_2d()));
         }
-        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
-        timer.add("csm.fit", t0.elapsed().as_secs_f64() * 1e3);
+        rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        rec.cpu("csm.fit", t0.elapsed().as_secs_f64() * 1e3);
         Ok(())
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let views: Vec<_> = (0..self.count as u32).map(|c| self.layer_view(c)).collect();
-        timer.stage(gpu, "csm.render", |enc| {
+        rec.stage("csm.render", |enc| {
             for (c, view) in views.iter().enumerate() {
                 let mut pass = raster::begin_pass(enc, "csm.render", &[], view);
                 pass.set_pipeline(&self.depth_pipeline);
@@ -234,7 +242,22 @@ impl Technique for Cascaded {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, false)
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, true)
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        report::report(self, gpu)
+    }
+}
+
+impl Cascaded {
+    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
+    fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         if !matches!(self.chosen, Some((_, cw, ch)) if cw == w && ch == h) {
             self.chosen = Some((gpu.storage("csm.chosen", w as u64 * h as u64 * 4), w, h));
@@ -255,14 +278,12 @@ impl Technique for Cascaded {
                 chosen.as_entire_binding(),
             ],
         );
-        timer.stage(gpu, "csm.evaluate", |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, "csm.evaluate", &self.eval_pipeline, &[&group], w, h)
+        rec.stage("csm.evaluate", |enc| {
+            if counting {
+                enc.clear_buffer(&self.counts, 0, None);
+            }
+            gpu.dispatch_2d(enc, "csm.evaluate", if counting { &self.count_pipeline } else { &self.eval_pipeline }, &[&group], w, h)
         });
         Ok(())
-    }
-
-    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
-        report::report(self, gpu)
     }
 }

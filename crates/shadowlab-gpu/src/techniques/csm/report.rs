@@ -97,6 +97,6 @@ fn read_layer(gpu: &Gpu, tex: &wgpu::Texture, layer: u32) -> Vec<u8> {
         tmp.as_image_copy(),
         size,
     );
-    gpu.queue.submit([enc.finish()]);
+    gpu.submit(enc.finish());
     gpu.read_texture(&tmp, 4)
 }

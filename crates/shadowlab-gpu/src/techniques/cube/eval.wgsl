@@ -32,7 +32,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let d0 = s.p - cube.light.xyz;
     let f0 = cube_face(d0);
     let t0 = clamp(vec2<i32>(floor(cube_project(f0, d0) * res)), vec2<i32>(0), vec2<i32>(ires - 1));
-    atomicAdd(&counts[(f0 * u32(ires) + u32(t0.y)) * u32(ires) + u32(t0.x)], 1u);
+    if COUNT_SAMPLES {
+        atomicAdd(&counts[(f0 * u32(ires) + u32(t0.y)) * u32(ires) + u32(t0.x)], 1u);
+    }
 
     let k = i32(cube.cfg.y);
     let half = f32(k - 1) * 0.5;

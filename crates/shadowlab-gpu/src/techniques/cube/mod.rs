@@ -21,11 +21,11 @@ use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::{ParamDef, ParamValues};
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
 use crate::techniques::sm::{count_image, depth_image, BIAS, BIAS_WGSL, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 
 const FACES_WGSL: &str = include_str!("faces.wgsl");
@@ -60,6 +60,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 002 section 3.3.1 and chapter 5.3 (CubeSM)",
     lights: &["point"],
     params: PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(CubeMap::new(gpu, scene, p, light)?)),
 };
 
@@ -141,6 +143,8 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
     lights: &["point"],
     params: NOTW_PARAMS,
+    stalls: "cube-notw.face_samples: the samples per face are read back to skip empty faces",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
 };
 
@@ -182,6 +186,8 @@ pub struct CubeMap {
     counts: wgpu::Buffer,
     eval_layout: wgpu::BindGroupLayout,
     eval_pipeline: wgpu::ComputePipeline,
+    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
+    count_pipeline: wgpu::ComputePipeline,
 }
 
 impl CubeMap {
@@ -218,6 +224,7 @@ impl CubeMap {
         };
         let eval_layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
         let eval_pipeline = gpu.compute_pipeline("cube.evaluate", &eval_src(), "main", &[&eval_layout]);
+        let count_pipeline = gpu.compute_pipeline_with("cube.evaluate", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
         Ok(CubeMap {
             res,
             far,
@@ -229,6 +236,7 @@ impl CubeMap {
             counts: gpu.storage("cube.counts", 6 * res as u64 * res as u64 * 4),
             eval_layout,
             eval_pipeline,
+            count_pipeline,
         })
     }
 
@@ -268,14 +276,14 @@ pub fn read_layers(gpu: &Gpu, tex: &wgpu::Texture) -> Vec<Vec<f32>> {
                 aspect: wgpu::TextureAspect::All,
             };
             enc.copy_texture_to_texture(src, tmp.as_image_copy(), wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 });
-            gpu.queue.submit([enc.finish()]);
+            gpu.submit(enc.finish());
             bytemuck::pod_collect_to_vec(&gpu.read_texture(&tmp, 4))
         })
         .collect()
 }
 
 impl Technique for CubeMap {
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let views: Vec<wgpu::TextureView> = (0..6)
             .map(|layer| {
                 self.map.create_view(&wgpu::TextureViewDescriptor {
@@ -286,7 +294,7 @@ impl Technique for CubeMap {
                 })
             })
             .collect();
-        timer.stage(gpu, "cube.render", |enc| {
+        rec.stage("cube.render", |enc| {
             for (view, group) in views.iter().zip(&self.face_groups) {
                 let mut pass = raster::begin_pass(enc, "cube.render", &[], view);
                 pass.set_pipeline(&self.depth_pipeline);
@@ -298,21 +306,12 @@ impl Technique for CubeMap {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let view = self
-            .map
-            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
-        let group = f.view_group(
-            gpu,
-            "cube.evaluate",
-            &self.eval_layout,
-            &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), self.counts.as_entire_binding()],
-        );
-        timer.stage(gpu, "cube.evaluate", |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, "cube.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
-        });
-        Ok(())
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, false)
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, true)
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
@@ -330,5 +329,34 @@ impl Technique for CubeMap {
             r.images.push(count_image(&format!("face {} view samples per texel", FACES[f].name), res, c));
         }
         r
+    }
+}
+
+impl CubeMap {
+    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
+    fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        let view = self
+            .map
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let group = f.view_group(
+            gpu,
+            "cube.evaluate",
+            &self.eval_layout,
+            &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), self.counts.as_entire_binding()],
+        );
+        rec.stage("cube.evaluate", |enc| {
+            if counting {
+                enc.clear_buffer(&self.counts, 0, None);
+            }
+            gpu.dispatch_2d(
+                enc,
+                "cube.evaluate",
+                if counting { &self.count_pipeline } else { &self.eval_pipeline },
+                &[&group],
+                f.gbuffer.width,
+                f.gbuffer.height,
+            )
+        });
+        Ok(())
     }
 }

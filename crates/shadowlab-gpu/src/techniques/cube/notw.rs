@@ -16,10 +16,10 @@ use shadowlab_core::params::ParamValues;
 use super::{clip, point_position, split_src};
 use crate::frame::LightUniform;
 use crate::gbuffer::GBuffer;
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::warp::{Variant, Warped};
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
 /// The names of the images of a face's `Warped` report that `cube-notw` passes on.
@@ -129,10 +129,11 @@ impl CubeNotw {
         &mut self,
         gpu: &Gpu,
         f: &FrameInputs,
-        timer: &mut StageTimer,
-        step: impl Fn(&mut Warped, &Gpu, &FrameInputs, &mut StageTimer) -> Result<(), GpuError>,
+        rec: &mut Recorder,
+        step: impl Fn(&mut Warped, &Gpu, &FrameInputs, &mut Recorder) -> Result<(), GpuError>,
     ) -> Result<(), GpuError> {
-        let mut local = StageTimer::default();
+        let outer = rec.set_rename(Some(("notw.".into(), "cube-notw.".into())));
+        let mut result = Ok(());
         for face in self.faces.iter_mut().filter(|face| face.samples > 0) {
             let g = f.gbuffer;
             let gbuffer = GBuffer {
@@ -156,18 +157,18 @@ impl CubeNotw {
                 frame: f.frame,
                 visibility: &vis,
             };
-            step(&mut face.warped, gpu, &fi, &mut local)?;
+            result = step(&mut face.warped, gpu, &fi, rec);
+            if result.is_err() {
+                break;
+            }
         }
-        for (name, ms) in local.samples {
-            let stage = name.strip_prefix("notw.").unwrap_or(&name);
-            timer.add(&format!("cube-notw.{stage}"), ms.iter().sum());
-        }
-        Ok(())
+        rec.set_rename(outer);
+        result
     }
 }
 
 impl Technique for CubeNotw {
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         let pixels = w as u64 * h as u64;
         if pixels != self.pixels {
@@ -178,32 +179,38 @@ impl Technique for CubeNotw {
             self.pixels = pixels;
         }
         let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
-        timer.stage(gpu, "cube-notw.split", |enc| {
+        rec.stage("cube-notw.split", |enc| {
             enc.clear_buffer(&self.face_samples, 0, None);
             for g in &groups {
                 gpu.dispatch_2d(enc, "cube-notw.split", &self.split, &[g], w, h);
             }
         });
-        let samples: Vec<u32> = gpu.read_buffer_as(&self.face_samples, 6);
+        let samples: Vec<u32> = rec.read_buffer_as(&self.face_samples, 6, "cube-notw.face_samples");
         for (face, s) in self.faces.iter_mut().zip(samples) {
             face.samples = s;
         }
-        self.each_face(gpu, f, timer, |w, gpu, fi, t| w.prepare(gpu, fi, t))
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.prepare(gpu, fi, t))
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.each_face(gpu, f, timer, |w, gpu, fi, t| w.render(gpu, fi, t))
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.render(gpu, fi, t))
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.each_face(gpu, f, timer, |w, gpu, fi, t| w.evaluate(gpu, fi, t))?;
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.evaluate(gpu, fi, t))?;
         let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
-        timer.stage(gpu, "cube-notw.merge", |enc| {
+        rec.stage("cube-notw.merge", |enc| {
             for g in &groups {
                 gpu.dispatch_2d(enc, "cube-notw.merge", &self.merge, &[g], f.gbuffer.width, f.gbuffer.height);
             }
         });
         Ok(())
+    }
+
+    /// Each face's analysis pass (its per-face visibility is rewritten with the same values, so
+    /// the merged visibility stands).
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.analyze(gpu, fi, t))
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {

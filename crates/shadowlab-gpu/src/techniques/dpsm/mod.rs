@@ -17,10 +17,10 @@ use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::paraboloid::{split_axis, DualParaboloid, Hemisphere, SPLIT_AXES};
 use shadowlab_core::params::{ParamDef, ParamValues};
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::warp::{self, Projection, Variant, Warped};
 use crate::techniques::{sm, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{Gpu, GpuError};
 
 /// Side of each hemisphere's map (texels). The setting: 512 per hemisphere against
@@ -163,6 +163,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "Brabec, Annen, Seidel 2002; seed 002 section 3.3.2 (eq. 3.3-3.10)",
     lights: &["point"],
     params: DPSM_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, false)?)),
 };
 
@@ -174,6 +176,8 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 002 section 5.3 (DPSM with NoTW), seed 000 section 3",
     lights: &["point"],
     params: NOTW_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, true)?)),
 };
 
@@ -214,26 +218,33 @@ impl Dpsm {
 }
 
 impl Technique for Dpsm {
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         if self.warped {
             for m in &mut self.maps {
-                m.prepare(gpu, f, timer)?;
+                m.prepare(gpu, f, rec)?;
             }
         }
         Ok(())
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         for m in &mut self.maps {
-            m.render(gpu, f, timer)?;
+            m.render(gpu, f, rec)?;
         }
         Ok(())
     }
 
     /// Each map writes the visibility of its hemisphere's samples.
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         for m in &mut self.maps {
-            m.evaluate(gpu, f, timer)?;
+            m.evaluate(gpu, f, rec)?;
+        }
+        Ok(())
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        for m in &mut self.maps {
+            m.analyze(gpu, f, rec)?;
         }
         Ok(())
     }

@@ -92,7 +92,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let res = fp.texel.z;
     let m0 = to_map(s.p);
-    if all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
+    if COUNT_SAMPLES && all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
         let t = vec2<u32>(m0.xy * res);
         atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
     }

@@ -180,6 +180,8 @@ pub const VSM_INFO: TechniqueInfo = TechniqueInfo {
     source: "Donnelly and Lauritzen 2006; seed 004 section 2.1",
     lights: LIGHTS,
     params: VSM_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Vsm)?)),
 };
 pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
@@ -190,6 +192,8 @@ pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
     source: "Annen et al. 2008, Salvi 2008; seed 004 section 2.1",
     lights: LIGHTS,
     params: ESM_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Esm)?)),
 };
 pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
@@ -200,6 +204,8 @@ pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
     source: "Lauritzen and McCool 2008; seed 004 section 2.1 (leak tracing's default)",
     lights: LIGHTS,
     params: EVSM_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Evsm)?)),
 };
 pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
@@ -210,6 +216,8 @@ pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
     source: "Peters and Klein 2015 (algorithm 2); seed 004 section 2.1",
     lights: LIGHTS,
     params: MSM_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Msm)?)),
 };
 

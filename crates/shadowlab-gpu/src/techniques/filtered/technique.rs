@@ -9,10 +9,10 @@ use shadowlab_core::params::ParamValues;
 use super::mips::{self, MipChain};
 use super::{eval_source, render_source, FilteredParams, Kind};
 use crate::blur::{mip0, Blur};
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::sm::{count_image, depth_image};
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 
 pub struct Filtered {
@@ -32,6 +32,8 @@ pub struct Filtered {
     render_pipeline: wgpu::RenderPipeline,
     render_group: wgpu::BindGroup,
     eval_pipeline: wgpu::ComputePipeline,
+    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
+    count_pipeline: wgpu::ComputePipeline,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -115,6 +117,8 @@ impl Filtered {
             &[binding::uniform(), binding::texture_float(), sampler_type, binding::storage(false)],
         );
         let eval_pipeline = gpu.compute_pipeline(&format!("{name}.evaluate"), &eval_source(), "main", &[&eval_layout]);
+        let count_pipeline =
+            gpu.compute_pipeline_with(&format!("{name}.evaluate"), &eval_source(), "main", &[&eval_layout], crate::context::COUNTING);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("filtered.gather"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -138,6 +142,7 @@ impl Filtered {
             render_pipeline,
             render_group,
             eval_pipeline,
+            count_pipeline,
             eval_layout,
             sampler,
         })
@@ -163,11 +168,11 @@ impl Filtered {
 }
 
 impl Technique for Filtered {
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let name = self.kind.name();
         let map_view = mip0(&self.map);
         let depth_view = self.depth.create_view(&Default::default());
-        timer.stage(gpu, &format!("{name}.render"), |enc| {
+        rec.stage(&format!("{name}.render"), |enc| {
             let label = format!("{name}.render");
             let mut pass = raster::begin_pass_with(enc, &label, &[&map_view], self.clear, &depth_view, wgpu::StoreOp::Discard);
             pass.set_pipeline(&self.render_pipeline);
@@ -177,35 +182,21 @@ impl Technique for Filtered {
         });
         if let Some(blur) = &self.blur {
             let label = format!("{name}.blur");
-            timer.stage(gpu, &label, |enc| blur.record(gpu, enc, &label));
+            rec.stage(&label, |enc| blur.record(gpu, enc, &label));
         }
         if let Some(m) = &self.mips {
             let label = format!("{name}.mips");
-            timer.stage(gpu, &label, |enc| m.record(gpu, enc, &label));
+            rec.stage(&label, |enc| m.record(gpu, enc, &label));
         }
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let name = self.kind.name();
-        let map_view = self.map.create_view(&Default::default());
-        let group = f.view_group(
-            gpu,
-            &format!("{name}.eval"),
-            &self.eval_layout,
-            &[
-                self.uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&map_view),
-                wgpu::BindingResource::Sampler(&self.sampler),
-                self.counts.as_entire_binding(),
-            ],
-        );
-        let label = format!("{name}.evaluate");
-        timer.stage(gpu, &label, |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, &label, &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
-        });
-        Ok(())
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, false)
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, true)
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
@@ -235,5 +226,39 @@ impl Technique for Filtered {
         r.images.push(depth_image(what, self.res, &depth));
         r.images.push(count_image("view samples per texel", self.res, &counts));
         r
+    }
+}
+
+impl Filtered {
+    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
+    fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        let name = self.kind.name();
+        let map_view = self.map.create_view(&Default::default());
+        let group = f.view_group(
+            gpu,
+            &format!("{name}.eval"),
+            &self.eval_layout,
+            &[
+                self.uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&map_view),
+                wgpu::BindingResource::Sampler(&self.sampler),
+                self.counts.as_entire_binding(),
+            ],
+        );
+        let label = format!("{name}.evaluate");
+        rec.stage(&label, |enc| {
+            if counting {
+                enc.clear_buffer(&self.counts, 0, None);
+            }
+            gpu.dispatch_2d(
+                enc,
+                &label,
+                if counting { &self.count_pipeline } else { &self.eval_pipeline },
+                &[&group],
+                f.gbuffer.width,
+                f.gbuffer.height,
+            )
+        });
+        Ok(())
     }
 }

@@ -7,9 +7,9 @@ use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::gpu::Iasm;
 use super::{eval_atlas_src, ATLAS_WGSL};
+use crate::record::Recorder;
 use crate::shaders::compose_depth;
 use crate::techniques::{view_layout, FrameInputs};
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 
 /// The conventional alternative: the tiles in a depth atlas (store=atlas).
@@ -21,6 +21,7 @@ pub struct Atlas {
     pipeline: wgpu::RenderPipeline,
     pub(super) eval_layout: wgpu::BindGroupLayout,
     pub(super) eval: wgpu::ComputePipeline,
+    pub(super) eval_count: wgpu::ComputePipeline,
 }
 
 pub(super) fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Result<Atlas, GpuError> {
@@ -32,12 +33,13 @@ pub(super) fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Resul
     let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose_depth(ATLAS_WGSL), layouts, &[]);
     let eval_layout = view_layout(gpu, "iasm.eval_atlas", &[binding::uniform(), binding::texture_depth(), binding::storage(false)]);
     let eval = gpu.compute_pipeline("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout]);
-    Ok(Atlas { texture, view, slots, pipeline, eval_layout, eval })
+    let eval_count = gpu.compute_pipeline_with("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout], crate::context::COUNTING);
+    Ok(Atlas { texture, view, slots, pipeline, eval_layout, eval, eval_count })
 }
 
 impl Iasm {
-    pub(super) fn render_atlas(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer, a: &Atlas) {
-        timer.stage(gpu, "iasm.shadows.clear", |enc| {
+    pub(super) fn render_atlas(&self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, a: &Atlas) {
+        rec.stage("iasm.shadows.clear", |enc| {
             drop(raster::begin_pass(enc, "iasm.shadows.clear", &[], &a.view));
         });
         for (rank, &t) in self.plan.order.iter().enumerate() {
@@ -45,7 +47,7 @@ impl Iasm {
                 continue;
             }
             let (r, [x, y]) = (self.plan.res[t], a.slots[rank]);
-            timer.stage(gpu, &format!("iasm.shadows.t{t:02}"), |enc| {
+            rec.stage(&format!("iasm.shadows.t{t:02}"), |enc| {
                 let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("iasm.shadows"),
                     color_attachments: &[],

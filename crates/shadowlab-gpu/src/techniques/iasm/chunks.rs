@@ -36,7 +36,7 @@ pub(super) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Ve
         pass.set_bind_group(1, &scene.group, &[]);
         pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
     }
-    gpu.queue.submit([enc.finish()]);
+    gpu.submit(enc.finish());
     gpu.take_error()?;
     let w: Vec<u32> = gpu.read_buffer_as(&boxes, n * 6);
     Ok(w.chunks_exact(6)

@@ -15,7 +15,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         visibility[s.i] = 1.0;
         return;
     }
-    if inside(l.uv0) && tile_res(tile_of(l.uv0)) > 0u {
+    if COUNT_SAMPLES && inside(l.uv0) && tile_res(tile_of(l.uv0)) > 0u {
         atomicAdd(&counts[buffer_index(l.uv0)], 1u);
     }
     let stored = stored_depth(l);

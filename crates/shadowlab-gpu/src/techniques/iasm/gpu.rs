@@ -12,10 +12,10 @@ use super::atlas::{make_atlas, Atlas};
 use super::chunks::chunk_bounds;
 use super::plan::{Plan, TileStats};
 use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, RENDER_WGSL};
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
 const TILE_STRIDE: u64 = 256;
@@ -55,6 +55,10 @@ pub struct Iasm {
     render: wgpu::RenderPipeline,
     eval_layout: wgpu::BindGroupLayout,
     eval: wgpu::ComputePipeline,
+    eval_count: wgpu::ComputePipeline,
+    /// The parameters this frame was evaluated with (the analysis pass evaluates with them
+    /// again; delayed mode has overwritten the buffer for the next frame by then).
+    evaluated: Option<IasmParams>,
 }
 
 impl Iasm {
@@ -121,6 +125,7 @@ impl Iasm {
         let analysis = gpu.compute_pipeline("iasm.analysis", &analysis_src(), "main", &[&analysis_layout]);
         let eval_layout = view_layout(gpu, "iasm.eval", &[binding::uniform(), binding::storage(true), binding::storage(false)]);
         let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
+        let eval_count = gpu.compute_pipeline_with("iasm.evaluate", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
         let atlas = (p.get_u32("store") == 1).then(|| make_atlas(gpu, &[&render_layout, &scene.layout])).transpose()?;
         Ok(Iasm {
@@ -154,6 +159,8 @@ impl Iasm {
             render,
             eval_layout,
             eval,
+            eval_count,
+            evaluated: None,
         })
     }
 
@@ -199,33 +206,33 @@ impl Iasm {
     }
 
     /// Dispatches the analysis of `f` with the current placement into `stats_buf`.
-    fn analyse(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
-        gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params()));
+    fn analyse(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        rec.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params()));
         let mut init: Vec<u32> = (0..TILE_COUNT).flat_map(|_| [0, 0, 0, u32::MAX, 0, 0, 0, 0]).collect();
         init.push(0);
-        gpu.queue.write_buffer(&self.stats_buf, 0, bytemuck::cast_slice(&init));
+        rec.write_buffer(&self.stats_buf, 0, bytemuck::cast_slice(&init));
         let group = f.view_group(gpu, "iasm.analysis", &self.analysis_layout, &self.analysis_extra());
-        timer.stage(gpu, "iasm.importance", |enc| {
+        rec.stage("iasm.importance", |enc| {
             gpu.dispatch_2d(enc, "iasm.importance", &self.analysis, &[&group], f.gbuffer.width, f.gbuffer.height)
         });
     }
 
-    fn read_stats(&self, gpu: &Gpu, timer: &mut StageTimer) -> TileStats {
+    fn read_stats(&self, rec: &mut Recorder) -> TileStats {
         let t0 = std::time::Instant::now();
-        let words: Vec<u32> = gpu.read_buffer_as(&self.stats_buf, TILE_COUNT * 8 + 1);
-        timer.add("iasm.readback", t0.elapsed().as_secs_f64() * 1e3);
+        let words: Vec<u32> = rec.read_buffer_as(&self.stats_buf, TILE_COUNT * 8 + 1, "iasm.readback");
+        rec.cpu("iasm.readback", t0.elapsed().as_secs_f64() * 1e3);
         TileStats::parse(&words)
     }
 
-    fn write_tiles(&self, gpu: &Gpu) {
+    fn write_tiles(&self, rec: &mut Recorder) {
         for t in 0..TILE_COUNT {
             let tp = TileParams {
                 view_proj: self.placement.tile_matrix(t, self.plan.near[t], self.plan.far[t]).to_cols_array_2d(),
                 tile: [self.plan.res[t], self.plan.off[t], 0, 0],
             };
-            gpu.queue.write_buffer(&self.tile_buf, t as u64 * TILE_STRIDE, bytemuck::bytes_of(&tp));
+            rec.write_buffer(&self.tile_buf, t as u64 * TILE_STRIDE, bytemuck::bytes_of(&tp));
         }
-        gpu.queue.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params()));
+        rec.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params()));
     }
 
     /// The GPU's texel index and tile (equations 3.2-3.5 in eval.wgsl) of buffer coordinates
@@ -252,7 +259,7 @@ impl Iasm {
             pass.set_bind_group(0, &group, &[]);
             pass.dispatch_workgroups((uvs.len() as u32).div_ceil(64), 1, 1);
         }
-        gpu.queue.submit([enc.finish()]);
+        gpu.submit(enc.finish());
         let out: Vec<[f32; 4]> = gpu.read_buffer_as(&probe, uvs.len());
         out.iter().map(|v| (v[2].to_bits(), v[3].to_bits())).collect()
     }
@@ -268,7 +275,7 @@ impl Iasm {
 }
 
 impl Technique for Iasm {
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.place(f);
         self.current = self.placement;
         if self.delayed && self.pending {
@@ -276,26 +283,27 @@ impl Technique for Iasm {
             // together, so every tile's planes and resolution describe that tile's region
             self.placement = self.analysed;
         } else {
-            self.analyse(gpu, f, timer);
+            self.analyse(gpu, f, rec);
         }
-        let stats = self.read_stats(gpu, timer);
+        let stats = self.read_stats(rec);
         self.make_plan(stats);
-        self.write_tiles(gpu);
+        self.write_tiles(rec);
+        self.evaluated = Some(self.params());
         Ok(())
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         if let Some(a) = &self.atlas {
-            self.render_atlas(gpu, f, timer, a);
+            self.render_atlas(gpu, f, rec, a);
             return Ok(());
         }
-        timer.stage(gpu, "iasm.shadows.clear", |enc| enc.clear_buffer(&self.shadow, 0, None));
+        rec.stage("iasm.shadows.clear", |enc| enc.clear_buffer(&self.shadow, 0, None));
         for t in 0..TILE_COUNT {
             if self.plan.empty[t] {
                 continue;
             }
             let r = self.plan.res[t];
-            timer.stage(gpu, &format!("iasm.shadows.t{t:02}"), |enc| {
+            rec.stage(&format!("iasm.shadows.t{t:02}"), |enc| {
                 let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("iasm.shadows"),
                     color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -321,10 +329,9 @@ impl Technique for Iasm {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let group = self.eval_group(gpu, f);
-        timer.stage(gpu, "iasm.evaluate", |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
+        rec.stage("iasm.evaluate", |enc| {
             let pipeline = self.atlas.as_ref().map_or(&self.eval, |a| &a.eval);
             gpu.dispatch_2d(enc, "iasm.evaluate", pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
         });
@@ -332,10 +339,26 @@ impl Technique for Iasm {
             // this frame's analysis, over this frame's square, feeds the next frame (thesis 4.3:
             // copied after the shadows)
             self.placement = self.current;
-            self.analyse(gpu, f, timer);
+            self.analyse(gpu, f, rec);
             self.analysed = self.current;
             self.pending = true;
         }
+        Ok(())
+    }
+
+    /// The evaluation again with the view samples counted per texel. In delayed mode the tile
+    /// planes the frame was evaluated with are the previous analysis's: they are still set
+    /// (the next frame's are written in its `prepare`).
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        if let Some(p) = self.evaluated {
+            rec.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&p));
+        }
+        let group = self.eval_group(gpu, f);
+        rec.stage("iasm.analysis", |enc| {
+            enc.clear_buffer(&self.counts, 0, None);
+            let pipeline = self.atlas.as_ref().map_or(&self.eval_count, |a| &a.eval_count);
+            gpu.dispatch_2d(enc, "iasm.analysis", pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
         Ok(())
     }
 

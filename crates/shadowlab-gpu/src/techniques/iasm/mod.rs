@@ -199,6 +199,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 001 (IASM thesis) chapter 3",
     lights: &["directional"],
     params: PARAMS,
+    stalls: "iasm.readback: the tile statistics are read back for the plan; with delayed=true they are the previous frame's, so the read waits on no work of this frame",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, p, light)?)),
 };
 

@@ -299,6 +299,8 @@ pub const LT_INFO: TechniqueInfo = TechniqueInfo {
     source: "Kern, Brüll, Grosch 2024 (seed 004) sections 3-3.4",
     lights: LIGHTS,
     params: LT_PARAMS,
+    stalls: "",
+    needs: "9 storage buffers per shader stage (WebGPU default: 8)",
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Lt)?)),
 };
 pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
@@ -309,6 +311,8 @@ pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 004 eq. 3 ('LTT only' of table 3)",
     lights: LIGHTS,
     params: LTT_PARAMS,
+    stalls: "",
+    needs: "9 storage buffers per shader stage (WebGPU default: 8)",
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Ltt)?)),
 };
 pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
@@ -319,5 +323,7 @@ pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
     source: "AMD FidelityFX Hybrid Shadows 2021 (seed 004's HySM)",
     lights: LIGHTS,
     params: HYBRID_PARAMS,
+    stalls: "",
+    needs: "9 storage buffers per shader stage (WebGPU default: 8)",
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::HybridPcf)?)),
 };

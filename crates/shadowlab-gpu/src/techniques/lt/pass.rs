@@ -11,10 +11,10 @@ use super::cascade::{single_level, Cascades};
 use super::screen::Screen;
 use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, MAX_MAPS};
 use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_POINT, FLAG_RR};
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::filtered::{render_source, FilteredParams};
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 
 /// Lights per technique instance (the lab runs one instance per light).
@@ -259,7 +259,7 @@ impl LeakTracing {
 
 impl Technique for LeakTracing {
     /// Cascades: fit this frame's slices, keep or replace each level's box (section 3.3).
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let t0 = std::time::Instant::now();
         if let Some(c) = self.cascades.as_mut() {
             let dirty = c.update(f, self.res, self.reuse, &mut self.params)?;
@@ -267,18 +267,18 @@ impl Technique for LeakTracing {
                 if d {
                     self.map_params.light_view_proj = self.params.levels[l].view_proj;
                     self.map_params.texel[0] = self.params.levels[l].info[0];
-                    gpu.queue.write_buffer(&self.map_uniforms[l].0, 0, bytemuck::bytes_of(&self.map_params));
+                    rec.write_buffer(&self.map_uniforms[l].0, 0, bytemuck::bytes_of(&self.map_params));
                     self.static_dirty[l] = true;
                 }
             }
-            timer.add(&format!("{}.fit", self.mode.name()), t0.elapsed().as_secs_f64() * 1e3);
+            rec.cpu(&format!("{}.fit", self.mode.name()), t0.elapsed().as_secs_f64() * 1e3);
         } else if !self.reuse {
             self.static_dirty.iter_mut().for_each(|d| *d = true);
         }
         Ok(())
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let name = self.mode.name();
         let label = format!("{name}.render");
         let dynamic = (f.scene.dynamic_first < f.scene.triangle_count).then_some(f.scene.dynamic_first..f.scene.triangle_count);
@@ -289,7 +289,7 @@ impl Technique for LeakTracing {
         if redraw.is_empty() && dynamic.is_none() {
             return Ok(());
         }
-        timer.stage(gpu, &label, |enc| {
+        rec.stage(&label, |enc| {
             for &l in &redraw {
                 self.draw(enc, &label, f, &self.static_map, l, 0..f.scene.dynamic_first);
             }
@@ -305,7 +305,7 @@ impl Technique for LeakTracing {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let name = self.mode.name();
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         let has_dynamic = self.dynamic_map.is_some() && f.scene.dynamic_first < f.scene.triangle_count;
@@ -313,7 +313,7 @@ impl Technique for LeakTracing {
         let mut params = self.params;
         params.mode[2] = frames;
         params.mode[3] |= if frames > 0 { FLAG_HAS_HISTORY } else { 0 } | if has_dynamic { FLAG_DYNAMIC } else { 0 };
-        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
+        rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
         let trace = gpu.uniform(&format!("{name}.trace_params"), &TraceParams { cfg: [self.mask_bits, w * h, 0, 0] });
         let s = self.screen.as_ref().expect("allocated above");
         let (cur, prev) = ((frames % 2) as usize, ((frames + 1) % 2) as usize);
@@ -352,13 +352,13 @@ impl Technique for LeakTracing {
             &[trace.as_entire_binding(), s.list.as_entire_binding(), s.args.as_entire_binding()],
         );
         let label = format!("{name}.classify");
-        timer.stage(gpu, &label, |enc| {
+        rec.stage(&label, |enc| {
             enc.clear_buffer(&s.masks[cur], 0, None);
             enc.clear_buffer(&s.list, 0, Some(4));
             gpu.dispatch_2d(enc, &label, &self.classify_pipeline, &[&classify], w, h);
         });
         let label = format!("{name}.trace");
-        timer.stage(gpu, &label, |enc| {
+        rec.stage(&label, |enc| {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&label), timestamp_writes: None });
                 pass.set_pipeline(&self.args_pipeline);

@@ -15,11 +15,11 @@ use shadowlab_core::mdsm::{max_distinct, pcf_width, search_width, Select, DEFAUL
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::{ParamDef, ParamValues, BOOL};
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
 use crate::techniques::sm::{self, count_image, depth_image, DepthPass, SmParams};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
 const SELECT_WGSL: &str = include_str!("select.wgsl");
@@ -153,6 +153,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "Pagot, Comba, Oliveira 2004 (seed 003)",
     lights: &["directional", "spot"],
     params: PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(MultiDepthMap::new(gpu, scene, p, light)?)),
 };
 
@@ -182,6 +184,8 @@ pub struct MultiDepthMap {
     select_pipeline: wgpu::ComputePipeline,
     select_group: wgpu::BindGroup,
     eval_pipeline: wgpu::ComputePipeline,
+    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
+    count_pipeline: wgpu::ComputePipeline,
     eval_layout: wgpu::BindGroupLayout,
 }
 
@@ -240,8 +244,23 @@ impl MultiDepthMap {
         let select_pipeline = gpu.compute_pipeline("mdsm.select", &compose(SELECT_WGSL, false), "main", &[&select_layout]);
         let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
         let eval_pipeline = gpu.compute_pipeline("mdsm.eval", &eval_src(), "main", &[&eval_layout]);
+        let count_pipeline = gpu.compute_pipeline_with("mdsm.eval", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
         let counts = gpu.storage("mdsm.counts", res as u64 * res as u64 * 4);
-        Ok(MultiDepthMap { res, k, n, params, depth, nsm, counts, uniform, select_pipeline, select_group, eval_pipeline, eval_layout })
+        Ok(MultiDepthMap {
+            res,
+            k,
+            n,
+            params,
+            depth,
+            nsm,
+            counts,
+            uniform,
+            select_pipeline,
+            select_group,
+            eval_pipeline,
+            count_pipeline,
+            eval_layout,
+        })
     }
 
     /// The uniform as uploaded (projection, bias, selection settings).
@@ -261,27 +280,20 @@ impl MultiDepthMap {
 }
 
 impl Technique for MultiDepthMap {
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.depth.render(gpu, f, timer);
-        timer.stage(gpu, "mdsm.select", |enc| {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.depth.render(gpu, f, rec);
+        rec.stage("mdsm.select", |enc| {
             gpu.dispatch_2d(enc, "mdsm.select", &self.select_pipeline, &[&self.select_group], self.res, self.res)
         });
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let nsm_view = self.nsm.create_view(&Default::default());
-        let group = f.view_group(
-            gpu,
-            "mdsm.eval",
-            &self.eval_layout,
-            &[self.uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&nsm_view), self.counts.as_entire_binding()],
-        );
-        timer.stage(gpu, "mdsm.evaluate", |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, "mdsm.evaluate", &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
-        });
-        Ok(())
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, false)
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, true)
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
@@ -299,5 +311,32 @@ impl Technique for MultiDepthMap {
         r.images.push(depth_image("base shadow map (depth)", self.res, &depth));
         r.images.push(count_image("view samples per texel", self.res, &counts));
         r
+    }
+}
+
+impl MultiDepthMap {
+    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
+    fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        let nsm_view = self.nsm.create_view(&Default::default());
+        let group = f.view_group(
+            gpu,
+            "mdsm.eval",
+            &self.eval_layout,
+            &[self.uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&nsm_view), self.counts.as_entire_binding()],
+        );
+        rec.stage("mdsm.evaluate", |enc| {
+            if counting {
+                enc.clear_buffer(&self.counts, 0, None);
+            }
+            gpu.dispatch_2d(
+                enc,
+                "mdsm.evaluate",
+                if counting { &self.count_pipeline } else { &self.eval_pipeline },
+                &[&group],
+                f.gbuffer.width,
+                f.gbuffer.height,
+            )
+        });
+        Ok(())
     }
 }

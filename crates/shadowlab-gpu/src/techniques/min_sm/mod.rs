@@ -16,10 +16,10 @@ use shadowlab_core::lightspace::{self, LightProjection};
 use shadowlab_core::params::{ParamDef, ParamValues};
 use shadowlab_core::scene::Bounds;
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::sm::{self, MapPass};
 use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, Gpu, GpuError};
 
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
@@ -91,6 +91,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 000 section 3.2 and seed 002 section 4.1.5 (MSF after Stamminger & Drettakis 2002, Perspective Shadow Maps); calipers: Toussaint 1983",
     lights: &["directional", "spot"],
     params: PARAMS,
+    stalls: "min-sm.readback: the band reduction of the view samples is read back for the CPU hull and calipers",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, p, light)?)),
 };
 
@@ -201,7 +203,7 @@ impl MinShadowMap {
 }
 
 impl Technique for MinShadowMap {
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let group = f.view_group(
             gpu,
             "min-sm.reduce",
@@ -213,10 +215,10 @@ impl Technique for MinShadowMap {
         let (lo, hi) = prior.unwrap_or((0.0, 0.0));
         // mode.w and prev of MsfReduce
         let w_at = std::mem::offset_of!(MsfReduce, mode) as u64 + 12;
-        gpu.queue.write_buffer(&self.reduce_uniform, w_at, bytemuck::bytes_of(&(prior.is_some() as u32)));
-        gpu.queue.write_buffer(&self.reduce_uniform, std::mem::offset_of!(MsfReduce, prev) as u64, bytemuck::bytes_of(&[lo, hi, 0.0, 0.0]));
+        rec.write_buffer(&self.reduce_uniform, w_at, bytemuck::bytes_of(&(prior.is_some() as u32)));
+        rec.write_buffer(&self.reduce_uniform, std::mem::offset_of!(MsfReduce, prev) as u64, bytemuck::bytes_of(&[lo, hi, 0.0, 0.0]));
         self.last_passes = if prior.is_some() { 1 } else { 2 };
-        timer.stage(gpu, "min-sm.reduce", |enc| {
+        rec.stage("min-sm.reduce", |enc| {
             enc.clear_buffer(&self.red, 0, None);
             gpu.dispatch_2d(enc, "min-sm.reduce.bounds", &self.bounds_pipeline, &[&group], w.div_ceil(RUN), h);
             if prior.is_none() {
@@ -225,8 +227,9 @@ impl Technique for MinShadowMap {
             enc.copy_buffer_to_buffer(&self.red, 0, &self.staging, 0, self.red.size());
         });
         let t0 = std::time::Instant::now();
+        rec.sync("min-sm.readback");
         let words = self.read_reduction(gpu)?;
-        timer.add("min-sm.readback", t0.elapsed().as_secs_f64() * 1e3);
+        rec.cpu("min-sm.readback", t0.elapsed().as_secs_f64() * 1e3);
 
         // CPU: hull, calipers, projection
         let t1 = std::time::Instant::now();
@@ -240,18 +243,23 @@ impl Technique for MinShadowMap {
         };
         let fit_ms = t1.elapsed().as_secs_f64() * 1e3;
         self.fit_ms.push(fit_ms);
-        timer.add("min-sm.fit", fit_ms);
-        self.pass.set_projection(gpu, vp, texel, persp);
+        rec.cpu("min-sm.fit", fit_ms);
+        self.pass.set_projection(rec, vp, texel, persp);
         Ok(())
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.pass.render(gpu, f, timer);
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.pass.render(gpu, f, rec);
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.pass.evaluate(gpu, f, timer);
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.pass.evaluate(gpu, f, rec);
+        Ok(())
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.pass.analyze(gpu, f, rec);
         Ok(())
     }
 

@@ -5,7 +5,7 @@
 // Sampling statistics: one more view sample in the texel of map position m0 (res x res map;
 // positions outside the map are not counted).
 fn count_sample(m0: vec3<f32>, res: f32) {
-    if all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
+    if COUNT_SAMPLES && all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
         let t = vec2<u32>(m0.xy * res);
         atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
     }

@@ -8,10 +8,10 @@ use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
 use shadowlab_core::params::{ParamDef, ParamValues};
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
 use crate::techniques::{compose_view, FrameInputs, NamedImage, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{Gpu, GpuError};
 
 mod pass;
@@ -125,6 +125,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "Williams 1978; seed 002 chapter 2; PCF: Reeves, Salesin, Cook 1987",
     lights: &["directional", "spot"],
     params: PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(ShadowMap::new(gpu, scene, p, light)?)),
 };
 
@@ -151,13 +153,18 @@ impl ShadowMap {
 }
 
 impl Technique for ShadowMap {
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.pass.render(gpu, f, timer);
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.pass.render(gpu, f, rec);
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        self.pass.evaluate(gpu, f, timer);
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.pass.evaluate(gpu, f, rec);
+        Ok(())
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.pass.analyze(gpu, f, rec);
         Ok(())
     }
 

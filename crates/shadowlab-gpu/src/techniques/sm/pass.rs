@@ -9,9 +9,10 @@ use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::ParamValues;
 
 use super::{count_image, depth_image, depth_source, eval_source, SmParams};
+use crate::context::COUNTING;
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::{view_layout, FrameInputs, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu};
 
 impl SmParams {
@@ -51,15 +52,15 @@ impl DepthPass {
     }
 
     /// Uploads a new uniform (projection, texel, bias).
-    pub fn set(&self, gpu: &Gpu, params: &SmParams) {
-        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(params));
+    pub fn set(&self, rec: &mut Recorder, params: &SmParams) {
+        rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(params));
     }
 
     /// Clears the map and draws the scene into it.
-    pub fn render(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
+    pub fn render(&self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let map_view = self.map.create_view(&Default::default());
         let stage = format!("{}.render", self.name);
-        timer.stage(gpu, &stage, |enc| {
+        rec.stage(&stage, |enc| {
             let mut pass = raster::begin_pass(enc, &stage, &[], &map_view);
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.group, &[]);
@@ -82,6 +83,8 @@ pub struct MapPass {
     pub params: SmParams,
     counts: wgpu::Buffer,
     eval_pipeline: wgpu::ComputePipeline,
+    /// The same evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
+    count_pipeline: wgpu::ComputePipeline,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -100,9 +103,10 @@ impl MapPass {
             &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
         );
         let eval_pipeline = gpu.compute_pipeline(&label, &eval_source(), "main", &[&eval_layout]);
+        let count_pipeline = gpu.compute_pipeline_with(&label, &eval_source(), "main", &[&eval_layout], COUNTING);
         let sampler = raster::comparison_sampler(gpu, &format!("{name}.cmp"));
         let counts = gpu.storage(&format!("{name}.counts"), res as u64 * res as u64 * 4);
-        MapPass { depth, pcf, params, counts, eval_pipeline, eval_layout, sampler }
+        MapPass { depth, pcf, params, counts, eval_pipeline, count_pipeline, eval_layout, sampler }
     }
 
     pub fn res(&self) -> u32 {
@@ -111,24 +115,22 @@ impl MapPass {
 
     /// Points the map at a new projection (texel size and perspective flag with it) for the
     /// next render and evaluation.
-    pub fn set_projection(&mut self, gpu: &Gpu, view_proj: glam::Mat4, texel: f32, perspective: bool) {
+    pub fn set_projection(&mut self, rec: &mut Recorder, view_proj: glam::Mat4, texel: f32, perspective: bool) {
         self.params.light_view_proj = view_proj.to_cols_array_2d();
         self.params.texel[0] = texel;
         self.params.texel[1] = perspective as u32 as f32;
-        self.depth.set(gpu, &self.params);
+        self.depth.set(rec, &self.params);
     }
 
-    pub fn render(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
-        self.depth.render(gpu, f, timer);
+    pub fn render(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        self.depth.render(gpu, f, rec);
     }
 
-    /// Shadow test of every view sample, counting the samples per texel.
-    pub fn evaluate(&self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) {
-        let name = self.depth.name;
+    fn eval_group(&self, gpu: &Gpu, f: &FrameInputs) -> wgpu::BindGroup {
         let map_view = self.depth.map.create_view(&Default::default());
-        let group = f.view_group(
+        f.view_group(
             gpu,
-            &format!("{name}.eval"),
+            &format!("{}.eval", self.depth.name),
             &self.eval_layout,
             &[
                 self.depth.uniform.as_entire_binding(),
@@ -136,11 +138,23 @@ impl MapPass {
                 wgpu::BindingResource::Sampler(&self.sampler),
                 self.counts.as_entire_binding(),
             ],
-        );
-        let stage = format!("{name}.evaluate");
-        timer.stage(gpu, &stage, |enc| {
+        )
+    }
+
+    /// Shadow test of every view sample.
+    pub fn evaluate(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        let group = self.eval_group(gpu, f);
+        let stage = format!("{}.evaluate", self.depth.name);
+        rec.stage(&stage, |enc| gpu.dispatch_2d(enc, &stage, &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height));
+    }
+
+    /// The lab's analysis: the evaluation again with the view samples counted per texel.
+    pub fn analyze(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        let group = self.eval_group(gpu, f);
+        let stage = format!("{}.analysis", self.depth.name);
+        rec.stage(&stage, |enc| {
             enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, &stage, &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
+            gpu.dispatch_2d(enc, &stage, &self.count_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
         });
     }
 

@@ -20,9 +20,9 @@ use shadowlab_core::edges::EdgeList;
 use shadowlab_core::light::Light;
 use shadowlab_core::params::{ParamDef, ParamValues};
 
+use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::techniques::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{binding, raster, Gpu, GpuError};
 use pipelines::{dispatch_1d, Pipelines, LIT_FORMAT};
 
@@ -72,6 +72,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "Crow 1977; z-fail: Everitt & Kilgard 2002; multiplicity: Milet, Kobrtek, Zemcik, Peciva 2014 (MKZP14 in seed 000)",
     lights: &["directional", "spot", "point"],
     params: PARAMS,
+    stalls: "",
+    needs: "optional: DEPTH_CLIP_CONTROL (unclipped depth for the infinite extrusion) and DEPTH32FLOAT_STENCIL8, used where offered",
     create: |gpu, scene, p, light| Ok(Box::new(ShadowVolumes::new(gpu, scene, p, light)?)),
 };
 
@@ -212,15 +214,15 @@ impl ShadowVolumes {
             pass.end_occlusion_query();
         }
         enc.resolve_query_set(&set, 0..1, &resolve, 0);
-        gpu.queue.submit([enc.finish()]);
+        gpu.submit(enc.finish());
         Some(gpu.read_buffer_as::<u64>(&resolve, 1)[0])
     }
 }
 
 impl Technique for ShadowVolumes {
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        gpu.queue.write_buffer(&self.draw, 0, bytemuck::cast_slice(&[0u32, 1, 0, 0]));
-        gpu.queue.write_buffer(&self.stats, 0, &[0u8; 16]);
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        rec.write_buffer(&self.draw, 0, bytemuck::cast_slice(&[0u32, 1, 0, 0]));
+        rec.write_buffer(&self.stats, 0, &[0u8; 16]);
         let group = binding::group(
             &gpu.device,
             "sv.silhouettes",
@@ -237,14 +239,14 @@ impl Technique for ShadowVolumes {
             ],
         );
         let (tris, edges) = (self.params.counts[0], self.params.counts[1]);
-        timer.stage(gpu, "sv.silhouettes", |enc| {
+        rec.stage("sv.silhouettes", |enc| {
             dispatch_1d(enc, "sv.facing", &self.p.facing, &[&group, &f.scene.group], tris);
             dispatch_1d(enc, "sv.edges", &self.p.edges, &[&group, &f.scene.group], edges);
         });
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         self.targets(gpu, w, h);
         let t = self.targets.as_ref().unwrap();
@@ -272,7 +274,7 @@ impl Technique for ShadowVolumes {
         let ds = t.depth.create_view(&Default::default());
         let lit = t.lit.create_view(&Default::default());
         let verts = f.scene.triangle_count * 3;
-        timer.stage(gpu, "sv.stencil", |enc| {
+        rec.stage("sv.stencil", |enc| {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("sv.stencil"),
                 color_attachments: &[],
@@ -299,7 +301,7 @@ impl Technique for ShadowVolumes {
         });
         self.last = Some((vol_group, f.scene.group.clone(), verts));
         let eval_group = f.view_group(gpu, "sv.eval", &self.p.eval_layout, &[wgpu::BindingResource::TextureView(&lit)]);
-        timer.stage(gpu, "sv.resolve", |enc| {
+        rec.stage("sv.resolve", |enc| {
             {
                 let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("sv.lit"),

@@ -203,7 +203,7 @@ impl Pipelines {
         let pipe = gpu.compute_pipeline("sv.gather", &compose(GATHER_WGSL, true), "main", &[&layout, &scene.layout]);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         dispatch_1d(&mut enc, "sv.gather", &pipe, &[&group, &scene.group], n as u32);
-        gpu.queue.submit([enc.finish()]);
+        gpu.submit(enc.finish());
         let p: Vec<[f32; 4]> = gpu.read_buffer_as(&out, n as usize);
         p.into_iter().map(|v| [v[0], v[1], v[2]]).collect()
     }

@@ -104,7 +104,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let m0 = clip_to_map(base_clip(wp, p));
     let u0 = to_dv(m0.xy, r);
     let c0 = warp(u0);
-    if all(c0 >= vec2<f32>(0.0)) && all(c0 < vec2<f32>(1.0)) {
+    if COUNT_SAMPLES && all(c0 >= vec2<f32>(0.0)) && all(c0 < vec2<f32>(1.0)) {
         let t = vec2<u32>(c0 * res);
         atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
     }

@@ -82,6 +82,8 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 000 section 3, seed 002 chapter 4 (Navratil et al.)",
     lights: LIGHTS,
     params: NOTW_OWN_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Notw)?)),
 };
 
@@ -93,6 +95,8 @@ pub const RTW_INFO: TechniqueInfo = TechniqueInfo {
     source: "Rosen 2012; seed 000 section 2.2, seed 002 section 3.2.2",
     lights: LIGHTS,
     params: RTW_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Rtw)?)),
 };
 
@@ -104,6 +108,8 @@ pub const DV_INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 000 section 3.2 (\"Ours-DV\"), Rosen 2012's desired view",
     lights: LIGHTS,
     params: DV_PARAMS,
+    stalls: "",
+    needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Dv)?)),
 };
 
@@ -174,6 +180,8 @@ pub struct Warped {
     split: [wgpu::ComputePipeline; 4],
     eval_layout: wgpu::BindGroupLayout,
     eval_pipeline: wgpu::ComputePipeline,
+    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
+    count_pipeline: wgpu::ComputePipeline,
     sampler: wgpu::Sampler,
 }
 
@@ -389,6 +397,8 @@ impl Warped {
             &[binding::uniform(), ro, tex, tex, binding::texture_depth(), binding::comparison_sampler(), rw],
         );
         let eval_pipeline = gpu.compute_pipeline(&format!("{name}.final_pass"), &eval_src(), "main", &[&eval_layout]);
+        let count_pipeline =
+            gpu.compute_pipeline_with(&format!("{name}.final_pass"), &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("warp.cmp"),
             compare: Some(wgpu::CompareFunction::LessEqual),
@@ -432,6 +442,7 @@ impl Warped {
             split,
             eval_layout,
             eval_pipeline,
+            count_pipeline,
             sampler,
         })
     }

@@ -5,9 +5,9 @@ use shadowlab_core::warp::Warp2D;
 
 use super::{Variant, Warped};
 use crate::prefix_sum::ScanParams;
+use crate::record::Recorder;
 use crate::techniques::sm::{count_image, depth_image};
 use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueReport};
-use crate::timing::StageTimer;
 use crate::{raster, Gpu, GpuError};
 
 /// Signed picture of warp offsets (seed 000 Figure 4): yellow positive, blue negative, black 0.
@@ -103,7 +103,7 @@ impl Warped {
 }
 
 impl Technique for Warped {
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let name = self.name();
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         let (xv, yv) = (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()));
@@ -120,8 +120,8 @@ impl Technique for Warped {
                 wgpu::BindingResource::TextureView(&yv),
             ],
         );
-        gpu.queue.write_buffer(&self.dv, 0, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
-        timer.stage(gpu, &format!("{name}.desired_view"), |enc| {
+        rec.write_buffer(&self.dv, 0, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
+        rec.stage(&format!("{name}.desired_view"), |enc| {
             gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
         });
         if self.variant == Variant::Dv {
@@ -129,7 +129,7 @@ impl Technique for Warped {
         }
         let res = self.res;
         let n = res * res;
-        timer.stage(gpu, &format!("{name}.importance_map"), |enc| {
+        rec.stage(&format!("{name}.importance_map"), |enc| {
             enc.clear_buffer(&self.work, 0, None);
             gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
             match self.variant {
@@ -164,7 +164,7 @@ impl Technique for Warped {
         Ok(())
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let name = self.name();
         let (xv, yv) = (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()));
         let subdiv = self.params.imp[3] > 0.0;
@@ -191,7 +191,7 @@ impl Technique for Warped {
                 .collect();
             let tris = self.params.ints[0];
             let n = tris.div_ceil(64);
-            timer.stage(gpu, &format!("{name}.subdivide"), |enc| {
+            rec.stage(&format!("{name}.subdivide"), |enc| {
                 enc.clear_buffer(&self.counters, 0, None);
                 let pass = |enc: &mut wgpu::CommandEncoder, g: &wgpu::BindGroup, p: usize, groups: Option<u32>| {
                     let mut pass =
@@ -215,7 +215,7 @@ impl Technique for Warped {
             });
         }
         let map_view = self.map.create_view(&Default::default());
-        timer.stage(gpu, &format!("{name}.shadow_map"), |enc| {
+        rec.stage(&format!("{name}.shadow_map"), |enc| {
             let mut pass = raster::begin_pass(enc, &format!("{name}.shadow_map"), &[], &map_view);
             pass.set_pipeline(&self.depth_pipeline);
             pass.set_bind_group(0, &depth_group, &[]);
@@ -229,22 +229,12 @@ impl Technique for Warped {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, timer: &mut StageTimer) -> Result<(), GpuError> {
-        let name = self.name();
-        let (xv, yv) = (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()));
-        let map_view = self.map.create_view(&Default::default());
-        let mut extra: Vec<wgpu::BindingResource> = self.lookup_resources(&xv, &yv).to_vec();
-        extra.extend([
-            wgpu::BindingResource::TextureView(&map_view),
-            wgpu::BindingResource::Sampler(&self.sampler),
-            self.counts.as_entire_binding(),
-        ]);
-        let group = f.view_group(gpu, &format!("{name}.final_pass"), &self.eval_layout, &extra);
-        timer.stage(gpu, &format!("{name}.final_pass"), |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, &format!("{name}.final_pass"), &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
-        });
-        Ok(())
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, false)
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, true)
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
@@ -303,5 +293,35 @@ impl Technique for Warped {
             r.images.push(offset_image("column warping functions o_y (column j, position y)", res, res, &full(1, w.cols_y, &w.oy, false)));
         }
         r
+    }
+}
+
+impl Warped {
+    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
+    fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        let name = self.name();
+        let (xv, yv) = (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()));
+        let map_view = self.map.create_view(&Default::default());
+        let mut extra: Vec<wgpu::BindingResource> = self.lookup_resources(&xv, &yv).to_vec();
+        extra.extend([
+            wgpu::BindingResource::TextureView(&map_view),
+            wgpu::BindingResource::Sampler(&self.sampler),
+            self.counts.as_entire_binding(),
+        ]);
+        let group = f.view_group(gpu, &format!("{name}.final_pass"), &self.eval_layout, &extra);
+        rec.stage(&format!("{name}.final_pass"), |enc| {
+            if counting {
+                enc.clear_buffer(&self.counts, 0, None);
+            }
+            gpu.dispatch_2d(
+                enc,
+                &format!("{name}.final_pass"),
+                if counting { &self.count_pipeline } else { &self.eval_pipeline },
+                &[&group],
+                f.gbuffer.width,
+                f.gbuffer.height,
+            )
+        });
+        Ok(())
     }
 }

@@ -1,0 +1,242 @@
+//! Recording a frame into the caller's command encoder.
+//!
+//! A technique's `prepare`, `render` and `evaluate` record their passes through a [`Recorder`]
+//! that wraps the `&mut wgpu::CommandEncoder` the caller hands in; they never submit or wait by
+//! themselves. Each group of passes is a *stage*, named `<technique>.<stage>`: the stage name is
+//! the wgpu label and the timing key. What the caller does with the stages is its choice:
+//! - [`Recorder::new`]: plain recording, as a host renderer uses it; the caller submits.
+//! - [`Recorder::with_stamps`]: a GPU timestamp before and after each stage into one query set
+//!   ([`FrameStamps`]), resolved once per frame (adapters with sane timestamps).
+//! - [`Recorder::profiled`]: the breakdown run: every stage is submitted and waited for alone and
+//!   timed by the wall clock (software adapters, whose timestamps read wrong). Its stage times
+//!   add the submit and wait of each stage, so they are a breakdown, never the frame's total.
+//!
+//! A technique that must read the GPU back in the middle of a frame (a reduction whose result
+//! the CPU needs before drawing) calls [`Recorder::sync`] or [`Recorder::read_buffer_as`]: what
+//! was recorded so far is submitted and waited for, and the stall is counted with its reason.
+//! Such techniques declare it in their registry entry (`TechniqueInfo::stalls`).
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use wgpu::util::DeviceExt;
+
+use crate::Gpu;
+
+/// Stages (pairs of timestamps) one frame can time.
+pub const MAX_STAGES: u32 = 128;
+
+/// The query set and buffers for one frame of per-stage GPU timestamps.
+pub struct FrameStamps {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    readback: wgpu::Buffer,
+}
+
+impl FrameStamps {
+    pub fn new(gpu: &Gpu) -> FrameStamps {
+        let n = 2 * MAX_STAGES;
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("frame.timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count: n,
+        });
+        let size = n as u64 * 8;
+        let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame.timestamps.resolve"),
+            size,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame.timestamps.readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        FrameStamps { set, resolve, readback }
+    }
+}
+
+enum Timing<'a> {
+    None,
+    Stamps(&'a FrameStamps, Vec<String>),
+    Profile(BTreeMap<String, f64>),
+}
+
+/// What a recorded frame leaves for its caller (see [`Recorder::finish`]).
+#[derive(Debug, Default)]
+pub struct Recorded {
+    /// Stage names in recording order, each with its timestamp pair index (timestamp frames).
+    pub stamped: Vec<String>,
+    /// Wall-clock ms per stage of a profiled frame (wait per stage); summed over repeated names.
+    pub profile_ms: BTreeMap<String, f64>,
+    /// Mid-frame submits and waits ([`Recorder::sync`]), by reason, in order.
+    pub stalls: Vec<String>,
+}
+
+impl Recorded {
+    /// Per-stage ms from the resolved timestamps of this frame (after the caller's submit and
+    /// wait); repeated stage names add up.
+    pub fn read_stamps(&self, gpu: &Gpu, stamps: &FrameStamps) -> BTreeMap<String, f64> {
+        let mut out = BTreeMap::new();
+        if self.stamped.is_empty() {
+            return out;
+        }
+        let t: Vec<u64> = gpu.map_read_as(&stamps.readback, 2 * self.stamped.len());
+        let period = gpu.queue.get_timestamp_period() as f64 * 1e-6;
+        for (i, name) in self.stamped.iter().enumerate() {
+            *out.entry(name.clone()).or_insert(0.0) += t[2 * i + 1].saturating_sub(t[2 * i]) as f64 * period;
+        }
+        out
+    }
+}
+
+/// Records a frame's stages into the caller's encoder (see the module docs).
+pub struct Recorder<'a> {
+    gpu: &'a Gpu,
+    enc: &'a mut wgpu::CommandEncoder,
+    timing: Timing<'a>,
+    stalls: Vec<String>,
+    /// Stage-name prefix rewrite (`from`, `to`): a technique built from another's passes
+    /// (cube-notw's faces are notw maps) names their stages as its own.
+    rename: Option<(String, String)>,
+}
+
+impl<'a> Recorder<'a> {
+    /// Plain recording into `enc`; the caller submits.
+    pub fn new(gpu: &'a Gpu, enc: &'a mut wgpu::CommandEncoder) -> Recorder<'a> {
+        Recorder { gpu, enc, timing: Timing::None, stalls: Vec::new(), rename: None }
+    }
+
+    /// Recording with a timestamp pair around each stage (the adapter must offer
+    /// `TIMESTAMP_QUERY_INSIDE_ENCODERS`: `gpu.gpu_timestamps`).
+    pub fn with_stamps(gpu: &'a Gpu, enc: &'a mut wgpu::CommandEncoder, stamps: &'a FrameStamps) -> Recorder<'a> {
+        Recorder { gpu, enc, timing: Timing::Stamps(stamps, Vec::new()), stalls: Vec::new(), rename: None }
+    }
+
+    /// The breakdown run: each stage submitted and waited for alone, timed by the wall clock.
+    pub fn profiled(gpu: &'a Gpu, enc: &'a mut wgpu::CommandEncoder) -> Recorder<'a> {
+        Recorder { gpu, enc, timing: Timing::Profile(BTreeMap::new()), stalls: Vec::new(), rename: None }
+    }
+
+    pub fn gpu(&self) -> &'a Gpu {
+        self.gpu
+    }
+
+    /// The encoder, for commands outside a named stage (copies, clears).
+    pub fn encoder(&mut self) -> &mut wgpu::CommandEncoder {
+        self.enc
+    }
+
+    /// Stages named `from...` are recorded as `to...` until the rewrite is set back (returns
+    /// the previous rewrite).
+    pub fn set_rename(&mut self, rename: Option<(String, String)>) -> Option<(String, String)> {
+        std::mem::replace(&mut self.rename, rename)
+    }
+
+    /// Records `f`'s passes as stage `name` (label and timing key).
+    pub fn stage<R>(&mut self, name: &str, f: impl FnOnce(&mut wgpu::CommandEncoder) -> R) -> R {
+        let renamed = self.rename.as_ref().and_then(|(from, to)| name.strip_prefix(from.as_str()).map(|rest| format!("{to}{rest}")));
+        let name = renamed.as_deref().unwrap_or(name);
+        match &mut self.timing {
+            Timing::None => f(self.enc),
+            Timing::Stamps(stamps, names) => {
+                let i = names.len() as u32;
+                assert!(i < MAX_STAGES, "more than {MAX_STAGES} timed stages in one frame");
+                self.enc.write_timestamp(&stamps.set, 2 * i);
+                let r = f(self.enc);
+                self.enc.write_timestamp(&stamps.set, 2 * i + 1);
+                names.push(name.to_string());
+                r
+            }
+            Timing::Profile(_) => {
+                // what was recorded before this stage is not part of it
+                submit_and_wait(self.gpu, self.enc, name);
+                let t0 = Instant::now();
+                let r = f(self.enc);
+                submit_and_wait(self.gpu, self.enc, name);
+                let ms = t0.elapsed().as_secs_f64() * 1e3;
+                if let Timing::Profile(m) = &mut self.timing {
+                    *m.entry(name.to_string()).or_insert(0.0) += ms;
+                }
+                r
+            }
+        }
+    }
+
+    /// Adds CPU work of `ms` done inside the frame (a fit between passes) to the breakdown of a
+    /// profiled frame, as stage `name`; other frames count it in their wall clock only.
+    pub fn cpu(&mut self, name: &str, ms: f64) {
+        if let Timing::Profile(m) = &mut self.timing {
+            *m.entry(name.to_string()).or_insert(0.0) += ms;
+        }
+    }
+
+    /// Writes `data` into `buf` at `offset`, ordered with the recorded passes (a copy from a
+    /// staging buffer; `queue.write_buffer` would land before the whole frame).
+    pub fn write_buffer(&mut self, buf: &wgpu::Buffer, offset: u64, data: &[u8]) {
+        if data.is_empty() {
+            return;
+        }
+        let staging = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("recorder.write"),
+            contents: data,
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+        self.enc.copy_buffer_to_buffer(&staging, 0, buf, offset, data.len() as u64);
+    }
+
+    /// The mid-frame stalls so far.
+    pub fn stalls(&self) -> &[String] {
+        &self.stalls
+    }
+
+    /// Submits what was recorded so far and waits: a declared mid-frame stall (`why` names it).
+    pub fn sync(&mut self, why: &str) {
+        submit_and_wait(self.gpu, self.enc, why);
+        self.stalls.push(why.to_string());
+    }
+
+    /// Copies `count` values of `buf` into a staging buffer in the frame, then
+    /// [`Recorder::sync`]s and reads them: one stall, one submit.
+    pub fn read_buffer_as<T: bytemuck::Pod>(&mut self, buf: &wgpu::Buffer, count: usize, why: &str) -> Vec<T> {
+        let size = ((count * std::mem::size_of::<T>()) as u64).div_ceil(4) * 4;
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(why),
+            size: size.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.enc.copy_buffer_to_buffer(buf, 0, &staging, 0, size);
+        self.sync(why);
+        self.gpu.map_read_as(&staging, count)
+    }
+
+    /// Ends recording: on a timestamp frame records the one resolve (and its copy for reading).
+    pub fn finish(self) -> Recorded {
+        let mut out = Recorded { stalls: self.stalls, ..Default::default() };
+        match self.timing {
+            Timing::None => {}
+            Timing::Stamps(stamps, names) => {
+                if !names.is_empty() {
+                    let n = 2 * names.len() as u32;
+                    self.enc.resolve_query_set(&stamps.set, 0..n, &stamps.resolve, 0);
+                    self.enc.copy_buffer_to_buffer(&stamps.resolve, 0, &stamps.readback, 0, n as u64 * 8);
+                }
+                out.stamped = names;
+            }
+            Timing::Profile(m) => out.profile_ms = m,
+        }
+        out
+    }
+}
+
+/// Submits the encoder's commands so far (replacing it with a fresh one of the same label) and
+/// waits for the device.
+fn submit_and_wait(gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str) {
+    let fresh = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    let done = std::mem::replace(enc, fresh);
+    gpu.submit(done.finish());
+    gpu.wait();
+}
