@@ -142,7 +142,7 @@ pub fn run(lab: &Lab, cfg: &RunConfig, frames: usize, repeat: usize, pb: &Progre
     // the breakdown: one more frame each, profiled, after the measured ones (it advances
     // techniques with history by a frame, so it comes last)
     let timestamps = lab.gpu.gpu_timestamps;
-    let mut profile = |inst: &mut Instance| if timestamps { Ok(BTreeMap::new()) } else { lab.profile(&view, inst) };
+    let profile = |inst: &mut Instance| if timestamps { Ok(BTreeMap::new()) } else { lab.profile(&view, inst) };
     pb.set_message("profiled breakdown");
     let rt_breakdown_ms = profile(&mut rt_inst)?;
     let mut techniques = Vec::new();

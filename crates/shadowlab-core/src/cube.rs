@@ -104,6 +104,27 @@ pub fn texel_size(f: usize, d: Vec3, res: u32) -> f32 {
     2.0 * d.dot(FACES[f].n) / res as f32
 }
 
+/// Whether the triangle `tri` lies wholly outside one side plane of face `f`'s 90-degree
+/// frustum from `light` (all three corners beyond it): it draws nothing into that face. The same
+/// test as cube/depth.wgsl's vertex stage, made conservative (a relative margin of 1e-4 in
+/// f64), so that a triangle kept by the GPU's f32 test is never dropped here. The cube map's
+/// per-face triangle lists are built with it once for the static geometry.
+pub fn outside_face(tri: &[Vec3; 3], light: Vec3, f: usize) -> bool {
+    let face = FACES[f];
+    let (n, u, v) = (face.n.as_dvec3(), face.u.as_dvec3(), face.v.as_dvec3());
+    let mut outside = [true; 4];
+    for p in tri {
+        let d = (*p - light).as_dvec3();
+        let (z, s, t) = (d.dot(n), d.dot(u), d.dot(v));
+        let beyond = |a: f64| a - z > 1e-4 * (a.abs() + z.abs()) + 1e-30;
+        let sides = [beyond(s), beyond(-s), beyond(t), beyond(-t)];
+        for k in 0..4 {
+            outside[k] &= sides[k];
+        }
+    }
+    outside.iter().any(|o| *o)
+}
+
 /// Clips a triangle to face `f`'s frustum from `light`: in front of the plane at distance
 /// `near` along the axis, and inside the square of half-width `tan_half` (1 = exactly 90
 /// degrees; a little more keeps clipped edges outside the map). The part inside comes back as
@@ -150,6 +171,29 @@ pub fn clip_to_face(tri: &[Vertex; 3], light: Vec3, f: usize, near: f32, tan_hal
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn outside_face_drops_only_triangles_wholly_beyond_one_side() {
+        let l = Vec3::ZERO;
+        // face +x looks along +x; its side planes are |z| = x and |y| = x
+        let inside = [Vec3::new(2.0, 0.1, 0.1), Vec3::new(2.0, -0.1, 0.2), Vec3::new(2.5, 0.0, -0.2)];
+        assert!(!outside_face(&inside, l, 0));
+        let beyond_z = [Vec3::new(1.0, 0.0, 2.0), Vec3::new(1.0, 0.5, 3.0), Vec3::new(0.5, -0.5, 2.5)];
+        assert!(outside_face(&beyond_z, l, 0));
+        // a triangle across the side plane (corners on both sides) is kept
+        let across = [Vec3::new(1.0, 0.0, 2.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 3.0)];
+        assert!(!outside_face(&across, l, 0));
+        // corners exactly on the plane are kept (the margin is conservative)
+        let on = [Vec3::new(1.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 2.0), Vec3::new(3.0, 0.1, 3.0)];
+        assert!(!outside_face(&on, l, 0));
+        // behind the light: beyond every side at once
+        let behind = [Vec3::new(-1.0, 0.0, 0.0), Vec3::new(-2.0, 0.1, 0.0), Vec3::new(-1.5, 0.0, 0.1)];
+        assert!(outside_face(&behind, l, 0));
+        // each triangle lands in at least one face
+        for tri in [inside, beyond_z, across, on, behind] {
+            assert!((0..6).any(|f| !outside_face(&tri, l, f)));
+        }
+    }
+
     use super::*;
     use glam::Vec4Swizzles;
 

@@ -56,9 +56,14 @@ pub struct HostResult {
 pub fn open_device() -> Result<Gpu, String> {
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapter = pollster::block_on(instance.request_adapter(&Default::default())).map_err(|e| e.to_string())?;
-    // lt needs 9 storage buffers per stage (`shadowlab techniques` lists each one's needs)
-    let mut limits = wgpu::Limits::default();
-    limits.max_storage_buffers_per_shader_stage = adapter.limits().max_storage_buffers_per_shader_stage.max(9);
+    // lt needs 10 storage buffers per stage (`shadowlab techniques` lists each one's needs); this
+    // host's own G-buffer writes 40 bytes per pixel (WebGPU's default allows 32)
+    let a = adapter.limits();
+    let limits = wgpu::Limits {
+        max_storage_buffers_per_shader_stage: a.max_storage_buffers_per_shader_stage.max(10),
+        max_color_attachment_bytes_per_sample: a.max_color_attachment_bytes_per_sample,
+        ..wgpu::Limits::default()
+    };
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("host"),
         required_limits: limits,
@@ -72,7 +77,7 @@ pub fn open_device() -> Result<Gpu, String> {
 pub fn run(gpu: &Gpu, scene: &Scene, size: u32, frames: usize) -> Result<HostResult, Box<dyn std::error::Error>> {
     let (camera, light) = (scene.camera, scene.lights[0]);
     let bvh = Bvh::build(scene)?;
-    let gscene = GpuScene::new(gpu, scene, &bvh)?;
+    let gscene = GpuScene::from_scene(gpu, scene, &bvh)?;
     let view = HostView::new(gpu, &gscene, size, size)?;
 
     // the host's own geometry and pass
@@ -117,7 +122,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, size: u32, frames: usize) -> Result<HostRes
             module: &module,
             entry_point: Some("vs"),
             compilation_options: Default::default(),
-            buffers: &[wgpu::VertexBufferLayout { array_stride: 24, step_mode: wgpu::VertexStepMode::Vertex, attributes: &attrs }],
+            buffers: &[Some(wgpu::VertexBufferLayout { array_stride: 24, step_mode: wgpu::VertexStepMode::Vertex, attributes: &attrs })],
         },
         primitive: Default::default(),
         depth_stencil: Some(wgpu::DepthStencilState {

@@ -23,7 +23,7 @@ use shadowlab_core::camera::Camera;
 use shadowlab_core::light::Light;
 
 use crate::frame::{FrameUniform, LightUniform};
-use crate::gbuffer::{GBuffer, GBufferPass};
+use crate::gbuffer::{GBuffer, MaskPass};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
@@ -53,7 +53,7 @@ pub struct HostView {
     /// R32Float copy of `visibility` ([`HostView::record_visibility_texture`]).
     pub visibility_texture: wgpu::Texture,
     eps: f32,
-    passes: GBufferPass,
+    mask: MaskPass,
     copy: wgpu::ComputePipeline,
     copy_group: wgpu::BindGroup,
 }
@@ -96,7 +96,7 @@ impl HostView {
             visibility,
             visibility_texture,
             eps: scene.eps,
-            passes: GBufferPass::new(gpu, scene),
+            mask: MaskPass::new(gpu),
             copy,
             copy_group,
         })
@@ -111,7 +111,7 @@ impl HostView {
         let (w, h) = (self.gbuffer.width, self.gbuffer.height);
         rec.write_buffer(&self.frame, 0, bytemuck::bytes_of(&FrameUniform::new(camera, prev, w, h)));
         rec.write_buffer(&self.light_buf, 0, bytemuck::bytes_of(&LightUniform::new(light, self.eps)));
-        self.passes.mask(gpu, rec, &self.frame, &self.light_buf, &self.gbuffer);
+        self.mask.record(gpu, rec, &self.frame, &self.light_buf, &self.gbuffer);
         Ok(())
     }
 

@@ -32,6 +32,10 @@ pub struct Lab<'a> {
     time: Cell<(f32, f32)>,
     /// Wall time of the last `set_time` that moved something (ms).
     animate_ms: Cell<f64>,
+    /// The one query set of a timed frame's stage timestamps (adapters with sane timestamps).
+    stamps: Option<FrameStamps>,
+    /// Whether the G-buffer and mask passes have run once (untimed warm-up).
+    gbuffer_warm: Cell<bool>,
 }
 
 /// One view of the scene for one light, with its G-buffer read back.
@@ -114,17 +118,23 @@ pub struct Run {
 impl<'a> Lab<'a> {
     pub fn new(gpu: &'a Gpu, scene: &'a Scene) -> Result<Lab<'a>, GpuError> {
         let bvh = Bvh::build(scene).map_err(GpuError::Invalid)?;
-        let d = scene.dynamic_first();
-        let gscene = if d == scene.triangle_count() {
-            GpuScene::new(gpu, scene, &bvh)?
-        } else {
-            let static_bvh = if d == 0 { Bvh::empty() } else { Bvh::build_range(scene, 0..d).map_err(GpuError::Invalid)? };
-            GpuScene::new(gpu, scene, &static_bvh)?
-        };
+        let gscene = GpuScene::from_scene(gpu, scene, &bvh)?;
         let gbuffer_pass = GBufferPass::new(gpu, &gscene);
         let shade_pass = ShadePass::new(gpu);
         gpu.take_error()?;
-        Ok(Lab { gpu, scene, bvh, gscene, gbuffer_pass, shade_pass, time: Cell::new((0.0, 0.0)), animate_ms: Cell::new(0.0) })
+        let stamps = gpu.gpu_timestamps.then(|| FrameStamps::new(gpu));
+        Ok(Lab {
+            gpu,
+            scene,
+            bvh,
+            gscene,
+            gbuffer_pass,
+            shade_pass,
+            time: Cell::new((0.0, 0.0)),
+            animate_ms: Cell::new(0.0),
+            stamps,
+            gbuffer_warm: Cell::new(false),
+        })
     }
 
     /// Moves the scene's moving objects to time `t` (frames), with motion vectors against
@@ -160,6 +170,13 @@ impl<'a> Lab<'a> {
             self.gbuffer_pass.render(gpu, rec, &self.gscene, &frame, &g);
             self.gbuffer_pass.mask(gpu, rec, &frame, &light_buf, &g);
         };
+        if !self.gbuffer_warm.replace(true) {
+            // the first frame compiles the pipelines' shaders (llvmpipe compiles on first use)
+            self.timed_frame(|rec| {
+                record(rec);
+                Ok(())
+            })?;
+        }
         let (frame_ms, stamped) = self.timed_frame(|rec| {
             record(rec);
             Ok(())
@@ -207,10 +224,10 @@ impl<'a> Lab<'a> {
     /// the adapter has sane timestamps). Mid-frame syncs inside `f` add their submits.
     fn timed_frame(&self, f: impl FnOnce(&mut Recorder) -> Result<(), GpuError>) -> Result<(f64, Option<BTreeMap<String, f64>>), GpuError> {
         let gpu = self.gpu;
-        let stamps = gpu.gpu_timestamps.then(|| FrameStamps::new(gpu));
+        let stamps = self.stamps.as_ref();
         let t0 = std::time::Instant::now();
         let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        let mut rec = match &stamps {
+        let mut rec = match stamps {
             Some(s) => Recorder::with_stamps(gpu, &mut enc, s),
             None => Recorder::new(gpu, &mut enc),
         };
@@ -219,7 +236,7 @@ impl<'a> Lab<'a> {
         gpu.submit(enc.finish());
         gpu.wait();
         let ms = t0.elapsed().as_secs_f64() * 1e3;
-        Ok((ms, stamps.map(|s| done.read_stamps(gpu, &s))))
+        Ok((ms, stamps.map(|s| done.read_stamps(gpu, s))))
     }
 
     /// One profiled frame of `f`: each stage submitted and waited for alone (the breakdown).

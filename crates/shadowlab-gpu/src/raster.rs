@@ -14,6 +14,37 @@ pub fn scene_pipeline(
     layouts: &[&wgpu::BindGroupLayout],
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
+    scene_pipeline_with(gpu, label, source, layouts, targets, true, &[])
+}
+
+/// [`scene_pipeline`] with WGSL `override` constants for the fragment stage.
+pub fn scene_pipeline_constants(
+    gpu: &Gpu,
+    label: &str,
+    source: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    targets: &[Option<wgpu::ColorTargetState>],
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
+    scene_pipeline_with(gpu, label, source, layouts, targets, true, constants)
+}
+
+/// A depth-only scene pipeline: with a fragment stage (`fs_main`, the alpha cut-out test) only
+/// where `scene.has_cutouts`; otherwise none, the same depths without fragment shading (llvmpipe
+/// then runs no shader per fragment, as a GL depth pass with an empty fragment shader).
+pub fn depth_pipeline(gpu: &Gpu, label: &str, source: &str, layouts: &[&wgpu::BindGroupLayout], has_cutouts: bool) -> wgpu::RenderPipeline {
+    scene_pipeline_with(gpu, label, source, layouts, &[], has_cutouts, &[])
+}
+
+fn scene_pipeline_with(
+    gpu: &Gpu,
+    label: &str,
+    source: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    targets: &[Option<wgpu::ColorTargetState>],
+    fragment: bool,
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
     let module = gpu.shader(label, source);
     let layout = gpu.pipeline_layout(label, layouts);
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -29,10 +60,10 @@ pub fn scene_pipeline(
             bias: Default::default(),
         }),
         multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
+        fragment: fragment.then_some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             targets,
         }),
         multiview_mask: None,

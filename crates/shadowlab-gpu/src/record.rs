@@ -240,3 +240,73 @@ fn submit_and_wait(gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str) {
     gpu.submit(done.finish());
     gpu.wait();
 }
+
+/// A readback that never stalls a frame: the frame records a copy of a buffer into a staging
+/// buffer mapped on submit ([`DelayedRead::record`]); the next frame takes the words if the
+/// GPU has finished them ([`DelayedRead::take`], which polls the device without waiting).
+/// Delayed modes (`csm:delayed=true`, `iasm:delayed=true`) use it for the previous frame's
+/// reduction instead of a [`Recorder::sync`].
+pub struct DelayedRead {
+    staging: wgpu::Buffer,
+    ready: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    /// A copy recorded and not yet taken.
+    pending: bool,
+}
+
+impl DelayedRead {
+    pub fn new(gpu: &Gpu, label: &str, size: u64) -> DelayedRead {
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.div_ceil(4).max(1) * 4,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        DelayedRead { staging, ready: Default::default(), pending: false }
+    }
+
+    /// Records the copy of `src` (its first `staging` bytes) and maps the copy when the frame's
+    /// commands are done. Call [`DelayedRead::take`] first in a frame that records again.
+    pub fn record(&mut self, rec: &mut Recorder, src: &wgpu::Buffer) {
+        if self.pending {
+            // the last copy was never taken: drop it (its mapping may still be in flight)
+            let _ = self.take_ready::<u32>(rec.gpu(), 0);
+            if self.pending {
+                return;
+            }
+        }
+        let size = self.staging.size();
+        let enc = rec.encoder();
+        enc.copy_buffer_to_buffer(src, 0, &self.staging, 0, size);
+        self.ready.store(false, std::sync::atomic::Ordering::Release);
+        let ready = self.ready.clone();
+        enc.map_buffer_on_submit(&self.staging, wgpu::MapMode::Read, .., move |r| {
+            if r.is_ok() {
+                ready.store(true, std::sync::atomic::Ordering::Release);
+            }
+        });
+        self.pending = true;
+    }
+
+    /// The last recorded copy's first `count` values, if its frame has finished on the GPU
+    /// (polls without waiting); None if nothing was recorded or it is not done yet.
+    pub fn take<T: bytemuck::Pod>(&mut self, gpu: &Gpu, count: usize) -> Option<Vec<T>> {
+        self.take_ready(gpu, count)
+    }
+
+    fn take_ready<T: bytemuck::Pod>(&mut self, gpu: &Gpu, count: usize) -> Option<Vec<T>> {
+        if !self.pending {
+            return None;
+        }
+        let _ = gpu.device.poll(wgpu::PollType::Poll);
+        if !self.ready.load(std::sync::atomic::Ordering::Acquire) {
+            return None;
+        }
+        let out = {
+            let view = self.staging.slice(..).get_mapped_range().ok()?;
+            bytemuck::pod_collect_to_vec(&view[..count * std::mem::size_of::<T>()])
+        };
+        self.staging.unmap();
+        self.pending = false;
+        Some(out)
+    }
+}

@@ -52,6 +52,11 @@ pub struct GpuScene {
     pub layout: wgpu::BindGroupLayout,
     pub group: wgpu::BindGroup,
     pub triangle_count: u32,
+    /// Whether any material is alpha-tested (`MAT_MASKED`); without, depth-only passes run
+    /// with no fragment stage (the cut-out test could discard nothing).
+    pub has_cutouts: bool,
+    /// Whether any material is single-sided (its back faces are discarded in the G-buffer).
+    pub single_sided: bool,
     /// Triangles `dynamic_first..triangle_count` are dynamic (moved by the scene's animations,
     /// rewritten every frame); `0..dynamic_first` are static. Equal to `triangle_count` for a
     /// scene without moving objects.
@@ -168,6 +173,8 @@ impl GpuScene {
             layout,
             group,
             triangle_count: tri_count as u32,
+            has_cutouts: scene.has_cutouts(),
+            single_sided: scene.materials.iter().any(|m| !m.double_sided),
             dynamic_first: dynamic_first as u32,
             bounds: scene.swept_bounds(),
             eps: scene.ray_epsilon(),
@@ -184,6 +191,18 @@ impl GpuScene {
         };
         g.set_time(gpu, scene, 0.0, 0.0)?;
         Ok(g)
+    }
+
+    /// The scene on the GPU with the BVH its ray tracing needs: `full` (a BVH over the whole
+    /// scene) when nothing moves, else one over the static triangles (the moving ones get a
+    /// tree of their own each frame). What the lab and a host both use.
+    pub fn from_scene(gpu: &Gpu, scene: &Scene, full: &Bvh) -> Result<GpuScene, GpuError> {
+        let d = scene.dynamic_first();
+        if d == scene.triangle_count() {
+            return GpuScene::new(gpu, scene, full);
+        }
+        let static_bvh = if d == 0 { Bvh::empty() } else { Bvh::build_range(scene, 0..d).map_err(GpuError::Invalid)? };
+        GpuScene::new(gpu, scene, &static_bvh)
     }
 
     /// The current vertices (3 per triangle), read back from the GPU.
@@ -225,6 +244,8 @@ impl GpuScene {
             layout: self.layout.clone(),
             group,
             triangle_count: count,
+            has_cutouts: self.has_cutouts,
+            single_sided: self.single_sided,
             dynamic_first: count,
             bounds: self.bounds,
             eps: self.eps,

@@ -70,3 +70,22 @@ fn the_timed_frame_of_sm_has_no_sample_counting() {
     assert!(s.used_texel_fraction > 0.0, "the analysis pass counted the view samples");
     assert!(run.stages_ms.keys().all(|k| !k.ends_with(".analysis")), "analysis stages are not timed: {:?}", run.stages_ms.keys());
 }
+
+#[test]
+fn delayed_modes_record_without_a_stall_and_match_on_a_still_view() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 96);
+    for (now, delayed) in [("csm", "csm:delayed=true"), ("iasm", "iasm:delayed=true")] {
+        let parse = |s: &str| shadowlab_core::params::TechniqueSpec::parse(s).unwrap();
+        // a warm-up frame, then the timed one: the delayed mode reads the warm-up's reduction
+        let a = lab.run(&v, &parse(now), 1).unwrap();
+        let b = lab.run(&v, &parse(delayed), 1).unwrap();
+        assert!(!a.stalls.is_empty(), "{now} reads back mid-frame");
+        assert!(b.stalls.is_empty() && b.submits_per_frame == 1, "{delayed}: {:?}, {} submits", b.stalls, b.submits_per_frame);
+        // a still view: the previous frame's reduction is this frame's
+        let same = a.visibility.iter().zip(&b.visibility).all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "{delayed} differs from {now} on a still view");
+    }
+}

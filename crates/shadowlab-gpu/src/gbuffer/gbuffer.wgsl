@@ -5,6 +5,10 @@
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 
+// False where the scene has no alpha cut-outs and no single-sided material: then nothing is
+// discarded, and the rasteriser may test depth before shading (no overdraw shaded).
+override DISCARDS: bool = true;
+
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
@@ -36,7 +40,7 @@ struct GOut {
 fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> GOut {
     let v = vertices[in.tri * 3u];
     let m = materials[v.material];
-    if cut_out(m, in.uv) || (!front && (m.flags & MAT_DOUBLE_SIDED) == 0u) {
+    if DISCARDS && (cut_out(m, in.uv) || (!front && (m.flags & MAT_DOUBLE_SIDED) == 0u)) {
         discard;
     }
     var n = v.normal;

@@ -56,8 +56,45 @@ impl GBuffer {
 pub struct GBufferPass {
     raster: wgpu::RenderPipeline,
     frame_layout: wgpu::BindGroupLayout,
-    mask: wgpu::ComputePipeline,
-    mask_layout: wgpu::BindGroupLayout,
+    mask: MaskPass,
+}
+
+/// The evaluation mask pass alone (a host draws its own G-buffer).
+pub struct MaskPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl MaskPass {
+    pub fn new(gpu: &Gpu) -> MaskPass {
+        let layout = binding::layout(
+            &gpu.device,
+            "mask",
+            wgpu::ShaderStages::COMPUTE,
+            &[binding::uniform(), binding::uniform(), binding::texture_float(), binding::texture_float(), binding::storage(false)],
+        );
+        let pipeline = gpu.compute_pipeline("mask", &compose(MASK_WGSL, false), "main", &[&layout]);
+        MaskPass { pipeline, layout }
+    }
+
+    /// Writes `g.mask` for one light (stage `mask`).
+    pub fn record(&self, gpu: &Gpu, rec: &mut Recorder, frame: &wgpu::Buffer, light: &wgpu::Buffer, g: &GBuffer) {
+        let pv = g.position.create_view(&Default::default());
+        let nv = g.normal.create_view(&Default::default());
+        let group = binding::group(
+            &gpu.device,
+            "mask",
+            &self.layout,
+            &[
+                frame.as_entire_binding(),
+                light.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&pv),
+                wgpu::BindingResource::TextureView(&nv),
+                g.mask.as_entire_binding(),
+            ],
+        );
+        rec.stage("mask", |enc| gpu.dispatch_2d(enc, "mask", &self.pipeline, &[&group], g.width, g.height));
+    }
 }
 
 impl GBufferPass {
@@ -67,16 +104,17 @@ impl GBufferPass {
         let frame_layout = binding::layout(d, "gbuffer.frame", vf, &[binding::uniform()]);
         let targets: Vec<Option<wgpu::ColorTargetState>> =
             [POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT, MOTION_FORMAT].iter().map(|f| Some((*f).into())).collect();
-        let raster = raster::scene_pipeline(gpu, "gbuffer", &compose(GBUFFER_WGSL, true), &[&frame_layout, &scene.layout], &targets);
-        let c = wgpu::ShaderStages::COMPUTE;
-        let mask_layout = binding::layout(
-            d,
-            "mask",
-            c,
-            &[binding::uniform(), binding::uniform(), binding::texture_float(), binding::texture_float(), binding::storage(false)],
+        // nothing to discard: the same fragments survive, without shading the hidden ones
+        let discards = if scene.has_cutouts || scene.single_sided { 1.0 } else { 0.0 };
+        let raster = raster::scene_pipeline_constants(
+            gpu,
+            "gbuffer",
+            &compose(GBUFFER_WGSL, true),
+            &[&frame_layout, &scene.layout],
+            &targets,
+            &[("DISCARDS", discards)],
         );
-        let mask = gpu.compute_pipeline("mask", &compose(MASK_WGSL, false), "main", &[&mask_layout]);
-        GBufferPass { raster, frame_layout, mask, mask_layout }
+        GBufferPass { raster, frame_layout, mask: MaskPass::new(gpu) }
     }
 
     /// Rasterises the scene into `g` (stage `gbuffer`).
@@ -97,20 +135,6 @@ impl GBufferPass {
 
     /// Writes `g.mask` for one light (stage `mask`).
     pub fn mask(&self, gpu: &Gpu, rec: &mut Recorder, frame: &wgpu::Buffer, light: &wgpu::Buffer, g: &GBuffer) {
-        let pv = g.position.create_view(&Default::default());
-        let nv = g.normal.create_view(&Default::default());
-        let group = binding::group(
-            &gpu.device,
-            "mask",
-            &self.mask_layout,
-            &[
-                frame.as_entire_binding(),
-                light.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&pv),
-                wgpu::BindingResource::TextureView(&nv),
-                g.mask.as_entire_binding(),
-            ],
-        );
-        rec.stage("mask", |enc| gpu.dispatch_2d(enc, "mask", &self.mask, &[&group], g.width, g.height));
+        self.mask.record(gpu, rec, frame, light, g);
     }
 }

@@ -32,7 +32,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     lights: &["directional", "spot", "point"],
     params: &[] as &[ParamDef],
     stalls: "",
-    needs: "",
+    needs: "9 storage buffers per shader stage (WebGPU default: 8)",
     create: |gpu, scene, _params, _light| Ok(Box::new(RayTraced::new(gpu, scene))),
 };
 

@@ -21,7 +21,7 @@ use shadowlab_core::params::ParamValues;
 
 pub use params::*;
 
-use crate::record::Recorder;
+use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, MinMax};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
@@ -44,7 +44,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     lights: &["directional"],
     params: PARAMS,
     stalls:
-        "with tighten=true (default): csm.readback, the view depth range read back before the fit; tighten=false records without a stall",
+        "with tighten=true (default): csm.readback, the view depth range read back before the fit; tighten=false, or delayed=true (the previous frame's range), records without a stall",
     needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, p, light)?)),
 };
@@ -80,6 +80,8 @@ pub struct Cascaded {
     snap: bool,
     fit: Fit,
     tighten: bool,
+    /// With `tighten`: the previous frame's range, read back without a stall.
+    delayed: Option<DelayedRead>,
     pcf: u32,
     dir: Vec3,
     params: CsmParams,
@@ -138,7 +140,8 @@ impl Cascaded {
         let depth_layout = binding::layout(d, "csm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_uniforms: Vec<_> = (0..count).map(|_| gpu.uniform("csm.cascade", &Mat4::IDENTITY.to_cols_array_2d())).collect();
         let depth_groups = depth_uniforms.iter().map(|u| binding::group(d, "csm.depth", &depth_layout, &[u.as_entire_binding()])).collect();
-        let depth_pipeline = raster::scene_pipeline(gpu, "csm.depth", &compose_depth(DEPTH_WGSL), &[&depth_layout, &scene.layout], &[]);
+        let depth_pipeline =
+            raster::depth_pipeline(gpu, "csm.depth", &compose_depth(DEPTH_WGSL), &[&depth_layout, &scene.layout], scene.has_cutouts);
         let eval_layout = view_layout(
             gpu,
             "csm.eval",
@@ -157,6 +160,7 @@ impl Cascaded {
             snap: p.get_bool("snap"),
             fit: if p.get_u32("fit") == 0 { Fit::Sphere } else { Fit::Box },
             tighten: p.get_bool("tighten"),
+            delayed: (p.get_bool("tighten") && p.get_bool("delayed")).then(|| DelayedRead::new(gpu, "csm.delayed", PROBE_BYTES)),
             pcf: p.get_u32("pcf"),
             dir: direction,
             params,
@@ -197,7 +201,13 @@ impl Technique for Cascaded {
     /// Depth reduction on the GPU and one readback (with `tighten`), the fit on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.depth_range = None;
-        if self.tighten {
+        if let Some(d) = self.delayed.as_mut() {
+            // the previous frame's range (None on the first frame: the whole frustum), then this
+            // frame's reduction for the next one
+            self.depth_range = d.take::<u32>(gpu, 2).and_then(|w| decode([w[0], w[1]]));
+            rec.stage("csm.analyze", |enc| self.reduce.record(gpu, enc, "csm.reduce", &f.gbuffer.position, &f.gbuffer.mask));
+            d.record(rec, &self.reduce.result);
+        } else if self.tighten {
             rec.stage("csm.analyze", |enc| {
                 self.reduce.record(gpu, enc, "csm.reduce", &f.gbuffer.position, &f.gbuffer.mask);
                 enc.copy_buffer_to_buffer(&self.reduce.result, 0, &self.probe, 0, PROBE_BYTES);

@@ -130,6 +130,16 @@ pub const PARAMS: &[ParamDef] = &[
         choices: BOOL,
     },
     ParamDef {
+        key: "delayed",
+        default: 0.0,
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        doc: "with tighten: use the previous frame's depth range (read back without a stall; the first frame splits the whole frustum) instead of this frame's (one sync)",
+        source: "shadowlab (the recorded-frame seam: a host frame never stalls); measured in docs/bench/recorded_frame.md",
+        choices: BOOL,
+    },
+    ParamDef {
         key: "bias",
         default: DEFAULT_BIAS,
         min: 0.0,

@@ -13,6 +13,10 @@ struct CubeFace {
 
 @group(0) @binding(0) var<uniform> cf: CubeFace;
 
+// False for the static triangles, drawn from per-face lists culled once on the CPU
+// (`cube::outside_face`); true for the moving ones, drawn whole into every face.
+override CULL_IN_VS: bool = true;
+
 struct CubeVsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uv: vec2<f32>,
@@ -28,6 +32,9 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> CubeVsOut {
     out.uv = o.uv;
     out.material = o.material;
     out.world = vertices[vi].pos;
+    if !CULL_IN_VS {
+        return out;
+    }
     let b = cube_basis(cf.face.x);
     let first = vi - vi % 3u;
     var outside = vec4<bool>(true);

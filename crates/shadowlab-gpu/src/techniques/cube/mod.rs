@@ -144,7 +144,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     lights: &["point"],
     params: NOTW_PARAMS,
     stalls: "cube-notw.face_samples: the samples per face are read back to skip empty faces",
-    needs: "",
+    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
 };
 
@@ -182,6 +182,10 @@ pub struct CubeMap {
     map: wgpu::Texture,
     face_groups: Vec<wgpu::BindGroup>,
     depth_pipeline: wgpu::RenderPipeline,
+    /// The static triangles of each face (vertex indices), culled once on the CPU.
+    face_indices: Vec<(wgpu::Buffer, u32)>,
+    /// Draws them without the vertex stage's per-face test.
+    static_pipeline: wgpu::RenderPipeline,
     params: wgpu::Buffer,
     counts: wgpu::Buffer,
     eval_layout: wgpu::BindGroupLayout,
@@ -212,6 +216,15 @@ impl CubeMap {
             })
             .collect();
         let depth_pipeline = raster::scene_pipeline(gpu, "cube.render", &depth_src(), &[&face_layout, &scene.layout], &[]);
+        let static_pipeline = raster::scene_pipeline_constants(
+            gpu,
+            "cube.render.static",
+            &depth_src(),
+            &[&face_layout, &scene.layout],
+            &[],
+            &[("CULL_IN_VS", 0.0)],
+        );
+        let face_indices = static_face_lists(gpu, scene, pos);
         let params = CubeParams {
             light: pos.extend(far).into(),
             cfg: [res as f32, pcf as f32, 0.0, 0.0],
@@ -232,6 +245,8 @@ impl CubeMap {
             map,
             face_groups,
             depth_pipeline,
+            face_indices,
+            static_pipeline,
             params: gpu.uniform("cube.params", &params),
             counts: gpu.storage("cube.counts", 6 * res as u64 * res as u64 * 4),
             eval_layout,
@@ -295,12 +310,19 @@ impl Technique for CubeMap {
             })
             .collect();
         rec.stage("cube.render", |enc| {
-            for (view, group) in views.iter().zip(&self.face_groups) {
+            for ((view, group), (indices, n)) in views.iter().zip(&self.face_groups).zip(&self.face_indices) {
                 let mut pass = raster::begin_pass(enc, "cube.render", &[], view);
-                pass.set_pipeline(&self.depth_pipeline);
                 pass.set_bind_group(0, group, &[]);
                 pass.set_bind_group(1, &f.scene.group, &[]);
-                pass.draw(0..f.scene.triangle_count * 3, 0..1);
+                if *n > 0 {
+                    pass.set_pipeline(&self.static_pipeline);
+                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..*n, 0, 0..1);
+                }
+                if f.scene.dynamic_first < f.scene.triangle_count {
+                    pass.set_pipeline(&self.depth_pipeline);
+                    pass.draw(f.scene.dynamic_first * 3..f.scene.triangle_count * 3, 0..1);
+                }
             }
         });
         Ok(())
@@ -320,6 +342,9 @@ impl Technique for CubeMap {
         let mut r = TechniqueReport { shadow_data_bytes: 6 * n as u64 * 4, sampling: Some(sampling_stats(&counts)), ..Default::default() };
         r.counters.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
         r.counters.insert("shadow_map_texels".into(), 6.0 * n as f64);
+        // the per-face lists of static triangles (geometry, kept per light; not shadow data)
+        r.counters.insert("face_list_bytes".into(), self.face_indices.iter().map(|(_, k)| *k as f64 * 4.0).sum());
+        r.counters.insert("face_list_triangles".into(), self.face_indices.iter().map(|(_, k)| (*k / 3) as f64).sum());
         for (f, face) in self.read_faces(gpu).iter().enumerate() {
             let samples = counts[f * n..(f + 1) * n].iter().map(|&c| c as u64).sum::<u64>();
             r.counters.insert(format!("view_samples_face_{}", FACES[f].name), samples as f64);
@@ -359,4 +384,24 @@ impl CubeMap {
         });
         Ok(())
     }
+}
+
+/// Per face, the vertex indices of the static triangles not wholly outside it
+/// (`cube::outside_face`): the faces then draw about a sixth of the scene each, with no per-face
+/// test in the vertex stage. The light of a technique instance never moves.
+fn static_face_lists(gpu: &Gpu, scene: &GpuScene, light: Vec3) -> Vec<(wgpu::Buffer, u32)> {
+    let verts = scene.read_vertices(gpu);
+    (0..6)
+        .map(|f| {
+            let idx: Vec<u32> = (0..scene.dynamic_first)
+                .filter(|&t| {
+                    let v = &verts[3 * t as usize..3 * t as usize + 3];
+                    !shadowlab_core::cube::outside_face(&[v[0].pos.into(), v[1].pos.into(), v[2].pos.into()], light, f)
+                })
+                .flat_map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect();
+            let n = idx.len() as u32;
+            (gpu.buffer_init(&format!("cube.face{f}.indices"), bytemuck::cast_slice(&idx), wgpu::BufferUsages::INDEX), n)
+        })
+        .collect()
 }

@@ -164,7 +164,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     lights: &["point"],
     params: DPSM_PARAMS,
     stalls: "",
-    needs: "",
+    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, false)?)),
 };
 
@@ -177,7 +177,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     lights: &["point"],
     params: NOTW_PARAMS,
     stalls: "",
-    needs: "",
+    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, true)?)),
 };
 

@@ -24,13 +24,13 @@ pub struct Atlas {
     pub(super) eval_count: wgpu::ComputePipeline,
 }
 
-pub(super) fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout]) -> Result<Atlas, GpuError> {
+pub(super) fn make_atlas(gpu: &Gpu, layouts: &[&wgpu::BindGroupLayout], has_cutouts: bool) -> Result<Atlas, GpuError> {
     let (w, h, slots) =
         core::atlas_layout(&THESIS_RESOLUTIONS).ok_or_else(|| GpuError::Invalid("iasm: resolution set does not fit an atlas".into()))?;
     gpu.check_size(w, h, "iasm atlas")?;
     let texture = raster::depth_target(gpu, "iasm.atlas", w, h, 1, wgpu::TextureUsages::empty());
     let view = texture.create_view(&Default::default());
-    let pipeline = raster::scene_pipeline(gpu, "iasm.atlas", &compose_depth(ATLAS_WGSL), layouts, &[]);
+    let pipeline = raster::depth_pipeline(gpu, "iasm.atlas", &compose_depth(ATLAS_WGSL), layouts, has_cutouts);
     let eval_layout = view_layout(gpu, "iasm.eval_atlas", &[binding::uniform(), binding::texture_depth(), binding::storage(false)]);
     let eval = gpu.compute_pipeline("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout]);
     let eval_count = gpu.compute_pipeline_with("iasm.evaluate", &eval_atlas_src(), "main", &[&eval_layout], crate::context::COUNTING);

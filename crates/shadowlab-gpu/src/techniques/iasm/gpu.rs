@@ -12,7 +12,7 @@ use super::atlas::{make_atlas, Atlas};
 use super::chunks::chunk_bounds;
 use super::plan::{Plan, TileStats};
 use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, RENDER_WGSL};
-use crate::record::Recorder;
+use crate::record::{DelayedRead, Recorder};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
 use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
@@ -56,6 +56,8 @@ pub struct Iasm {
     eval_layout: wgpu::BindGroupLayout,
     eval: wgpu::ComputePipeline,
     eval_count: wgpu::ComputePipeline,
+    /// Delayed mode: the previous frame's statistics, read back without a stall.
+    delayed_read: DelayedRead,
     /// The parameters this frame was evaluated with (the analysis pass evaluates with them
     /// again; delayed mode has overwritten the buffer for the next frame by then).
     evaluated: Option<IasmParams>,
@@ -127,7 +129,7 @@ impl Iasm {
         let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
         let eval_count = gpu.compute_pipeline_with("iasm.evaluate", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
-        let atlas = (p.get_u32("store") == 1).then(|| make_atlas(gpu, &[&render_layout, &scene.layout])).transpose()?;
+        let atlas = (p.get_u32("store") == 1).then(|| make_atlas(gpu, &[&render_layout, &scene.layout], scene.has_cutouts)).transpose()?;
         Ok(Iasm {
             m: p.get("m") as f32,
             k: p.get("k") as f32,
@@ -160,6 +162,7 @@ impl Iasm {
             eval_layout,
             eval,
             eval_count,
+            delayed_read: DelayedRead::new(gpu, "iasm.delayed", (TILE_COUNT * 8 + 1) as u64 * 4),
             evaluated: None,
         })
     }
@@ -285,7 +288,11 @@ impl Technique for Iasm {
         } else {
             self.analyse(gpu, f, rec);
         }
-        let stats = self.read_stats(rec);
+        let stats = match self.delayed_read.take::<u32>(gpu, TILE_COUNT * 8 + 1).filter(|_| self.delayed && self.pending) {
+            Some(words) => TileStats::parse(&words),
+            // this frame's analysis (or, delayed, one whose frame has not finished): a sync
+            None => self.read_stats(rec),
+        };
         self.make_plan(stats);
         self.write_tiles(rec);
         self.evaluated = Some(self.params());
@@ -340,6 +347,7 @@ impl Technique for Iasm {
             // copied after the shadows)
             self.placement = self.current;
             self.analyse(gpu, f, rec);
+            self.delayed_read.record(rec, &self.stats_buf);
             self.analysed = self.current;
             self.pending = true;
         }

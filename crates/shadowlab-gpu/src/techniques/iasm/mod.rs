@@ -199,7 +199,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 001 (IASM thesis) chapter 3",
     lights: &["directional"],
     params: PARAMS,
-    stalls: "iasm.readback: the tile statistics are read back for the plan; with delayed=true they are the previous frame's, so the read waits on no work of this frame",
+    stalls: "iasm.readback: the tile statistics are read back for the plan; delayed=true plans with the previous frame's, read back without a stall (a sync only on the first frame, or when the previous frame has not finished)",
     needs: "",
     create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, p, light)?)),
 };

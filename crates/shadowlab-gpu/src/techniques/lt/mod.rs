@@ -300,7 +300,7 @@ pub const LT_INFO: TechniqueInfo = TechniqueInfo {
     lights: LIGHTS,
     params: LT_PARAMS,
     stalls: "",
-    needs: "9 storage buffers per shader stage (WebGPU default: 8)",
+    needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Lt)?)),
 };
 pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
@@ -312,7 +312,7 @@ pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
     lights: LIGHTS,
     params: LTT_PARAMS,
     stalls: "",
-    needs: "9 storage buffers per shader stage (WebGPU default: 8)",
+    needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Ltt)?)),
 };
 pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
@@ -324,6 +324,6 @@ pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
     lights: LIGHTS,
     params: HYBRID_PARAMS,
     stalls: "",
-    needs: "9 storage buffers per shader stage (WebGPU default: 8)",
+    needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::HybridPcf)?)),
 };

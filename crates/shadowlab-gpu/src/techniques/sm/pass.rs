@@ -47,7 +47,7 @@ impl DepthPass {
         let label = format!("{name}.depth");
         let layout = binding::layout(d, &label, wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let group = binding::group(d, &label, &layout, &[uniform.as_entire_binding()]);
-        let pipeline = raster::scene_pipeline(gpu, &label, &depth_source(), &[&layout, &scene.layout], &[]);
+        let pipeline = raster::depth_pipeline(gpu, &label, &depth_source(), &[&layout, &scene.layout], scene.has_cutouts);
         DepthPass { name, res, map, uniform, pipeline, group }
     }
 

@@ -73,7 +73,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     lights: &["directional", "spot", "point"],
     params: PARAMS,
     stalls: "",
-    needs: "optional: DEPTH_CLIP_CONTROL (unclipped depth for the infinite extrusion) and DEPTH32FLOAT_STENCIL8, used where offered",
+    needs: "12 storage buffers per shader stage (WebGPU default: 8); optional: DEPTH_CLIP_CONTROL (unclipped depth for the infinite extrusion) and DEPTH32FLOAT_STENCIL8, used where offered",
     create: |gpu, scene, p, light| Ok(Box::new(ShadowVolumes::new(gpu, scene, p, light)?)),
 };
 

@@ -83,7 +83,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     lights: LIGHTS,
     params: NOTW_OWN_PARAMS,
     stalls: "",
-    needs: "",
+    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Notw)?)),
 };
 
@@ -96,7 +96,7 @@ pub const RTW_INFO: TechniqueInfo = TechniqueInfo {
     lights: LIGHTS,
     params: RTW_PARAMS,
     stalls: "",
-    needs: "",
+    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Rtw)?)),
 };
 
@@ -109,7 +109,7 @@ pub const DV_INFO: TechniqueInfo = TechniqueInfo {
     lights: LIGHTS,
     params: DV_PARAMS,
     stalls: "",
-    needs: "",
+    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Dv)?)),
 };
 
