@@ -230,3 +230,36 @@ fn cube_notw_mix_1_spreads_more_and_beats_the_flatter_warp_on_the_room() {
     assert!(sn.used_texel_fraction > so.used_texel_fraction, "used texels {} vs {}", sn.used_texel_fraction, so.used_texel_fraction);
     assert!(w_new < w_old, "mix 1 {w_new:.3} % vs mix 2 {w_old:.3} %");
 }
+
+#[test]
+fn hardware_depth_faces_hold_the_same_distances_and_verdicts_as_distance_faces() {
+    // depth=hardware (reversed near/z, the distance recovered along the texel's centre ray)
+    // and depth=distance (the linear distance per fragment) store the same quantity, rounded
+    // differently
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, ROOM_POINT, 192);
+    let light = scene.lights[ROOM_POINT];
+    let mut faces = Vec::new();
+    let mut vis = Vec::new();
+    for s in ["cube:depth=distance,pcf=3", "cube:depth=hardware,pcf=3"] {
+        let (_, p) = techniques::resolve(&spec(s), Some(&light)).unwrap();
+        let mut cube = CubeMap::new(&gpu, &lab.gscene, &p, &light).unwrap();
+        submit_frame(&mut cube, &gpu, &v.inputs(&lab.gscene)).unwrap();
+        faces.push(cube.read_faces(&gpu));
+        vis.push(gpu.read_buffer_as::<f32>(&v.visibility, v.gbuffer.pixels()));
+    }
+    let (mut covered, mut worst) = (0, 0.0f32);
+    for (a, b) in faces[0].iter().flatten().zip(faces[1].iter().flatten()) {
+        assert_eq!(*a >= 1.0, *b >= 1.0, "the same texels are covered");
+        if *a < 1.0 {
+            covered += 1;
+            worst = worst.max((a - b).abs() / a);
+        }
+    }
+    assert!(covered > 1000, "{covered} texels covered");
+    assert!(worst < 1e-4, "relative distance difference {worst}");
+    let a = agreement(&vis[0], &vis[1], &v.mask);
+    assert!(a >= 99.99, "verdicts agree on {a:.4} % of the pixels");
+}

@@ -7,7 +7,7 @@ struct CubeFace {
     view_proj: mat4x4<f32>,
     // xyz: light position, w: far (distance that maps to depth 1)
     light: vec4<f32>,
-    // x: face index
+    // x: face index, y: near (f32 bits; depth=hardware)
     face: vec4<u32>,
 }
 
@@ -16,6 +16,10 @@ struct CubeFace {
 // False for the static triangles, drawn from per-face lists culled once on the CPU
 // (`cube::outside_face`); true for the moving ones, drawn whole into every face.
 override CULL_IN_VS: bool = true;
+// `depth=hardware`: no distance written per fragment; the rasteriser's depth is reversed,
+// near / z (z = the distance along the face's axis; face.y holds `near` as bits), so that the
+// evaluation recovers the distance along the texel's centre ray.
+override HW_DEPTH: bool = false;
 
 struct CubeVsOut {
     @builtin(position) clip: vec4<f32>,
@@ -32,6 +36,10 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> CubeVsOut {
     out.uv = o.uv;
     out.material = o.material;
     out.world = vertices[vi].pos;
+    if HW_DEPTH {
+        // clip.w is the distance along the face axis: NDC depth = near / w
+        out.clip.z = bitcast<f32>(cf.face.y);
+    }
     if !CULL_IN_VS {
         return out;
     }
@@ -57,4 +65,12 @@ fn fs_main(in: CubeVsOut) -> @builtin(frag_depth) f32 {
         discard;
     }
     return length(in.world - cf.light.xyz) / cf.light.w;
+}
+
+// `depth=hardware` on scenes with cut-outs: the test alone, the rasteriser writes the depth.
+@fragment
+fn fs_cut_out(in: CubeVsOut) {
+    if cut_out(materials[in.material], in.uv) {
+        discard;
+    }
 }

@@ -8,13 +8,28 @@
 struct CubeParams {
     // xyz: light position, w: far
     light: vec4<f32>,
-    // x: resolution per face, y: pcf kernel width
+    // x: resolution per face, y: pcf kernel width, z: near (depth=hardware)
     cfg: vec4<f32>,
     // x: constant bias, y: slope-scaled bias, z: normal offset (texels), w: max slope
     bias: vec4<f32>,
 }
 
 @group(0) @binding(6) var<uniform> cube: CubeParams;
+// `depth=hardware`: the faces hold near / z (reversed depth, 0 = empty); the occluder's
+// distance is z times the length of the texel's centre direction (whose axis component is 1).
+override HW_DEPTH: bool = false;
+
+fn stored_distance(g: u32, t: vec2<i32>, res: f32) -> f32 {
+    let v = textureLoad(faces, t, i32(g), 0);
+    if !HW_DEPTH {
+        return v;
+    }
+    if v <= 0.0 {
+        return 2.0;
+    }
+    let dc = cube_direction(g, (vec2<f32>(t) + 0.5) / res);
+    return cube.cfg.z / v * length(dc) / cube.light.w;
+}
 @group(0) @binding(7) var faces: texture_depth_2d_array;
 @group(0) @binding(8) var<storage, read_write> counts: array<atomic<u32>>;
 
@@ -50,7 +65,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             let dir = cube_direction(f, m + (vec2<f32>(f32(x), f32(y)) - half) / res);
             let g = cube_face(dir);
             let t = clamp(vec2<i32>(floor(cube_project(g, dir) * res)), vec2<i32>(0), vec2<i32>(ires - 1));
-            lit += select(0.0, 1.0, dist <= textureLoad(faces, t, i32(g), 0));
+            lit += select(0.0, 1.0, dist <= stored_distance(g, t, res));
         }
     }
     visibility[s.i] = lit / f32(k * k);

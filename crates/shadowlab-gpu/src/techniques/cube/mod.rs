@@ -50,11 +50,31 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 /// sm's parameters apply unchanged: `res` is per face (the seeds' 512), the bias is in texels of
 /// the face at the sample. sm's bias sweep was on directional/spot lights; see docs/bench/point.md
 /// for the point-light check.
-pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET];
+pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET, DEPTH];
+
+/// How a face stores depth. `distance` (0): the linear distance to the light written by the
+/// fragment stage (exact per fragment, but every fragment runs a shader and no early depth
+/// test). `hardware` (1): the rasteriser's reversed depth near / z, with no fragment stage
+/// where the scene has no cut-outs (as a GL depth pass with an empty fragment shader); the
+/// evaluation recovers the distance along the texel's centre ray (the same quantity, rounded
+/// differently). Default hardware: chosen on room light 1 and the courtyard lantern, checked on
+/// conference light 1 and sponza-peer (1024x1024; res 512, pcf 3, res 1024): the same wrong %
+/// to three decimals on all four, `cube.render` 3-8x faster (docs/bench/recorded_frame.md).
+pub const DEFAULT_DEPTH: f64 = 1.0;
+pub const DEPTH: ParamDef = ParamDef {
+    key: "depth",
+    default: DEFAULT_DEPTH,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    doc: "face depth: distance (linear distance per fragment: a fragment shader on every fragment) or hardware (reversed near/z from the rasteriser, no fragment stage without cut-outs; distance recovered in the evaluation)",
+    source: "distance: seed 002 3.3.1; hardware: the NoTW authors' app (depth-only faces); measured in docs/bench/recorded_frame.md",
+    choices: &["distance", "hardware"],
+};
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "cube",
-    summary: "cube shadow map for point lights: six 90-degree faces of linear light distance, seamless NxN PCF across face edges",
+    summary: "cube shadow map for point lights: six 90-degree faces (reversed hardware depth, or linear light distance), seamless NxN PCF across face edges",
     cost: "six depth passes over the scene (per-face triangle culling) + N^2 fetches per pixel; 6 res^2 x 4 bytes",
     quality: "as sm per face; the face the camera looks into gets all the view samples (seed 002 Fig. 5.6)",
     source: "seed 002 section 3.3.1 and chapter 5.3 (CubeSM)",
@@ -162,6 +182,7 @@ pub(crate) fn point_position(name: &str, light: &Light) -> Result<Vec3, GpuError
 pub struct CubeFace {
     pub view_proj: [[f32; 4]; 4],
     pub light: [f32; 4],
+    /// x: face index, y: near as f32 bits (depth=hardware).
     pub face: [u32; 4],
 }
 
@@ -177,6 +198,9 @@ pub struct CubeParams {
 /// A point light's cube shadow map: six layers of one Depth32Float array texture.
 pub struct CubeMap {
     res: u32,
+    near: f32,
+    /// `depth=hardware`: the faces hold reversed depth near / z.
+    hardware: bool,
     far: f32,
     pcf: u32,
     map: wgpu::Texture,
@@ -201,6 +225,7 @@ impl CubeMap {
         gpu.check_size(res, res, "cube face")?;
         let far = bounds_far(scene, pos);
         let near = (far * 1e-4).max(1e-5);
+        let hardware = p.get_u32("depth") == 1;
         let d = &gpu.device;
         let map = raster::depth_target(gpu, "cube.map", res, res, 6, wgpu::TextureUsages::empty());
         let face_layout = binding::layout(d, "cube.depth", wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
@@ -209,25 +234,19 @@ impl CubeMap {
                 let u = CubeFace {
                     view_proj: face_view_proj(pos, f, near, far).to_cols_array_2d(),
                     light: pos.extend(far).into(),
-                    face: [f as u32, 0, 0, 0],
+                    face: [f as u32, near.to_bits(), 0, 0],
                 };
                 let buf = gpu.uniform(&format!("cube.face{f}"), &u);
                 binding::group(d, "cube.depth", &face_layout, &[buf.as_entire_binding()])
             })
             .collect();
-        let depth_pipeline = raster::scene_pipeline(gpu, "cube.render", &depth_src(), &[&face_layout, &scene.layout], &[]);
-        let static_pipeline = raster::scene_pipeline_constants(
-            gpu,
-            "cube.render.static",
-            &depth_src(),
-            &[&face_layout, &scene.layout],
-            &[],
-            &[("CULL_IN_VS", 0.0)],
-        );
+        let layouts = [&face_layout, &scene.layout];
+        let depth_pipeline = face_pipeline(gpu, "cube.render", &layouts, hardware, true, scene.has_cutouts);
+        let static_pipeline = face_pipeline(gpu, "cube.render.static", &layouts, hardware, false, scene.has_cutouts);
         let face_indices = static_face_lists(gpu, scene, pos);
         let params = CubeParams {
             light: pos.extend(far).into(),
-            cfg: [res as f32, pcf as f32, 0.0, 0.0],
+            cfg: [res as f32, pcf as f32, near, 0.0],
             bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
         };
         let array = wgpu::BindingType::Texture {
@@ -236,11 +255,15 @@ impl CubeMap {
             multisampled: false,
         };
         let eval_layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
-        let eval_pipeline = gpu.compute_pipeline("cube.evaluate", &eval_src(), "main", &[&eval_layout]);
-        let count_pipeline = gpu.compute_pipeline_with("cube.evaluate", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
+        let hw = if hardware { 1.0 } else { 0.0 };
+        let eval_pipeline = gpu.compute_pipeline_with("cube.evaluate", &eval_src(), "main", &[&eval_layout], &[("HW_DEPTH", hw)]);
+        let count_pipeline =
+            gpu.compute_pipeline_with("cube.evaluate", &eval_src(), "main", &[&eval_layout], &[("HW_DEPTH", hw), ("COUNT_SAMPLES", 1.0)]);
         Ok(CubeMap {
             res,
             far,
+            near,
+            hardware,
             pcf,
             map,
             face_groups,
@@ -261,8 +284,20 @@ impl CubeMap {
     }
 
     /// The six faces (+x, -x, +y, -y, +z, -z), each `res x res` row-major: distance / far.
+    /// The faces as distance / far (1 = empty), whichever way they store depth.
     pub fn read_faces(&self, gpu: &Gpu) -> Vec<Vec<f32>> {
-        read_layers(gpu, &self.map)
+        let mut faces = read_layers(gpu, &self.map);
+        if self.hardware {
+            let res = self.res as usize;
+            for (f, face) in faces.iter_mut().enumerate() {
+                for (i, v) in face.iter_mut().enumerate() {
+                    let (x, y) = ((i % res) as f32 + 0.5, (i / res) as f32 + 0.5);
+                    let dc = shadowlab_core::cube::direction(f, x / res as f32, y / res as f32);
+                    *v = if *v <= 0.0 { 1.0 } else { (self.near / *v * dc.length() / self.far).min(1.0) };
+                }
+            }
+        }
+        faces
     }
 
     /// View samples per texel of the last evaluation, face after face.
@@ -309,9 +344,22 @@ impl Technique for CubeMap {
                 })
             })
             .collect();
+        // reversed depth clears to 0 (empty = farthest)
+        let clear = if self.hardware { 0.0 } else { 1.0 };
         rec.stage("cube.render", |enc| {
             for ((view, group), (indices, n)) in views.iter().zip(&self.face_groups).zip(&self.face_indices) {
-                let mut pass = raster::begin_pass(enc, "cube.render", &[], view);
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("cube.render"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view,
+                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
                 pass.set_bind_group(0, group, &[]);
                 pass.set_bind_group(1, &f.scene.group, &[]);
                 if *n > 0 {
@@ -404,4 +452,47 @@ fn static_face_lists(gpu: &Gpu, scene: &GpuScene, light: Vec3) -> Vec<(wgpu::Buf
             (gpu.buffer_init(&format!("cube.face{f}.indices"), bytemuck::cast_slice(&idx), wgpu::BufferUsages::INDEX), n)
         })
         .collect()
+}
+
+/// A face pipeline: `distance` writes the linear distance in the fragment stage (`fs_main`);
+/// `hardware` keeps the rasteriser's reversed depth (test `Greater`), with a fragment stage
+/// only for the cut-out test. `cull_in_vs`: the vertex stage's per-face test (moving triangles).
+fn face_pipeline(
+    gpu: &Gpu,
+    label: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    hardware: bool,
+    cull_in_vs: bool,
+    cutouts: bool,
+) -> wgpu::RenderPipeline {
+    let module = gpu.shader(label, &depth_src());
+    let constants = [("CULL_IN_VS", if cull_in_vs { 1.0 } else { 0.0 }), ("HW_DEPTH", if hardware { 1.0 } else { 0.0 })];
+    let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+    let fragment = match (hardware, cutouts) {
+        (false, _) => Some("fs_main"),
+        (true, true) => Some("fs_cut_out"),
+        (true, false) => None,
+    };
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&gpu.pipeline_layout(label, layouts)),
+        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: options.clone(), buffers: &[] },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: raster::DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(if hardware { wgpu::CompareFunction::Greater } else { wgpu::CompareFunction::Less }),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: fragment.map(|entry| wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: options,
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
