@@ -96,7 +96,30 @@ enum Command {
     },
 }
 
+/// Mesa's window-system code prints `error: XDG_RUNTIME_DIR is invalid or not set in the
+/// environment.` on every run where the variable is missing, which users read as shadowlab's
+/// error. shadowlab opens no window: a private runtime directory (0700, under the temporary
+/// directory) stands in for it, so that every `error:` line is shadowlab's own.
+fn ensure_runtime_dir() {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+        if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| !d.is_empty()) {
+            return;
+        }
+        let uid = std::fs::metadata("/proc/self").map(|m| m.uid()).unwrap_or(0);
+        let dir = std::env::temp_dir().join(format!("shadowlab-runtime-{uid}"));
+        let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        let ours = std::fs::metadata(&dir).is_ok_and(|m| m.is_dir() && m.uid() == uid && m.mode() & 0o077 == 0);
+        if ours {
+            // single-threaded here: nothing else reads the environment yet
+            std::env::set_var("XDG_RUNTIME_DIR", &dir);
+        }
+    }
+}
+
 fn main() {
+    ensure_runtime_dir();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Scenes => listing::scenes(),

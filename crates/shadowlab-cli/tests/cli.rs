@@ -300,3 +300,22 @@ fn moving_objects_move_with_the_frames_and_bad_animations_are_clear_errors() {
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&setup_dir);
 }
+
+#[test]
+fn no_stray_error_lines_without_xdg_runtime_dir() {
+    // Mesa complains on stderr when XDG_RUNTIME_DIR is unset; the binary sets a private one
+    if skip_gpu() {
+        return;
+    }
+    let out = tmp("xdg.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_shadowlab"))
+        .env_remove("XDG_RUNTIME_DIR")
+        .args(["render", "--scene", "planebox", "--size", "32x32", "-t", "sm", "--repeat", "1", "--quiet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "render failed: {err}");
+    assert!(!err.contains("error"), "stray error output: {err}");
+    let _ = std::fs::remove_file(&out);
+}
