@@ -9,12 +9,18 @@
 // discarded, and the rasteriser may test depth before shading (no overdraw shaded).
 override DISCARDS: bool = true;
 
+// The triangle's normal and material travel as flat varyings (every vertex of a triangle
+// stores the same face normal and material): read once per vertex, not once per fragment.
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) uv: vec2<f32>,
-    @location(2) @interpolate(flat) tri: u32,
+    @location(2) @interpolate(flat) normal: vec3<f32>,
     @location(3) prev_world: vec3<f32>,
+    @location(4) @interpolate(flat) base_color: vec4<f32>,
+    // tex_offset, tex_width, tex_height, flags
+    @location(5) @interpolate(flat) tex: vec4<u32>,
+    @location(6) @interpolate(flat) alpha_cutoff: f32,
 }
 
 @vertex
@@ -24,8 +30,12 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     o.clip = frame.view_proj * vec4<f32>(v.pos, 1.0);
     o.world = v.pos;
     o.uv = v.uv;
-    o.tri = vi / 3u;
+    o.normal = v.normal;
     o.prev_world = previous_position(vi);
+    let m = materials[v.material];
+    o.base_color = m.base_color;
+    o.tex = vec4<u32>(m.tex_offset, m.tex_width, m.tex_height, m.flags);
+    o.alpha_cutoff = m.alpha_cutoff;
     return o;
 }
 
@@ -38,12 +48,17 @@ struct GOut {
 
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> GOut {
-    let v = vertices[in.tri * 3u];
-    let m = materials[v.material];
+    var m: Material;
+    m.base_color = in.base_color;
+    m.tex_offset = in.tex.x;
+    m.tex_width = in.tex.y;
+    m.tex_height = in.tex.z;
+    m.flags = in.tex.w;
+    m.alpha_cutoff = in.alpha_cutoff;
     if DISCARDS && (cut_out(m, in.uv) || (!front && (m.flags & MAT_DOUBLE_SIDED) == 0u)) {
         discard;
     }
-    var n = v.normal;
+    var n = in.normal;
     if dot(n, frame.camera_pos.xyz - in.world) < 0.0 {
         n = -n;
     }
