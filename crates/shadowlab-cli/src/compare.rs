@@ -44,6 +44,8 @@ pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
 pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
     anyhow::ensure!(args.frames >= 1, "--frames must be at least 1");
     let cfg = resolve(args, BASELINE)?;
+    // before any work: never replace what shadowlab did not write
+    crate::output::check_target(out)?;
     let t_start = std::time::Instant::now();
     let gpu = Gpu::new()?;
     let frames = args.frames.max(1);

@@ -1,9 +1,33 @@
 //! Outputs are written under a temporary name and renamed into place, so an interrupted run
-//! never leaves a half-written report.
+//! never leaves a half-written report. An existing `--out` is replaced only if shadowlab wrote
+//! it (its [`MARKER`] file is there) or it is an empty directory; anything else is refused
+//! before any work, and nothing is touched.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+
+/// The file every output directory of shadowlab holds: the proof that replacing it loses
+/// nothing of the user's.
+pub const MARKER: &str = ".shadowlab-output";
+
+/// Whether `target` may be (re)written as an output directory: absent, an empty directory, or
+/// one shadowlab wrote. Otherwise one line naming the path and what to do.
+pub fn check_target(target: &Path) -> Result<()> {
+    let Ok(meta) = std::fs::symlink_metadata(target) else { return Ok(()) };
+    let shown = target.display();
+    if !meta.is_dir() {
+        anyhow::bail!("--out {shown} exists and is not a directory; choose another path or remove it");
+    }
+    if target.join(MARKER).is_file() {
+        return Ok(());
+    }
+    let empty = std::fs::read_dir(target).with_context(|| format!("reading {shown}"))?.next().is_none();
+    if !empty {
+        anyhow::bail!("--out {shown} is a directory that shadowlab did not write (no {MARKER} in it); choose a new or empty directory, or remove it yourself");
+    }
+    Ok(())
+}
 
 /// A directory being written; [`StagedDir::commit`] moves it to its final name.
 pub struct StagedDir {
@@ -14,6 +38,7 @@ pub struct StagedDir {
 
 impl StagedDir {
     pub fn new(target: &Path) -> Result<StagedDir> {
+        check_target(target)?;
         let name = target.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_else(|| "report".into());
         let parent = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
         std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
@@ -21,6 +46,8 @@ impl StagedDir {
         let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&tmp);
         std::fs::create_dir_all(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+        std::fs::write(tmp.join(MARKER), concat!("written by shadowlab ", env!("CARGO_PKG_VERSION"), "\n"))
+            .with_context(|| format!("writing {}", tmp.display()))?;
         Ok(StagedDir { tmp, target: target.to_path_buf(), done: false })
     }
 
@@ -30,6 +57,8 @@ impl StagedDir {
 
     /// Replaces the target with the staged directory.
     pub fn commit(mut self) -> Result<PathBuf> {
+        // checked again: something may have appeared there during the run
+        check_target(&self.target)?;
         if self.target.exists() {
             let old = self.tmp.with_extension("old");
             std::fs::rename(&self.target, &old).with_context(|| format!("moving the old {} aside", self.target.display()))?;
@@ -89,6 +118,7 @@ mod tests {
         let target = root.join("report");
         std::fs::create_dir_all(&target).unwrap();
         std::fs::write(target.join("old.txt"), "old").unwrap();
+        std::fs::write(target.join(MARKER), "written by shadowlab").unwrap();
         let stale = root.join(".report.partial-4000000000");
         std::fs::create_dir_all(&stale).unwrap();
         let staged = StagedDir::new(&target).unwrap();
@@ -103,6 +133,46 @@ mod tests {
         drop(staged);
         assert!(!target.join("half.txt").exists());
         assert_eq!(std::fs::read_dir(&root).unwrap().count(), 1);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn outputs_never_replace_what_shadowlab_did_not_write() {
+        let root = std::env::temp_dir().join(format!("shadowlab-safety-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        std::fs::create_dir_all(&root).unwrap();
+        // a directory of the user's: refused, untouched
+        let mine = root.join("mine");
+        std::fs::create_dir_all(&mine).unwrap();
+        std::fs::write(mine.join("thesis.tex"), "years of work").unwrap();
+        let e = StagedDir::new(&mine).err().expect("refused").to_string();
+        assert!(e.contains("did not write") && e.contains("mine"), "{e}");
+        assert_eq!(std::fs::read_to_string(mine.join("thesis.tex")).unwrap(), "years of work");
+        assert_eq!(std::fs::read_dir(&root).unwrap().count(), 1, "nothing staged beside it");
+        // a file: refused, untouched
+        let file = root.join("notes.txt");
+        std::fs::write(&file, "keep").unwrap();
+        let e = StagedDir::new(&file).err().expect("refused").to_string();
+        assert!(e.contains("not a directory"), "{e}");
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep");
+        // an empty directory: used, and marked
+        let empty = root.join("empty");
+        std::fs::create_dir_all(&empty).unwrap();
+        let staged = StagedDir::new(&empty).unwrap();
+        std::fs::write(staged.path("index.html"), "r").unwrap();
+        staged.commit().unwrap();
+        assert!(empty.join(MARKER).is_file() && empty.join("index.html").is_file());
+        // shadowlab's own output: replaced
+        let staged = StagedDir::new(&empty).unwrap();
+        staged.commit().unwrap();
+        assert!(!empty.join("index.html").exists() && empty.join(MARKER).is_file());
+        // something of the user's that appeared during the run: the commit refuses
+        let late = root.join("late");
+        let staged = StagedDir::new(&late).unwrap();
+        std::fs::create_dir_all(&late).unwrap();
+        std::fs::write(late.join("x"), "user").unwrap();
+        assert!(staged.commit().is_err());
+        assert_eq!(std::fs::read_to_string(late.join("x")).unwrap(), "user");
         std::fs::remove_dir_all(&root).unwrap();
     }
 

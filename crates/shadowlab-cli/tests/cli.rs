@@ -319,3 +319,30 @@ fn no_stray_error_lines_without_xdg_runtime_dir() {
     assert!(!err.contains("error"), "stray error output: {err}");
     let _ = std::fs::remove_file(&out);
 }
+
+#[test]
+fn out_refuses_a_directory_or_file_shadowlab_did_not_write() {
+    // refused before any GPU work, so this runs without an adapter too
+    let dir = tmp("users-dir");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("mine.txt"), "keep me").unwrap();
+    let file = tmp("users-file");
+    std::fs::write(&file, "keep me too").unwrap();
+    for (out, needle) in [(&dir, "did not write"), (&file, "not a directory")] {
+        let o = run(&["compare", "--scene", "planebox", "--size", "16x16", "-t", "sm", "-q", "--out", out.to_str().unwrap()]);
+        assert_clean_error(&o, needle);
+        assert_eq!(String::from_utf8_lossy(&o.stderr).lines().filter(|l| l.contains("error")).count(), 1, "one error line");
+    }
+    assert_eq!(std::fs::read_to_string(dir.join("mine.txt")).unwrap(), "keep me");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep me too");
+    assert_eq!(
+        std::fs::read_dir(dir.parent().unwrap())
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().contains("users-dir.partial"))
+            .count(),
+        0
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_file(&file).unwrap();
+}
