@@ -269,7 +269,7 @@ impl DelayedRead {
     pub fn record(&mut self, rec: &mut Recorder, src: &wgpu::Buffer) {
         if self.pending {
             // the last copy was never taken: drop it (its mapping may still be in flight)
-            let _ = self.take_ready::<u32>(rec.gpu(), 0);
+            let _ = self.take::<u32>(rec.gpu(), 0);
             if self.pending {
                 return;
             }
@@ -290,10 +290,6 @@ impl DelayedRead {
     /// The last recorded copy's first `count` values, if its frame has finished on the GPU
     /// (polls without waiting); None if nothing was recorded or it is not done yet.
     pub fn take<T: bytemuck::Pod>(&mut self, gpu: &Gpu, count: usize) -> Option<Vec<T>> {
-        self.take_ready(gpu, count)
-    }
-
-    fn take_ready<T: bytemuck::Pod>(&mut self, gpu: &Gpu, count: usize) -> Option<Vec<T>> {
         if !self.pending {
             return None;
         }

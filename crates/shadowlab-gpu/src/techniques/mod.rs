@@ -79,6 +79,46 @@ impl FrameInputs<'_> {
     }
 }
 
+/// A technique's evaluation and its analysis variant: the same shader compiled twice, once as
+/// shipped and once with `COUNT_SAMPLES` (the view samples counted per texel, lab only).
+pub struct EvalPipelines {
+    timed: wgpu::ComputePipeline,
+    counting: wgpu::ComputePipeline,
+}
+
+impl EvalPipelines {
+    /// Both pipelines of `source`'s `main` over `layout`, with `constants` (and `COUNT_SAMPLES`).
+    pub fn new(gpu: &Gpu, label: &str, source: &str, layout: &wgpu::BindGroupLayout, constants: &[(&str, f64)]) -> EvalPipelines {
+        let timed = gpu.compute_pipeline_with(label, source, "main", &[layout], constants);
+        let mut with_counts = constants.to_vec();
+        with_counts.extend_from_slice(crate::context::COUNTING);
+        let counting = gpu.compute_pipeline_with(label, source, "main", &[layout], &with_counts);
+        EvalPipelines { timed, counting }
+    }
+
+    /// Records the evaluation over the `w x h` view as stage `stage`; with `counting`, the
+    /// analysis variant after clearing `counts`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        rec: &mut Recorder,
+        stage: &str,
+        counts: &wgpu::Buffer,
+        group: &wgpu::BindGroup,
+        w: u32,
+        h: u32,
+        counting: bool,
+    ) {
+        rec.stage(stage, |enc| {
+            if counting {
+                enc.clear_buffer(counts, 0, None);
+            }
+            gpu.dispatch_2d(enc, stage, if counting { &self.counting } else { &self.timed }, &[group], w, h)
+        });
+    }
+}
+
 /// An RGBA8 picture a technique offers the report (shadow maps, count maps, warps).
 #[derive(Clone, Debug)]
 pub struct NamedImage {

@@ -95,9 +95,8 @@ pub struct Cascaded {
     depth_uniforms: Vec<wgpu::Buffer>,
     depth_groups: Vec<wgpu::BindGroup>,
     depth_pipeline: wgpu::RenderPipeline,
-    eval_pipeline: wgpu::ComputePipeline,
-    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
-    count_pipeline: wgpu::ComputePipeline,
+    /// The evaluation and its analysis variant.
+    eval: crate::techniques::EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     reduce: MinMax,
@@ -147,9 +146,7 @@ impl Cascaded {
             "csm.eval",
             &[binding::uniform(), texture_depth_array(), binding::comparison_sampler(), binding::storage(false), binding::storage(false)],
         );
-        let eval_pipeline = gpu.compute_pipeline("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout]);
-        let count_pipeline =
-            gpu.compute_pipeline_with("csm.eval", &compose_view(EVAL_WGSL, false), "main", &[&eval_layout], crate::context::COUNTING);
+        let eval = crate::techniques::EvalPipelines::new(gpu, "csm.eval", &compose_view(EVAL_WGSL, false), &eval_layout, &[]);
         let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {
@@ -173,8 +170,7 @@ impl Cascaded {
             depth_uniforms,
             depth_groups,
             depth_pipeline,
-            eval_pipeline,
-            count_pipeline,
+            eval,
             eval_layout,
             sampler,
             reduce: MinMax::new(gpu, "csm.reduce", 3),
@@ -288,12 +284,7 @@ impl Cascaded {
                 chosen.as_entire_binding(),
             ],
         );
-        rec.stage("csm.evaluate", |enc| {
-            if counting {
-                enc.clear_buffer(&self.counts, 0, None);
-            }
-            gpu.dispatch_2d(enc, "csm.evaluate", if counting { &self.count_pipeline } else { &self.eval_pipeline }, &[&group], w, h)
-        });
+        self.eval.record(gpu, rec, "csm.evaluate", &self.counts, &group, w, h, counting);
         Ok(())
     }
 }

@@ -213,9 +213,8 @@ pub struct CubeMap {
     params: wgpu::Buffer,
     counts: wgpu::Buffer,
     eval_layout: wgpu::BindGroupLayout,
-    eval_pipeline: wgpu::ComputePipeline,
-    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
-    count_pipeline: wgpu::ComputePipeline,
+    /// The evaluation and its analysis variant.
+    eval: crate::techniques::EvalPipelines,
 }
 
 impl CubeMap {
@@ -241,8 +240,9 @@ impl CubeMap {
             })
             .collect();
         let layouts = [&face_layout, &scene.layout];
-        let depth_pipeline = face_pipeline(gpu, "cube.render", &layouts, hardware, true, scene.has_cutouts);
-        let static_pipeline = face_pipeline(gpu, "cube.render.static", &layouts, hardware, false, scene.has_cutouts);
+        let module = gpu.shader("cube.render", &depth_src());
+        let depth_pipeline = face_pipeline(gpu, &module, "cube.render", &layouts, hardware, true, scene.has_cutouts);
+        let static_pipeline = face_pipeline(gpu, &module, "cube.render.static", &layouts, hardware, false, scene.has_cutouts);
         let face_indices = static_face_lists(gpu, scene, pos);
         let params = CubeParams {
             light: pos.extend(far).into(),
@@ -256,9 +256,7 @@ impl CubeMap {
         };
         let eval_layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
         let hw = if hardware { 1.0 } else { 0.0 };
-        let eval_pipeline = gpu.compute_pipeline_with("cube.evaluate", &eval_src(), "main", &[&eval_layout], &[("HW_DEPTH", hw)]);
-        let count_pipeline =
-            gpu.compute_pipeline_with("cube.evaluate", &eval_src(), "main", &[&eval_layout], &[("HW_DEPTH", hw), ("COUNT_SAMPLES", 1.0)]);
+        let eval = crate::techniques::EvalPipelines::new(gpu, "cube.evaluate", &eval_src(), &eval_layout, &[("HW_DEPTH", hw)]);
         Ok(CubeMap {
             res,
             far,
@@ -273,8 +271,7 @@ impl CubeMap {
             params: gpu.uniform("cube.params", &params),
             counts: gpu.storage("cube.counts", 6 * res as u64 * res as u64 * 4),
             eval_layout,
-            eval_pipeline,
-            count_pipeline,
+            eval,
         })
     }
 
@@ -417,19 +414,7 @@ impl CubeMap {
             &self.eval_layout,
             &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), self.counts.as_entire_binding()],
         );
-        rec.stage("cube.evaluate", |enc| {
-            if counting {
-                enc.clear_buffer(&self.counts, 0, None);
-            }
-            gpu.dispatch_2d(
-                enc,
-                "cube.evaluate",
-                if counting { &self.count_pipeline } else { &self.eval_pipeline },
-                &[&group],
-                f.gbuffer.width,
-                f.gbuffer.height,
-            )
-        });
+        self.eval.record(gpu, rec, "cube.evaluate", &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
         Ok(())
     }
 }
@@ -459,13 +444,13 @@ fn static_face_lists(gpu: &Gpu, scene: &GpuScene, light: Vec3) -> Vec<(wgpu::Buf
 /// only for the cut-out test. `cull_in_vs`: the vertex stage's per-face test (moving triangles).
 fn face_pipeline(
     gpu: &Gpu,
+    module: &wgpu::ShaderModule,
     label: &str,
     layouts: &[&wgpu::BindGroupLayout],
     hardware: bool,
     cull_in_vs: bool,
     cutouts: bool,
 ) -> wgpu::RenderPipeline {
-    let module = gpu.shader(label, &depth_src());
     let constants = [("CULL_IN_VS", if cull_in_vs { 1.0 } else { 0.0 }), ("HW_DEPTH", if hardware { 1.0 } else { 0.0 })];
     let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     let fragment = match (hardware, cutouts) {
@@ -476,7 +461,7 @@ fn face_pipeline(
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&gpu.pipeline_layout(label, layouts)),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: options.clone(), buffers: &[] },
+        vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: options.clone(), buffers: &[] },
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: raster::DEPTH_FORMAT,

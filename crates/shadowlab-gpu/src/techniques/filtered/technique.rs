@@ -31,9 +31,8 @@ pub struct Filtered {
     uniform: wgpu::Buffer,
     render_pipeline: wgpu::RenderPipeline,
     render_group: wgpu::BindGroup,
-    eval_pipeline: wgpu::ComputePipeline,
-    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
-    count_pipeline: wgpu::ComputePipeline,
+    /// The evaluation and its analysis variant.
+    eval: crate::techniques::EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -116,9 +115,7 @@ impl Filtered {
             &format!("{name}.eval"),
             &[binding::uniform(), binding::texture_float(), sampler_type, binding::storage(false)],
         );
-        let eval_pipeline = gpu.compute_pipeline(&format!("{name}.evaluate"), &eval_source(), "main", &[&eval_layout]);
-        let count_pipeline =
-            gpu.compute_pipeline_with(&format!("{name}.evaluate"), &eval_source(), "main", &[&eval_layout], crate::context::COUNTING);
+        let eval = crate::techniques::EvalPipelines::new(gpu, &format!("{name}.evaluate"), &eval_source(), &eval_layout, &[]);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("filtered.gather"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -141,8 +138,7 @@ impl Filtered {
             uniform,
             render_pipeline,
             render_group,
-            eval_pipeline,
-            count_pipeline,
+            eval,
             eval_layout,
             sampler,
         })
@@ -246,19 +242,7 @@ impl Filtered {
             ],
         );
         let label = format!("{name}.evaluate");
-        rec.stage(&label, |enc| {
-            if counting {
-                enc.clear_buffer(&self.counts, 0, None);
-            }
-            gpu.dispatch_2d(
-                enc,
-                &label,
-                if counting { &self.count_pipeline } else { &self.eval_pipeline },
-                &[&group],
-                f.gbuffer.width,
-                f.gbuffer.height,
-            )
-        });
+        self.eval.record(gpu, rec, &label, &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
         Ok(())
     }
 }

@@ -183,9 +183,8 @@ pub struct MultiDepthMap {
     uniform: wgpu::Buffer,
     select_pipeline: wgpu::ComputePipeline,
     select_group: wgpu::BindGroup,
-    eval_pipeline: wgpu::ComputePipeline,
-    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
-    count_pipeline: wgpu::ComputePipeline,
+    /// The evaluation and its analysis variant.
+    eval: crate::techniques::EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
 }
 
@@ -243,24 +242,9 @@ impl MultiDepthMap {
         );
         let select_pipeline = gpu.compute_pipeline("mdsm.select", &compose(SELECT_WGSL, false), "main", &[&select_layout]);
         let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
-        let eval_pipeline = gpu.compute_pipeline("mdsm.eval", &eval_src(), "main", &[&eval_layout]);
-        let count_pipeline = gpu.compute_pipeline_with("mdsm.eval", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
+        let eval = crate::techniques::EvalPipelines::new(gpu, "mdsm.eval", &eval_src(), &eval_layout, &[]);
         let counts = gpu.storage("mdsm.counts", res as u64 * res as u64 * 4);
-        Ok(MultiDepthMap {
-            res,
-            k,
-            n,
-            params,
-            depth,
-            nsm,
-            counts,
-            uniform,
-            select_pipeline,
-            select_group,
-            eval_pipeline,
-            count_pipeline,
-            eval_layout,
-        })
+        Ok(MultiDepthMap { res, k, n, params, depth, nsm, counts, uniform, select_pipeline, select_group, eval, eval_layout })
     }
 
     /// The uniform as uploaded (projection, bias, selection settings).
@@ -324,19 +308,7 @@ impl MultiDepthMap {
             &self.eval_layout,
             &[self.uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&nsm_view), self.counts.as_entire_binding()],
         );
-        rec.stage("mdsm.evaluate", |enc| {
-            if counting {
-                enc.clear_buffer(&self.counts, 0, None);
-            }
-            gpu.dispatch_2d(
-                enc,
-                "mdsm.evaluate",
-                if counting { &self.count_pipeline } else { &self.eval_pipeline },
-                &[&group],
-                f.gbuffer.width,
-                f.gbuffer.height,
-            )
-        });
+        self.eval.record(gpu, rec, "mdsm.evaluate", &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
         Ok(())
     }
 }

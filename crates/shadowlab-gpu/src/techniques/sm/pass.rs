@@ -9,10 +9,9 @@ use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::ParamValues;
 
 use super::{count_image, depth_image, depth_source, eval_source, SmParams};
-use crate::context::COUNTING;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::techniques::{view_layout, FrameInputs, TechniqueReport};
+use crate::techniques::{view_layout, EvalPipelines, FrameInputs, TechniqueReport};
 use crate::{binding, raster, Gpu};
 
 impl SmParams {
@@ -82,9 +81,8 @@ pub struct MapPass {
     pub pcf: u32,
     pub params: SmParams,
     counts: wgpu::Buffer,
-    eval_pipeline: wgpu::ComputePipeline,
-    /// The same evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
-    count_pipeline: wgpu::ComputePipeline,
+    /// The evaluation and its analysis variant.
+    eval: EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -102,11 +100,10 @@ impl MapPass {
             &label,
             &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
         );
-        let eval_pipeline = gpu.compute_pipeline(&label, &eval_source(), "main", &[&eval_layout]);
-        let count_pipeline = gpu.compute_pipeline_with(&label, &eval_source(), "main", &[&eval_layout], COUNTING);
+        let eval = EvalPipelines::new(gpu, &label, &eval_source(), &eval_layout, &[]);
         let sampler = raster::comparison_sampler(gpu, &format!("{name}.cmp"));
         let counts = gpu.storage(&format!("{name}.counts"), res as u64 * res as u64 * 4);
-        MapPass { depth, pcf, params, counts, eval_pipeline, count_pipeline, eval_layout, sampler }
+        MapPass { depth, pcf, params, counts, eval, eval_layout, sampler }
     }
 
     pub fn res(&self) -> u32 {
@@ -145,17 +142,14 @@ impl MapPass {
     pub fn evaluate(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let group = self.eval_group(gpu, f);
         let stage = format!("{}.evaluate", self.depth.name);
-        rec.stage(&stage, |enc| gpu.dispatch_2d(enc, &stage, &self.eval_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height));
+        self.eval.record(gpu, rec, &stage, &self.counts, &group, f.gbuffer.width, f.gbuffer.height, false);
     }
 
     /// The lab's analysis: the evaluation again with the view samples counted per texel.
     pub fn analyze(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let group = self.eval_group(gpu, f);
         let stage = format!("{}.analysis", self.depth.name);
-        rec.stage(&stage, |enc| {
-            enc.clear_buffer(&self.counts, 0, None);
-            gpu.dispatch_2d(enc, &stage, &self.count_pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
-        });
+        self.eval.record(gpu, rec, &stage, &self.counts, &group, f.gbuffer.width, f.gbuffer.height, true);
     }
 
     /// `sm`'s report (memory, sampling, fetches, texels, depth and count pictures) and the

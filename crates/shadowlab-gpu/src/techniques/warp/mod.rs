@@ -179,9 +179,8 @@ pub struct Warped {
     /// split_root, split_args, split_level, draw_args.
     split: [wgpu::ComputePipeline; 4],
     eval_layout: wgpu::BindGroupLayout,
-    eval_pipeline: wgpu::ComputePipeline,
-    /// The evaluation with `COUNT_SAMPLES` (the lab's analysis pass).
-    count_pipeline: wgpu::ComputePipeline,
+    /// The evaluation and its analysis variant.
+    eval: crate::techniques::EvalPipelines,
     sampler: wgpu::Sampler,
 }
 
@@ -396,9 +395,7 @@ impl Warped {
             &format!("{name}.final_pass"),
             &[binding::uniform(), ro, tex, tex, binding::texture_depth(), binding::comparison_sampler(), rw],
         );
-        let eval_pipeline = gpu.compute_pipeline(&format!("{name}.final_pass"), &eval_src(), "main", &[&eval_layout]);
-        let count_pipeline =
-            gpu.compute_pipeline_with(&format!("{name}.final_pass"), &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
+        let eval = crate::techniques::EvalPipelines::new(gpu, &format!("{name}.final_pass"), &eval_src(), &eval_layout, &[]);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("warp.cmp"),
             compare: Some(wgpu::CompareFunction::LessEqual),
@@ -441,8 +438,7 @@ impl Warped {
             split_layout,
             split,
             eval_layout,
-            eval_pipeline,
-            count_pipeline,
+            eval,
             sampler,
         })
     }

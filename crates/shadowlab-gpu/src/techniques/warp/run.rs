@@ -309,19 +309,7 @@ impl Warped {
             self.counts.as_entire_binding(),
         ]);
         let group = f.view_group(gpu, &format!("{name}.final_pass"), &self.eval_layout, &extra);
-        rec.stage(&format!("{name}.final_pass"), |enc| {
-            if counting {
-                enc.clear_buffer(&self.counts, 0, None);
-            }
-            gpu.dispatch_2d(
-                enc,
-                &format!("{name}.final_pass"),
-                if counting { &self.count_pipeline } else { &self.eval_pipeline },
-                &[&group],
-                f.gbuffer.width,
-                f.gbuffer.height,
-            )
-        });
+        self.eval.record(gpu, rec, &format!("{name}.final_pass"), &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
         Ok(())
     }
 }
