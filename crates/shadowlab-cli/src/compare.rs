@@ -9,7 +9,7 @@ use shadowlab_core::metrics::{edge_pixels, error_image};
 use shadowlab_gpu::lab::{Lab, Run};
 use shadowlab_gpu::Gpu;
 
-use crate::config::{resolve, RunConfig, BASELINE};
+use crate::config::{resolve, RunConfig};
 use crate::frames::{summarize, ReferenceFrame};
 use crate::output::{slug, StagedDir};
 use crate::{export, report, RunArgs};
@@ -25,13 +25,13 @@ fn progress(quiet: bool, len: u64) -> ProgressBar {
 
 pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
     anyhow::ensure!(args.frames == 1, "render draws one view; use compare --frames {} for a camera path", args.frames);
-    let cfg = resolve(args, &["rt"])?;
+    let cfg = resolve(args, &["rt".to_string()])?;
     anyhow::ensure!(cfg.specs.len() == 1, "render takes one technique (got {}); use compare for several", cfg.specs.len());
     let gpu = Gpu::new()?;
     let lab = Lab::new(&gpu, &cfg.scene)?;
     lab.set_time(cfg.time, cfg.time)?;
     let view = lab.view(&cfg.camera, &cfg.camera, cfg.light(), cfg.width, cfg.height)?;
-    let run = lab.run(&view, &cfg.specs[0], args.repeat)?;
+    let run = lab.run_resolved(&view, &cfg.specs[0], args.repeat)?;
     let tmp = out.with_extension("partial.png");
     export::png(&tmp, cfg.width, cfg.height, &run.shaded)?;
     std::fs::rename(&tmp, out)?;
@@ -43,7 +43,7 @@ pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
 
 pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
     anyhow::ensure!(args.frames >= 1, "--frames must be at least 1");
-    let cfg = resolve(args, BASELINE)?;
+    let cfg = resolve(args, &shadowlab_gpu::registry::default_compare())?;
     // before any work: never replace what shadowlab did not write
     crate::output::check_target(out)?;
     let t_start = std::time::Instant::now();

@@ -11,34 +11,9 @@ use shadowlab_core::loaders::{self, SceneTransform};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
 use shadowlab_core::setup::{SceneSource, Setup};
+use shadowlab_gpu::registry::{self, Resolved};
 
 use crate::RunArgs;
-
-/// Techniques `compare` runs when neither the setup nor `-t` names any: one of each family at
-/// its defaults (those that do not support the run's light type are left out).
-pub const BASELINE: &[&str] = &[
-    "sm",
-    "sm:pcf=3",
-    "sv",
-    "rtw",
-    "notw",
-    "notw-dv",
-    "min-sm",
-    "mdsm",
-    "vsm",
-    "evsm",
-    "msm",
-    "evsm:sd=true",
-    "csm",
-    "iasm",
-    "cube",
-    "cube-notw",
-    "dpsm",
-    "dpsm-notw",
-    "lt",
-    "ltt",
-    "hybrid-pcf",
-];
 
 pub struct RunConfig {
     pub scene: Scene,
@@ -51,7 +26,8 @@ pub struct RunConfig {
     pub light_index: usize,
     pub width: u32,
     pub height: u32,
-    pub specs: Vec<TechniqueSpec>,
+    /// Each spec resolved once against the registry (and checked against the light).
+    pub specs: Vec<Resolved>,
     /// Animation time of frame 0 (`--time`, frames).
     pub time: f32,
 }
@@ -101,7 +77,9 @@ fn scene_arg(s: &str) -> SceneSource {
     }
 }
 
-pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
+/// Resolves a run; without techniques from `-t` or the setup it runs `default_specs`
+/// (the registry's default compare set leaves out what the light cannot use).
+pub fn resolve(args: &RunArgs, default_specs: &[String]) -> Result<RunConfig> {
     let setup = match &args.setup {
         Some(p) => Setup::load(p).map_err(|e| anyhow!(e))?,
         None => Setup::default(),
@@ -117,16 +95,18 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
     } else if !setup.techniques.is_empty() {
         setup.techniques.iter().map(|t| t.spec.clone()).collect()
     } else {
-        default_specs.iter().map(|s| s.to_string()).collect()
+        default_specs.to_vec()
     };
-    let specs = specs_text.iter().map(|s| TechniqueSpec::parse(s).map_err(|e| anyhow!(e))).collect::<Result<Vec<_>>>()?;
+    let mut specs = Vec::new();
     let mut labels = std::collections::HashSet::new();
-    for s in &specs {
+    for text in &specs_text {
         // names and parameters are checked before a (possibly large) scene is loaded
-        shadowlab_gpu::techniques::resolve(s, None)?;
-        if !labels.insert(s.label()) {
-            bail!("two techniques share the label '{}'; give one `label=...`", s.label());
+        let spec = TechniqueSpec::parse(text).map_err(|e| anyhow!(e))?;
+        let r = registry::resolve(&spec, None)?;
+        if !labels.insert(r.label.clone()) {
+            bail!("two techniques share the label '{}'; give one `label=...`", r.label);
         }
+        specs.push(r);
     }
     let (width, height) = match &args.size {
         Some(s) => parse_size(s)?,
@@ -151,11 +131,13 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
     if args.light >= lights.len() {
         bail!("--light {}: the run has {} light(s)", args.light, lights.len());
     }
-    let mut specs = specs;
+    let light = &lights[args.light];
     if defaults {
-        // the default list skips what the light cannot use; named techniques are checked below
-        let light = &lights[args.light];
-        specs.retain(|s| shadowlab_gpu::techniques::resolve(s, Some(light)).is_ok());
+        // the default list skips what the light cannot use; named techniques must support it
+        specs.retain(|s| s.check_light(light).is_ok());
+    }
+    for s in &specs {
+        s.check_light(light)?;
     }
     let cfg = RunConfig {
         source: match &source {
@@ -172,8 +154,5 @@ pub fn resolve(args: &RunArgs, default_specs: &[&str]) -> Result<RunConfig> {
         specs,
         time: args.time,
     };
-    for s in &cfg.specs {
-        shadowlab_gpu::techniques::resolve(s, Some(cfg.light()))?;
-    }
     Ok(cfg)
 }

@@ -79,11 +79,10 @@ pub fn run(lab: &Lab, cfg: &RunConfig, frames: usize, repeat: usize, pb: &Progre
     let cameras = if frames == 1 { vec![cfg.camera] } else { path_cameras(&cfg.camera, &cfg.camera_path, frames) };
     let (warm_up, timed) = if frames == 1 { (true, repeat) } else { (false, 1) };
     let light = cfg.light();
-    let mut rt_inst = lab.instantiate(&shadowlab_gpu::reference::INFO, Default::default(), "rt".into(), light)?;
+    let mut rt_inst = lab.instantiate(&shadowlab_gpu::registry::reference(), light)?;
     let mut insts: Vec<Instance> = Vec::new();
     for spec in &cfg.specs {
-        let (info, params) = shadowlab_gpu::techniques::resolve(spec, Some(light))?;
-        insts.push(lab.instantiate(info, params, spec.label(), light).with_context(|| format!("technique '{}'", spec.label()))?);
+        insts.push(lab.instantiate(spec, light).with_context(|| format!("technique '{}'", spec.label))?);
     }
     let mut reference = Vec::new();
     let mut records: Vec<Vec<FrameRecord>> = vec![Vec::new(); insts.len()];

@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use shadowlab_core::builtin::{BUILTIN_SCENES, DEFAULT_SCENE};
-use shadowlab_gpu::techniques::REGISTRY;
+use shadowlab_gpu::registry::REGISTRY;
 
 pub fn scenes() -> Result<()> {
     println!("Built-in scenes (no files needed):");

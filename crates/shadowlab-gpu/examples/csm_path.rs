@@ -16,7 +16,7 @@ use shadowlab_core::camera::{path_cameras, Camera, CameraKey};
 use shadowlab_core::metrics::{compare, flicker_pct};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
-use shadowlab_gpu::techniques;
+use shadowlab_gpu::registry;
 use shadowlab_gpu::Gpu;
 
 const DEFAULT_SPECS: &[&str] = &[
@@ -62,8 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut insts = Vec::new();
     for s in &specs {
         let spec = TechniqueSpec::parse(s)?;
-        let (info, params) = techniques::resolve(&spec, Some(&light))?;
-        insts.push(lab.instantiate(info, params, spec.label(), &light)?);
+        insts.push(lab.instantiate(&registry::resolve(&spec, Some(&light))?, &light)?);
     }
     // per technique: wrong % per frame, flicker per pair, previous visibility
     let mut wrong = vec![Vec::new(); insts.len()];

@@ -14,8 +14,9 @@ use shadowlab_core::scene::Scene;
 use shadowlab_gpu::gbuffer::{MOTION_FORMAT, NORMAL_FORMAT, POSITION_FORMAT};
 use shadowlab_gpu::host::HostView;
 use shadowlab_gpu::record::Recorder;
+use shadowlab_gpu::registry;
 use shadowlab_gpu::scene_gpu::GpuScene;
-use shadowlab_gpu::techniques::{self, run_frame};
+use shadowlab_gpu::technique::run_frame;
 use shadowlab_gpu::Gpu;
 use wgpu::util::DeviceExt;
 
@@ -146,9 +147,9 @@ pub fn run(gpu: &Gpu, scene: &Scene, size: u32, frames: usize) -> Result<HostRes
     // the techniques, through the registry, each with its own visibility buffer
     let mut techs = Vec::new();
     for name in ["sm", "lt"] {
-        let (info, params) = techniques::resolve(&TechniqueSpec::parse(name)?, Some(&light))?;
+        let spec = registry::resolve(&TechniqueSpec::parse(name)?, Some(&light))?;
         let vis = gpu.storage(&format!("host.visibility.{name}"), size as u64 * size as u64 * 4);
-        techs.push((name.to_string(), (info.create)(gpu, &gscene, &params, &light)?, vis));
+        techs.push((name.to_string(), (spec.info.create)(gpu, &gscene, &spec.values, &light)?, vis));
     }
 
     let g = &view.gbuffer;

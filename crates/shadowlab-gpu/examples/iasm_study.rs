@@ -18,7 +18,7 @@ use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
 use shadowlab_core::setup::{SceneSource, Setup};
 use shadowlab_gpu::lab::{Lab, View};
-use shadowlab_gpu::techniques;
+use shadowlab_gpu::registry;
 use shadowlab_gpu::Gpu;
 
 type Res = Result<(), Box<dyn std::error::Error>>;
@@ -72,8 +72,7 @@ fn path_study(lab: &Lab, scene: &Scene, cam: &Camera, size: u32, frames: usize, 
     println!("| spec | wrong % (mean) | wrong % (max) | flicker % (mean) | flicker % (max) |");
     println!("|---|---|---|---|---|");
     for spec in specs {
-        let (info, p) = techniques::resolve(&TechniqueSpec::parse(spec)?, Some(&light))?;
-        let mut inst = lab.instantiate(info, p, spec.clone(), &light)?;
+        let mut inst = lab.instantiate(&registry::resolve(&TechniqueSpec::parse(spec)?, Some(&light))?, &light)?;
         let (mut wrong, mut flick) = (Vec::new(), Vec::new());
         let mut prev: Option<Vec<f32>> = None;
         for (i, v) in views.iter().enumerate() {

@@ -27,7 +27,7 @@ use crate::gbuffer::{GBuffer, MaskPass};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
-use crate::techniques::FrameInputs;
+use crate::technique::FrameInputs;
 use crate::{binding, Gpu, GpuError};
 
 const TO_TEXTURE_WGSL: &str = include_str!("host_visibility.wgsl");

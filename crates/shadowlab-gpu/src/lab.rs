@@ -13,9 +13,10 @@ use shadowlab_core::scene::Scene;
 use crate::frame::{FrameUniform, LightUniform};
 use crate::gbuffer::{GBuffer, GBufferPass};
 use crate::record::{FrameStamps, Recorded, Recorder};
+use crate::registry::{self, Resolved};
 use crate::scene_gpu::GpuScene;
 use crate::shade::ShadePass;
-use crate::techniques::{self, FrameInputs, TechniqueInfo, TechniqueReport};
+use crate::technique::{self, FrameInputs, TechniqueInfo, TechniqueReport};
 use crate::timing::median;
 use crate::{Gpu, GpuError};
 
@@ -70,7 +71,7 @@ pub struct Instance {
     pub label: String,
     pub info: &'static TechniqueInfo,
     pub params: ParamValues,
-    pub tech: Box<dyn techniques::Technique>,
+    pub tech: Box<dyn technique::Technique>,
     /// Pipeline and resource creation (ms).
     pub setup_ms: f64,
 }
@@ -254,19 +255,12 @@ impl<'a> Lab<'a> {
     /// Resolves `spec`, creates the technique, runs it once to warm up and `repeat` more times
     /// timed, then shades and reads back its visibility.
     pub fn run(&self, view: &View, spec: &TechniqueSpec, repeat: usize) -> Result<Run, GpuError> {
-        let (info, params) = techniques::resolve(spec, Some(&view.light))?;
-        self.run_resolved(view, info, params, spec.label(), repeat)
+        self.run_resolved(view, &registry::resolve(spec, Some(&view.light))?, repeat)
     }
 
-    pub fn run_resolved(
-        &self,
-        view: &View,
-        info: &'static TechniqueInfo,
-        params: ParamValues,
-        label: String,
-        repeat: usize,
-    ) -> Result<Run, GpuError> {
-        let mut inst = self.instantiate(info, params, label, &view.light)?;
+    /// [`Lab::run`] for a spec resolved once by the caller.
+    pub fn run_resolved(&self, view: &View, spec: &Resolved, repeat: usize) -> Result<Run, GpuError> {
+        let mut inst = self.instantiate(spec, &view.light)?;
         let mut run = self.step(view, &mut inst, true, repeat)?;
         if !self.gpu.gpu_timestamps {
             // timestamp adapters have the stages of the timed frames already
@@ -283,24 +277,25 @@ impl<'a> Lab<'a> {
         self.set_time(view.time, view.prev_time)?;
         let inputs = view.inputs(&self.gscene);
         let tech = inst.tech.as_mut();
-        let ms = self.profiled_frame(|rec| techniques::run_frame(tech, self.gpu, &inputs, rec))?;
+        let ms = self.profiled_frame(|rec| technique::run_frame(tech, self.gpu, &inputs, rec))?;
         self.gpu.take_error()?;
         Ok(ms)
     }
 
     /// Creates a technique for `light` once, to be run on a sequence of views with
     /// [`Lab::step`] (camera paths: techniques that keep state across frames see them in order).
-    pub fn instantiate(
-        &self,
-        info: &'static TechniqueInfo,
-        params: ParamValues,
-        label: String,
-        light: &Light,
-    ) -> Result<Instance, GpuError> {
+    pub fn instantiate(&self, spec: &Resolved, light: &Light) -> Result<Instance, GpuError> {
+        spec.check_light(light)?;
         let t0 = std::time::Instant::now();
-        let tech = (info.create)(self.gpu, &self.gscene, &params, light)?;
+        let tech = (spec.info.create)(self.gpu, &self.gscene, &spec.values, light)?;
         self.gpu.take_error()?;
-        Ok(Instance { label, info, params, tech, setup_ms: t0.elapsed().as_secs_f64() * 1e3 })
+        Ok(Instance {
+            label: spec.label.clone(),
+            info: spec.info,
+            params: spec.values.clone(),
+            tech,
+            setup_ms: t0.elapsed().as_secs_f64() * 1e3,
+        })
     }
 
     /// Runs `inst` on `view`: once untimed when `warm_up`, then `repeat` times timed (at least
@@ -312,7 +307,7 @@ impl<'a> Lab<'a> {
         let inputs = view.inputs(&self.gscene);
         let tech = inst.tech.as_mut();
         if warm_up {
-            techniques::submit_frame(tech, gpu, &inputs)?;
+            technique::submit_frame(tech, gpu, &inputs)?;
             gpu.wait();
             gpu.take_error()?;
         }
@@ -324,7 +319,7 @@ impl<'a> Lab<'a> {
             let before = gpu.submit_count();
             let mut frame_stalls = Vec::new();
             let (ms, stages) = self.timed_frame(|rec| {
-                techniques::run_frame(tech, gpu, &inputs, rec)?;
+                technique::run_frame(tech, gpu, &inputs, rec)?;
                 frame_stalls = rec.stalls().to_vec();
                 Ok(())
             })?;
@@ -368,6 +363,6 @@ impl<'a> Lab<'a> {
 
     /// The reference on this view.
     pub fn reference(&self, view: &View, repeat: usize) -> Result<Run, GpuError> {
-        self.run_resolved(view, &crate::reference::INFO, ParamValues::default(), "rt".into(), repeat)
+        self.run_resolved(view, &registry::reference(), repeat)
     }
 }

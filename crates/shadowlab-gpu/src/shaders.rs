@@ -1,6 +1,7 @@
 //! Shader composition: every shader is `common.wgsl` + (optionally `scene.wgsl`, and for the
 //! depth-only shadow passes `depth.wgsl`) + its own file.
-//! [`all`] lists every composed shader so a CPU-only test validates each with naga.
+//! [`crate::registry::shaders`] lists every composed shader so a CPU-only test validates each
+//! with naga.
 
 pub const COMMON: &str = include_str!("common.wgsl");
 pub const SCENE: &str = include_str!("scene.wgsl");
@@ -20,18 +21,4 @@ pub fn compose(body: &str, with_scene: bool) -> String {
 /// pass from a light), then `body` (its uniform and entry points).
 pub fn compose_depth(body: &str) -> String {
     compose(&format!("{DEPTH}{body}"), true)
-}
-
-/// (file name, composed source) of every shader the crate uses.
-pub fn all() -> Vec<(&'static str, String)> {
-    let mut v = vec![];
-    v.extend(crate::gbuffer::shaders());
-    v.extend(crate::host::shaders());
-    v.extend(crate::reference::shaders());
-    v.extend(crate::shade::shaders());
-    v.extend(crate::reduce::shaders());
-    v.extend(crate::blur::shaders());
-    v.extend(crate::prefix_sum::shaders());
-    v.extend(crate::techniques::shaders());
-    v
 }

@@ -182,7 +182,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 fn occluded_static_and_occluded_dynamic_each_see_their_part() {
     use shadowlab_core::bvh::{occluded_from, shadow_ray};
     use shadowlab_gpu::reference::TRACE_WGSL;
-    use shadowlab_gpu::techniques::{compose_view, view_layout};
+    use shadowlab_gpu::technique::{compose_view, view_layout};
     let Some(gpu) = gpu() else { return };
     let scene = builtin("foliage").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();

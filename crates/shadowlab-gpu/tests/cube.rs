@@ -7,8 +7,9 @@ use shadowlab_core::cube::{face_of, project, tap_texel, texel_size};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
+use shadowlab_gpu::registry;
+use shadowlab_gpu::technique::submit_frame;
 use shadowlab_gpu::techniques::cube::CubeMap;
-use shadowlab_gpu::techniques::{self, submit_frame};
 use shadowlab_gpu::GpuError;
 
 mod common;
@@ -48,13 +49,14 @@ fn cube_rejects_other_lights() {
     let Some(gpu) = gpu() else { return };
     let scene = builtin("room").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
-    let (info, p) = techniques::resolve(&spec("cube"), None).unwrap();
+    let shadowlab_gpu::registry::Resolved { info, values: p, .. } = registry::resolve(&spec("cube"), None).unwrap();
     for light in [scene.lights[0], Light::Directional { direction: -Vec3::Y }] {
         assert!(matches!((info.create)(&gpu, &lab.gscene, &p, &light), Err(GpuError::Invalid(_))));
-        assert!(techniques::resolve(&spec("cube-notw"), Some(&light)).is_err());
+        assert!(registry::resolve(&spec("cube-notw"), Some(&light)).is_err());
     }
     // cube-notw's default window (128) needs res above it: a clear error, not a panic
-    let (info, p) = techniques::resolve(&spec("cube-notw:res=64"), Some(&scene.lights[ROOM_POINT])).unwrap();
+    let shadowlab_gpu::registry::Resolved { info, values: p, .. } =
+        registry::resolve(&spec("cube-notw:res=64"), Some(&scene.lights[ROOM_POINT])).unwrap();
     match (info.create)(&gpu, &lab.gscene, &p, &scene.lights[ROOM_POINT]) {
         Err(GpuError::Invalid(m)) => assert!(m.contains("window"), "{m}"),
         _ => panic!("cube-notw:res=64 with window 128 accepted"),
@@ -71,7 +73,7 @@ fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {
     let light = scene.lights[ROOM_POINT];
     let Light::Point { position } = light else { panic!("room light 1 is a point light") };
     let v = view(&lab, &scene, ROOM_POINT, 256);
-    let (_, p) = techniques::resolve(&spec("cube:res=64,pcf=3"), Some(&light)).unwrap();
+    let shadowlab_gpu::registry::Resolved { info: _, values: p, .. } = registry::resolve(&spec("cube:res=64,pcf=3"), Some(&light)).unwrap();
     let mut cube = CubeMap::new(&gpu, &lab.gscene, &p, &light).unwrap();
     submit_frame(&mut cube, &gpu, &v.inputs(&lab.gscene)).unwrap();
     let gpu_vis: Vec<f32> = gpu.read_buffer_as(&v.visibility, v.mask.len());
@@ -244,7 +246,7 @@ fn hardware_depth_faces_hold_the_same_distances_and_verdicts_as_distance_faces()
     let mut faces = Vec::new();
     let mut vis = Vec::new();
     for s in ["cube:depth=distance,pcf=3", "cube:depth=hardware,pcf=3"] {
-        let (_, p) = techniques::resolve(&spec(s), Some(&light)).unwrap();
+        let shadowlab_gpu::registry::Resolved { info: _, values: p, .. } = registry::resolve(&spec(s), Some(&light)).unwrap();
         let mut cube = CubeMap::new(&gpu, &lab.gscene, &p, &light).unwrap();
         submit_frame(&mut cube, &gpu, &v.inputs(&lab.gscene)).unwrap();
         faces.push(cube.read_faces(&gpu));

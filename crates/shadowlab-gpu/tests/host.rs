@@ -23,8 +23,9 @@ fn host_app_matches_the_lab_with_one_submit_per_frame() {
     let lab = Lab::new(&lab_gpu, &scene).unwrap();
     let v = lab.view(&r.camera, &r.camera, &r.light, r.width, r.height).unwrap();
     for (name, host_vis) in &r.visibility {
-        let (info, params) = shadowlab_gpu::techniques::resolve(&TechniqueSpec::parse(name).unwrap(), Some(&r.light)).unwrap();
-        let mut inst = lab.instantiate(info, params, name.clone(), &r.light).unwrap();
+        let shadowlab_gpu::registry::Resolved { info, values: params, .. } =
+            shadowlab_gpu::registry::resolve(&TechniqueSpec::parse(name).unwrap(), Some(&r.light)).unwrap();
+        let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, name.clone()), &r.light).unwrap();
         // the same number of frames as the host ran (lt keeps a temporal mask)
         let mut run = lab.step(&v, &mut inst, false, 1).unwrap();
         for _ in 1..frames {

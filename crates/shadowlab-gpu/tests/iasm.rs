@@ -5,7 +5,7 @@ use shadowlab_core::builtin::builtin;
 use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
-use shadowlab_gpu::techniques;
+use shadowlab_gpu::registry;
 use shadowlab_gpu::techniques::iasm::Iasm;
 
 mod common;
@@ -48,7 +48,7 @@ fn gpu_texel_index_matches_cpu_equations() {
     let scene = builtin("planebox").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 64);
-    let values = techniques::resolve(&TechniqueSpec::parse("iasm:store=buffer").unwrap(), Some(&v.light)).unwrap().1;
+    let values = registry::resolve(&TechniqueSpec::parse("iasm:store=buffer").unwrap(), Some(&v.light)).unwrap().values;
     let tech = Iasm::new(&gpu, &lab.gscene, &values, &v.light).unwrap();
     // a scrambled assignment
     let order = core::rank(&std::array::from_fn(|i| ((i * 11) % 16) as f64), &[false; 16]);
@@ -82,8 +82,9 @@ fn delayed_iasm_on_a_still_camera_equals_iasm_after_the_first_frame() {
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 256);
     let make = |spec: &str| {
-        let (info, p) = techniques::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
-        lab.instantiate(info, p, spec.into(), &v.light).unwrap()
+        let shadowlab_gpu::registry::Resolved { info, values: p, .. } =
+            registry::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
+        lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, p, spec), &v.light).unwrap()
     };
     let mut now = make("iasm");
     let mut late = make("iasm:delayed=true");

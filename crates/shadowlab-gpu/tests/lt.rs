@@ -10,15 +10,16 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
 use shadowlab_gpu::lab::{Lab, View};
+use shadowlab_gpu::registry;
+use shadowlab_gpu::technique::{submit_frame, Technique};
 use shadowlab_gpu::techniques::lt::{LeakTracing, Mode};
-use shadowlab_gpu::techniques::{self, submit_frame, Technique};
 
 mod common;
 use common::*;
 
 fn make(lab: &Lab, spec: &str, light: &shadowlab_core::light::Light) -> LeakTracing {
     let spec = TechniqueSpec::parse(spec).unwrap();
-    let (info, params) = techniques::resolve(&spec, Some(light)).unwrap();
+    let shadowlab_gpu::registry::Resolved { info, values: params, .. } = registry::resolve(&spec, Some(light)).unwrap();
     let mode = match info.name {
         "lt" => Mode::Lt,
         "ltt" => Mode::Ltt,
@@ -137,11 +138,11 @@ fn reprojection_off_screen_forces_a_ray() {
 
 /// Runs `spec` and `rt` along `cams` (256x256), returning per frame (wrong %, rays, rt rays).
 fn along(lab: &Lab, scene: &Scene, spec: &str, cams: &[Camera]) -> Vec<(f64, f64, f64)> {
-    let info = techniques::find(&TechniqueSpec::parse(spec).unwrap().name).unwrap();
+    let info = registry::find(&TechniqueSpec::parse(spec).unwrap().name).unwrap();
     let params = TechniqueSpec::parse(spec).unwrap().resolve(info.params).unwrap();
     let light = scene.lights[0];
-    let mut inst = lab.instantiate(info, params, spec.into(), &light).unwrap();
-    let mut rt_inst = lab.instantiate(&shadowlab_gpu::reference::INFO, Default::default(), "rt".into(), &light).unwrap();
+    let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, spec), &light).unwrap();
+    let mut rt_inst = lab.instantiate(&shadowlab_gpu::registry::reference(), &light).unwrap();
     let mut out = Vec::new();
     for (f, cam) in cams.iter().enumerate() {
         let prev = if f == 0 { cam } else { &cams[f - 1] };
@@ -392,11 +393,11 @@ const LT_MOVING_MARGIN_PCT: f64 = 0.02;
 /// the objects move faster than at the CLI's 1 per frame). Also returns how many evaluated
 /// pixels of `rt` changed between frame 8 and the last frame.
 fn along_moving(lab: &Lab, scene: &Scene, spec: &str, cams: &[Camera]) -> (Vec<(f64, f64, f64)>, usize) {
-    let info = techniques::find(&TechniqueSpec::parse(spec).unwrap().name).unwrap();
+    let info = registry::find(&TechniqueSpec::parse(spec).unwrap().name).unwrap();
     let params = TechniqueSpec::parse(spec).unwrap().resolve(info.params).unwrap();
     let light = scene.lights[0];
-    let mut inst = lab.instantiate(info, params, spec.into(), &light).unwrap();
-    let mut rt_inst = lab.instantiate(&shadowlab_gpu::reference::INFO, Default::default(), "rt".into(), &light).unwrap();
+    let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, spec), &light).unwrap();
+    let mut rt_inst = lab.instantiate(&shadowlab_gpu::registry::reference(), &light).unwrap();
     let (mut out, mut at8) = (Vec::new(), None);
     let mut changed = 0;
     for (f, cam) in cams.iter().enumerate() {
@@ -454,7 +455,7 @@ fn point_light_uses_a_cube_map() {
     assert!(faces.len() >= 4, "view samples on faces {faces:?}");
     for spec in ["lt:res=512", "lt"] {
         let mut t = make(&lab, spec, &light);
-        let mut rt_inst = lab.instantiate(&shadowlab_gpu::reference::INFO, Default::default(), "rt".into(), &light).unwrap();
+        let mut rt_inst = lab.instantiate(&shadowlab_gpu::registry::reference(), &light).unwrap();
         for f in 0..10 {
             let time = f as f32 * TIME_STEP;
             lab.set_time(time, (time - TIME_STEP).max(0.0)).unwrap();

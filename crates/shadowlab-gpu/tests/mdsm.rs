@@ -7,8 +7,8 @@ use shadowlab_core::mdsm::{distinct_values, max_distinct, pcf, pcf_offsets, regi
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, View};
+use shadowlab_gpu::technique::submit_frame;
 use shadowlab_gpu::techniques::mdsm::{MultiDepthMap, INFO};
-use shadowlab_gpu::techniques::submit_frame;
 use shadowlab_gpu::Gpu;
 
 mod common;
@@ -241,7 +241,7 @@ fn bad_parameters_are_clear_errors() {
 #[test]
 fn wgsl_constants_match_core() {
     use shadowlab_core::mdsm::{MAX_DEPTHS, SEARCH_SIZES};
-    let all = shadowlab_gpu::techniques::shaders();
+    let all = shadowlab_gpu::registry::shaders();
     let select = &all.iter().find(|(n, _)| *n == "mdsm/select.wgsl").unwrap().1;
     let max_q = SEARCH_SIZES.iter().max().unwrap();
     assert!(select.contains(&format!("const MAX_Q: u32 = {max_q}u;")), "select.wgsl MAX_Q must be {max_q}");

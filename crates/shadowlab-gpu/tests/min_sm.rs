@@ -137,7 +137,7 @@ fn bad_requests_are_errors() {
 #[test]
 fn one_pass_reduction_is_exact_on_a_repeat_and_conservative_along_a_path() {
     use shadowlab_core::camera::path_cameras;
-    use shadowlab_gpu::techniques::resolve;
+    use shadowlab_gpu::registry::resolve;
     let Some(gpu) = gpu() else { return };
     let scene = builtin("courtyard").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
@@ -150,8 +150,8 @@ fn one_pass_reduction_is_exact_on_a_repeat_and_conservative_along_a_path() {
     assert_eq!(one.visibility, two.visibility);
     assert_eq!(one.report.counters["hull_points"], two.report.counters["hull_points"]);
 
-    let (info, params) = resolve(&spec("min-sm"), Some(&light)).unwrap();
-    let mut inst = lab.instantiate(info, params, "min-sm".into(), &light).unwrap();
+    let shadowlab_gpu::registry::Resolved { info, values: params, .. } = resolve(&spec("min-sm"), Some(&light)).unwrap();
+    let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, "min-sm"), &light).unwrap();
     let cams = path_cameras(&scene.camera, &scene.camera_path, 5);
     for (i, cam) in cams.iter().enumerate() {
         let v = lab.view(cam, cam, &light, 128, 128).unwrap();

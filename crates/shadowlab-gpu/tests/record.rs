@@ -7,7 +7,7 @@ mod common;
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::params::ParamValues;
 use shadowlab_gpu::lab::Lab;
-use shadowlab_gpu::techniques::REGISTRY;
+use shadowlab_gpu::registry::REGISTRY;
 
 use common::*;
 
@@ -22,7 +22,7 @@ fn each_technique(mut check: impl FnMut(&str, &str, &shadowlab_gpu::lab::Run, &[
             let v = view(&lab, &scene, l, 96);
             for info in REGISTRY.iter().filter(|t| t.lights.contains(&light.kind())) {
                 let params: ParamValues = shadowlab_core::params::TechniqueSpec::parse(info.name).unwrap().resolve(info.params).unwrap();
-                let mut inst = lab.instantiate(info, params, info.name.into(), light).unwrap();
+                let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, info.name), light).unwrap();
                 let run = lab.step(&v, &mut inst, true, 1).unwrap();
                 // the visibility buffer after the analysis passes, report and shading
                 let after: Vec<f32> = gpu.read_buffer_as(&v.visibility, v.gbuffer.pixels());

@@ -20,7 +20,7 @@ fn parse(name: &str, src: &str) -> naga::Module {
 
 #[test]
 fn every_shader_validates() {
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     assert!(all.len() >= 6);
     for (name, src) in &all {
         parse(name, src);
@@ -30,7 +30,7 @@ fn every_shader_validates() {
 #[test]
 fn every_wgsl_file_is_composed_somewhere() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let composed: String = shadowlab_gpu::shaders::all().into_iter().map(|(_, s)| s).collect();
+    let composed: String = shadowlab_gpu::registry::shaders().into_iter().map(|(_, s)| s).collect();
     let mut stack = vec![root];
     let mut seen = 0;
     while let Some(dir) = stack.pop() {
@@ -71,7 +71,7 @@ fn check(module: &naga::Module, name: &str, size: usize, offsets: &[(&str, usize
 
 #[test]
 fn shared_struct_layouts_match_rust() {
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     let rt = get("rt.wgsl");
     check(
@@ -136,7 +136,7 @@ fn shared_struct_layouts_match_rust() {
 #[test]
 fn mdsm_params_layout_matches_wgsl() {
     use shadowlab_gpu::techniques::mdsm::MdsmParams;
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     for name in ["mdsm/select.wgsl", "mdsm/eval.wgsl"] {
         let src = &all.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("{name} not composed")).1;
         check(
@@ -152,7 +152,7 @@ fn mdsm_params_layout_matches_wgsl() {
 fn sv_struct_layouts_match_rust() {
     use shadowlab_core::edges::Edge;
     use shadowlab_gpu::techniques::sv::SvParams;
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for f in ["sv/silhouette.wgsl", "sv/volume.wgsl", "sv/resolve.wgsl"] {
         check(&get(f), "SvParams", size_of::<SvParams>(), &[("counts", 0), ("extrude", offset_of!(SvParams, extrude))]);
@@ -167,7 +167,7 @@ fn sv_struct_layouts_match_rust() {
 fn csm_and_reduce_layouts_match_rust() {
     use shadowlab_gpu::reduce::ReduceParams;
     use shadowlab_gpu::techniques::csm::{CascadeU, CsmParams};
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     let eval = get("csm/eval.wgsl");
     check(&eval, "Cascade", size_of::<CascadeU>(), &[("view_proj", 0), ("info", offset_of!(CascadeU, info))]);
@@ -184,7 +184,7 @@ fn csm_and_reduce_layouts_match_rust() {
 #[test]
 fn iasm_layouts_match_wgsl() {
     use shadowlab_gpu::techniques::iasm::{IasmParams, TileParams};
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for n in ["iasm/analysis.wgsl", "iasm/eval.wgsl", "iasm/eval_atlas.wgsl", "iasm/probe.wgsl"] {
         check(
@@ -212,7 +212,7 @@ fn iasm_layouts_match_wgsl() {
 fn filtered_and_blur_layouts_match_rust() {
     use shadowlab_gpu::blur::BlurParams;
     use shadowlab_gpu::techniques::filtered::FilteredParams;
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for f in ["filtered/render.wgsl", "filtered/eval.wgsl"] {
         check(
@@ -240,7 +240,7 @@ fn filtered_and_blur_layouts_match_rust() {
 #[test]
 fn min_sm_reduce_layout_matches_rust() {
     use shadowlab_gpu::techniques::min_sm::MsfReduce;
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let src = &all.iter().find(|(n, _)| *n == "min_sm/reduce.wgsl").expect("min_sm/reduce.wgsl listed").1;
     check(
         &parse("min_sm/reduce.wgsl", src),
@@ -254,7 +254,7 @@ fn min_sm_reduce_layout_matches_rust() {
 fn warp_struct_layouts_match_rust() {
     use shadowlab_gpu::prefix_sum::ScanParams;
     use shadowlab_gpu::techniques::warp::WarpParams;
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl"] {
         check(
@@ -289,7 +289,7 @@ fn warp_struct_layouts_match_rust() {
 #[test]
 fn scene_info_layout_matches_wgsl() {
     use shadowlab_gpu::scene_gpu::SceneInfo;
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     for name in ["rt.wgsl", "gbuffer.wgsl"] {
         let src = &all.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("{name} not composed")).1;
         check(
@@ -308,7 +308,7 @@ fn scene_info_layout_matches_wgsl() {
 #[test]
 fn cube_layouts_match_wgsl() {
     use shadowlab_gpu::techniques::cube::{CubeFace, CubeParams};
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap_or_else(|| panic!("{n} not composed")).1);
     check(
         &get("cube/depth.wgsl"),
@@ -327,7 +327,7 @@ fn cube_layouts_match_wgsl() {
 #[test]
 fn lt_params_layout_matches_wgsl() {
     use shadowlab_gpu::techniques::lt::{LevelU, LtParams, TraceParams};
-    let all = shadowlab_gpu::shaders::all();
+    let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap_or_else(|| panic!("{n} not composed")).1);
     check(
         &get("lt/classify.wgsl"),
@@ -365,7 +365,7 @@ const FOLDERS: &[(&str, &[&str])] = &[
 #[test]
 fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {
     let mut most: std::collections::BTreeMap<String, usize> = Default::default();
-    for (name, src) in shadowlab_gpu::shaders::all() {
+    for (name, src) in shadowlab_gpu::registry::shaders() {
         let module = naga::front::wgsl::parse_str(&src).unwrap();
         let n = module.global_variables.iter().filter(|(_, g)| matches!(g.space, naga::AddressSpace::Storage { .. })).count();
         let folder = name.split('/').next().unwrap().to_string();
@@ -378,7 +378,7 @@ fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {
         let Some((_, names)) = FOLDERS.iter().find(|(f, _)| f == folder) else {
             panic!("{folder} binds {n} storage buffers (WebGPU's default is {DEFAULT_STORAGE_BUFFERS}): add it to FOLDERS and declare it in TechniqueInfo::needs");
         };
-        for t in shadowlab_gpu::techniques::REGISTRY.iter().filter(|t| names.contains(&t.name)) {
+        for t in shadowlab_gpu::registry::REGISTRY.iter().filter(|t| names.contains(&t.name)) {
             let want = format!("{n} storage buffers per shader stage");
             assert!(t.needs.contains(&want), "{} binds {n} storage buffers ({folder}); its needs say: {:?}", t.name, t.needs);
         }

@@ -8,7 +8,8 @@ use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::warp;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::prefix_sum::{PrefixSum, ScanParams};
-use shadowlab_gpu::techniques;
+use shadowlab_gpu::registry;
+use shadowlab_gpu::technique;
 use shadowlab_gpu::techniques::warp::{Variant, Warped};
 use wgpu::BufferUsages;
 
@@ -66,10 +67,11 @@ fn gpu_prefix_sums_equal_the_cpu() {
 
 /// Runs a warp technique directly on a view (to read back its internals).
 fn run_direct(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant: Variant) -> Warped {
-    let (_, params) = techniques::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
+    let shadowlab_gpu::registry::Resolved { info: _, values: params, .. } =
+        registry::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
     let mut t = Warped::new(gpu, &lab.gscene, &params, &v.light, variant).unwrap();
     let f = v.inputs(&lab.gscene);
-    techniques::submit_frame(&mut t, gpu, &f).unwrap();
+    technique::submit_frame(&mut t, gpu, &f).unwrap();
     gpu.take_error().unwrap();
     t
 }

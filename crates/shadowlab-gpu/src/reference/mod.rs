@@ -6,7 +6,7 @@ use shadowlab_core::params::ParamDef;
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::{binding, Gpu, GpuError};
 
 /// The shadow-ray library (`occluded`, `sample_shadowed`): needs `scene.wgsl` and the view
@@ -33,6 +33,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[] as &[ParamDef],
     stalls: "",
     needs: "9 storage buffers per shader stage (WebGPU default: 8)",
+    compare: &[],
     create: |gpu, scene, _params, _light| Ok(Box::new(RayTraced::new(gpu, scene))),
 };
 

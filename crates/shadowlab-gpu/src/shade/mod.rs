@@ -2,7 +2,7 @@
 
 use crate::gbuffer::GBuffer;
 use crate::shaders::compose;
-use crate::techniques::FrameInputs;
+use crate::technique::FrameInputs;
 use crate::{binding, Gpu};
 
 const SHADE_WGSL: &str = include_str!("shade.wgsl");

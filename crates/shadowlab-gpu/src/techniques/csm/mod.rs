@@ -25,7 +25,7 @@ use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, MinMax};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
-use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::{binding, raster, Gpu, GpuError};
 
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
@@ -46,6 +46,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls:
         "with tighten=true (default): csm.readback, the view depth range read back before the fit; tighten=false, or delayed=true (the previous frame's range), records without a stall",
     needs: "",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, p, light)?)),
 };
 
@@ -96,7 +97,7 @@ pub struct Cascaded {
     depth_groups: Vec<wgpu::BindGroup>,
     depth_pipeline: wgpu::RenderPipeline,
     /// The evaluation and its analysis variant.
-    eval: crate::techniques::EvalPipelines,
+    eval: crate::technique::EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     reduce: MinMax,
@@ -146,7 +147,7 @@ impl Cascaded {
             "csm.eval",
             &[binding::uniform(), texture_depth_array(), binding::comparison_sampler(), binding::storage(false), binding::storage(false)],
         );
-        let eval = crate::techniques::EvalPipelines::new(gpu, "csm.eval", &compose_view(EVAL_WGSL, false), &eval_layout, &[]);
+        let eval = crate::technique::EvalPipelines::new(gpu, "csm.eval", &compose_view(EVAL_WGSL, false), &eval_layout, &[]);
         let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {

@@ -4,8 +4,8 @@
 use shadowlab_core::metrics::sampling_stats;
 
 use super::Cascaded;
-use crate::techniques::sm::{count_image, depth_image};
-use crate::techniques::{NamedImage, TechniqueReport};
+use crate::technique::{NamedImage, TechniqueReport};
+use crate::techniques::pictures::{count_image, depth_image};
 use crate::Gpu;
 
 /// Cascade colours of the cascade-index picture (cascade 0 first); blended pixels are lighter.

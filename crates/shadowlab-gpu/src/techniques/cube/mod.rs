@@ -24,8 +24,9 @@ use shadowlab_core::params::{ParamDef, ParamValues};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
-use crate::techniques::sm::{count_image, depth_image, BIAS, BIAS_WGSL, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
-use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::techniques::pictures::{count_image, depth_image};
+use crate::techniques::sm::{BIAS, BIAS_WGSL, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
 use crate::{binding, raster, Gpu, GpuError};
 
 const FACES_WGSL: &str = include_str!("faces.wgsl");
@@ -82,6 +83,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: PARAMS,
     stalls: "",
     needs: "",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(CubeMap::new(gpu, scene, p, light)?)),
 };
 
@@ -165,6 +167,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     params: NOTW_PARAMS,
     stalls: "cube-notw.face_samples: the samples per face are read back to skip empty faces",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
 };
 
@@ -214,7 +217,7 @@ pub struct CubeMap {
     counts: wgpu::Buffer,
     eval_layout: wgpu::BindGroupLayout,
     /// The evaluation and its analysis variant.
-    eval: crate::techniques::EvalPipelines,
+    eval: crate::technique::EvalPipelines,
 }
 
 impl CubeMap {
@@ -256,7 +259,7 @@ impl CubeMap {
         };
         let eval_layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
         let hw = if hardware { 1.0 } else { 0.0 };
-        let eval = crate::techniques::EvalPipelines::new(gpu, "cube.evaluate", &eval_src(), &eval_layout, &[("HW_DEPTH", hw)]);
+        let eval = crate::technique::EvalPipelines::new(gpu, "cube.evaluate", &eval_src(), &eval_layout, &[("HW_DEPTH", hw)]);
         Ok(CubeMap {
             res,
             far,

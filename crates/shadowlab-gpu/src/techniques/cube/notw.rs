@@ -18,8 +18,8 @@ use crate::frame::LightUniform;
 use crate::gbuffer::GBuffer;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
+use crate::technique::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::techniques::warp::{Variant, Warped};
-use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::{binding, Gpu, GpuError};
 
 /// The names of the images of a face's `Warped` report that `cube-notw` passes on.
@@ -243,7 +243,7 @@ impl Technique for CubeNotw {
                 }
             }
             for img in fr.images.into_iter().filter(|img| FACE_IMAGES.iter().any(|p| img.name.starts_with(p))) {
-                r.images.push(crate::techniques::NamedImage { name: format!("face {name}: {}", img.name), ..img });
+                r.images.push(crate::technique::NamedImage { name: format!("face {name}: {}", img.name), ..img });
             }
         }
         r.counters.insert("faces_rendered".into(), active as f64);

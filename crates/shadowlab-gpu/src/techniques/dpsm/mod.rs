@@ -19,8 +19,9 @@ use shadowlab_core::params::{ParamDef, ParamValues};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
+use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::techniques::sm;
 use crate::techniques::warp::{self, Projection, Variant, Warped};
-use crate::techniques::{sm, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::{Gpu, GpuError};
 
 /// Side of each hemisphere's map (texels). The setting: 512 per hemisphere against
@@ -165,6 +166,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: DPSM_PARAMS,
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, false)?)),
 };
 
@@ -178,6 +180,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     params: NOTW_PARAMS,
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, true)?)),
 };
 

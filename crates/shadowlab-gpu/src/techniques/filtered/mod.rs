@@ -25,7 +25,7 @@ use shadowlab_core::moments as cpu;
 use shadowlab_core::params::{ParamDef, BOOL};
 
 use crate::shaders::compose;
-use crate::techniques::{compose_view, TechniqueInfo};
+use crate::technique::{compose_view, TechniqueInfo};
 pub use technique::Filtered;
 
 /// The representation library (encoders, bounds, `*_visibility_gather`): self-contained WGSL
@@ -182,6 +182,7 @@ pub const VSM_INFO: TechniqueInfo = TechniqueInfo {
     params: VSM_PARAMS,
     stalls: "",
     needs: "",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Vsm)?)),
 };
 pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
@@ -194,6 +195,7 @@ pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
     params: ESM_PARAMS,
     stalls: "",
     needs: "",
+    compare: &[],
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Esm)?)),
 };
 pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
@@ -206,6 +208,7 @@ pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
     params: EVSM_PARAMS,
     stalls: "",
     needs: "",
+    compare: &["", "sd=true"],
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Evsm)?)),
 };
 pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
@@ -218,6 +221,7 @@ pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
     params: MSM_PARAMS,
     stalls: "",
     needs: "",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Msm)?)),
 };
 

@@ -11,8 +11,8 @@ use super::{eval_source, render_source, FilteredParams, Kind};
 use crate::blur::{mip0, Blur};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::techniques::sm::{count_image, depth_image};
-use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
+use crate::technique::{view_layout, FrameInputs, Technique, TechniqueReport};
+use crate::techniques::pictures::{count_image, depth_image};
 use crate::{binding, raster, Gpu, GpuError};
 
 pub struct Filtered {
@@ -32,7 +32,7 @@ pub struct Filtered {
     render_pipeline: wgpu::RenderPipeline,
     render_group: wgpu::BindGroup,
     /// The evaluation and its analysis variant.
-    eval: crate::techniques::EvalPipelines,
+    eval: crate::technique::EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -115,7 +115,7 @@ impl Filtered {
             &format!("{name}.eval"),
             &[binding::uniform(), binding::texture_float(), sampler_type, binding::storage(false)],
         );
-        let eval = crate::techniques::EvalPipelines::new(gpu, &format!("{name}.evaluate"), &eval_source(), &eval_layout, &[]);
+        let eval = crate::technique::EvalPipelines::new(gpu, &format!("{name}.evaluate"), &eval_source(), &eval_layout, &[]);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("filtered.gather"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,

@@ -9,7 +9,7 @@ use super::gpu::Iasm;
 use super::{eval_atlas_src, ATLAS_WGSL};
 use crate::record::Recorder;
 use crate::shaders::compose_depth;
-use crate::techniques::{view_layout, FrameInputs};
+use crate::technique::{view_layout, FrameInputs};
 use crate::{binding, raster, Gpu, GpuError};
 
 /// The conventional alternative: the tiles in a depth atlas (store=atlas).

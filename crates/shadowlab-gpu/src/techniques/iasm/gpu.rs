@@ -15,7 +15,7 @@ use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, RENDER_WG
 use crate::record::{DelayedRead, Recorder};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
-use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
+use crate::technique::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::{binding, Gpu, GpuError};
 
 const TILE_STRIDE: u64 = 256;

@@ -5,8 +5,8 @@ use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 use shadowlab_core::metrics::sampling_stats;
 
 use super::gpu::Iasm;
-use crate::techniques::sm::depth_image;
-use crate::techniques::{NamedImage, TechniqueReport};
+use crate::technique::{NamedImage, TechniqueReport};
+use crate::techniques::pictures::depth_image;
 use crate::Gpu;
 
 /// Side of one tile in the pictures.

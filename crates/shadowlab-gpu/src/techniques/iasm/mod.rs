@@ -21,7 +21,8 @@ use bytemuck::{Pod, Zeroable};
 use shadowlab_core::params::{ParamDef, BOOL};
 
 use crate::shaders::{compose, compose_depth};
-use crate::techniques::{compose_view, sm, TechniqueInfo};
+use crate::technique::{compose_view, TechniqueInfo};
+use crate::techniques::sm;
 
 pub use gpu::Iasm;
 
@@ -201,6 +202,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: PARAMS,
     stalls: "iasm.readback: the tile statistics are read back for the plan; delayed=true plans with the previous frame's, read back without a stall (a sync only on the first frame, or when the previous frame has not finished)",
     needs: "",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, p, light)?)),
 };
 

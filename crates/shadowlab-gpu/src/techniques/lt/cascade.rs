@@ -9,7 +9,7 @@ use shadowlab_core::leak;
 use shadowlab_core::scene::Bounds;
 
 use super::{LevelU, LtParams};
-use crate::techniques::FrameInputs;
+use crate::technique::FrameInputs;
 use crate::GpuError;
 
 /// View depth served by the only level of a single map.

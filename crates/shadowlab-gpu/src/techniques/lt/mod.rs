@@ -44,8 +44,8 @@ use shadowlab_core::moments as cpu;
 use shadowlab_core::params::{ParamDef, BOOL};
 
 use crate::reference::TRACE_WGSL;
+use crate::technique::{compose_view, TechniqueInfo};
 use crate::techniques::filtered::MOMENTS_WGSL;
-use crate::techniques::{compose_view, TechniqueInfo};
 pub use pass::LeakTracing;
 
 const CLASSIFY_WGSL: &str = include_str!("classify.wgsl");
@@ -301,6 +301,7 @@ pub const LT_INFO: TechniqueInfo = TechniqueInfo {
     params: LT_PARAMS,
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Lt)?)),
 };
 pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
@@ -313,6 +314,7 @@ pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
     params: LTT_PARAMS,
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Ltt)?)),
 };
 pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
@@ -325,5 +327,6 @@ pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
     params: HYBRID_PARAMS,
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::HybridPcf)?)),
 };

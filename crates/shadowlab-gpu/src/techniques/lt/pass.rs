@@ -13,8 +13,8 @@ use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, 
 use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_POINT, FLAG_RR};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
+use crate::technique::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::techniques::filtered::{render_source, FilteredParams};
-use crate::techniques::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::{binding, raster, Gpu, GpuError};
 
 /// Lights per technique instance (the lab runs one instance per light).

@@ -5,8 +5,8 @@ use shadowlab_core::leak::{self, Class, Mask, BIT_LTT, BIT_RS};
 
 use super::pass::LeakTracing;
 use super::Mode;
-use crate::techniques::sm::depth_image;
-use crate::techniques::{NamedImage, TechniqueReport};
+use crate::technique::{NamedImage, TechniqueReport};
+use crate::techniques::pictures::depth_image;
 use crate::Gpu;
 
 pub(super) fn report(t: &LeakTracing, gpu: &Gpu) -> TechniqueReport {

@@ -18,8 +18,9 @@ use shadowlab_core::params::{ParamDef, ParamValues, BOOL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
-use crate::techniques::sm::{self, count_image, depth_image, DepthPass, SmParams};
-use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::techniques::pictures::{count_image, depth_image};
+use crate::techniques::sm::{self, DepthPass, SmParams};
 use crate::{binding, Gpu, GpuError};
 
 const SELECT_WGSL: &str = include_str!("select.wgsl");
@@ -155,6 +156,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: PARAMS,
     stalls: "",
     needs: "",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(MultiDepthMap::new(gpu, scene, p, light)?)),
 };
 
@@ -184,7 +186,7 @@ pub struct MultiDepthMap {
     select_pipeline: wgpu::ComputePipeline,
     select_group: wgpu::BindGroup,
     /// The evaluation and its analysis variant.
-    eval: crate::techniques::EvalPipelines,
+    eval: crate::technique::EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
 }
 
@@ -242,7 +244,7 @@ impl MultiDepthMap {
         );
         let select_pipeline = gpu.compute_pipeline("mdsm.select", &compose(SELECT_WGSL, false), "main", &[&select_layout]);
         let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
-        let eval = crate::techniques::EvalPipelines::new(gpu, "mdsm.eval", &eval_src(), &eval_layout, &[]);
+        let eval = crate::technique::EvalPipelines::new(gpu, "mdsm.eval", &eval_src(), &eval_layout, &[]);
         let counts = gpu.storage("mdsm.counts", res as u64 * res as u64 * 4);
         Ok(MultiDepthMap { res, k, n, params, depth, nsm, counts, uniform, select_pipeline, select_group, eval, eval_layout })
     }

@@ -18,8 +18,8 @@ use shadowlab_core::scene::Bounds;
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
+use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::techniques::sm::{self, MapPass};
-use crate::techniques::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::{binding, Gpu, GpuError};
 
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
@@ -93,6 +93,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: PARAMS,
     stalls: "min-sm.readback: the band reduction of the view samples is read back for the CPU hull and calipers",
     needs: "",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, p, light)?)),
 };
 

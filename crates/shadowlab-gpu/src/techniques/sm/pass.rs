@@ -8,10 +8,11 @@ use shadowlab_core::lightspace::LightProjection;
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::ParamValues;
 
-use super::{count_image, depth_image, depth_source, eval_source, SmParams};
+use super::{depth_source, eval_source, SmParams};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::techniques::{view_layout, EvalPipelines, FrameInputs, TechniqueReport};
+use crate::technique::{view_layout, EvalPipelines, FrameInputs, TechniqueReport};
+use crate::techniques::pictures::{count_image, depth_image};
 use crate::{binding, raster, Gpu};
 
 impl SmParams {

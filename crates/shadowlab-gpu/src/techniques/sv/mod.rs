@@ -22,7 +22,7 @@ use shadowlab_core::params::{ParamDef, ParamValues};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::techniques::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::{binding, raster, Gpu, GpuError};
 use pipelines::{dispatch_1d, Pipelines, LIT_FORMAT};
 
@@ -74,6 +74,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: PARAMS,
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8); optional: DEPTH_CLIP_CONTROL (unclipped depth for the infinite extrusion) and DEPTH32FLOAT_STENCIL8, used where offered",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(ShadowVolumes::new(gpu, scene, p, light)?)),
 };
 

@@ -2,7 +2,7 @@
 //! (depth copy, volumes with two-sided stencil, stencil resolve).
 
 use crate::shaders::compose;
-use crate::techniques::{compose_view, view_layout};
+use crate::technique::{compose_view, view_layout};
 use crate::{binding, Gpu};
 
 const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");

@@ -35,7 +35,7 @@ use shadowlab_core::params::ParamValues;
 use crate::prefix_sum::PrefixSum;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
-use crate::techniques::{compose_view, view_layout, TechniqueInfo};
+use crate::technique::{compose_view, view_layout, TechniqueInfo};
 use crate::{binding, raster, Gpu, GpuError};
 
 const PARAMS_WGSL: &str = include_str!("params.wgsl");
@@ -84,6 +84,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     params: NOTW_OWN_PARAMS,
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Notw)?)),
 };
 
@@ -97,6 +98,7 @@ pub const RTW_INFO: TechniqueInfo = TechniqueInfo {
     params: RTW_PARAMS,
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Rtw)?)),
 };
 
@@ -110,6 +112,7 @@ pub const DV_INFO: TechniqueInfo = TechniqueInfo {
     params: DV_PARAMS,
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
+    compare: &[""],
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Dv)?)),
 };
 
@@ -180,7 +183,7 @@ pub struct Warped {
     split: [wgpu::ComputePipeline; 4],
     eval_layout: wgpu::BindGroupLayout,
     /// The evaluation and its analysis variant.
-    eval: crate::techniques::EvalPipelines,
+    eval: crate::technique::EvalPipelines,
     sampler: wgpu::Sampler,
 }
 
@@ -395,7 +398,7 @@ impl Warped {
             &format!("{name}.final_pass"),
             &[binding::uniform(), ro, tex, tex, binding::texture_depth(), binding::comparison_sampler(), rw],
         );
-        let eval = crate::techniques::EvalPipelines::new(gpu, &format!("{name}.final_pass"), &eval_src(), &eval_layout, &[]);
+        let eval = crate::technique::EvalPipelines::new(gpu, &format!("{name}.final_pass"), &eval_src(), &eval_layout, &[]);
         let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("warp.cmp"),
             compare: Some(wgpu::CompareFunction::LessEqual),

@@ -6,8 +6,8 @@ use shadowlab_core::warp::Warp2D;
 use super::{Variant, Warped};
 use crate::prefix_sum::ScanParams;
 use crate::record::Recorder;
-use crate::techniques::sm::{count_image, depth_image};
-use crate::techniques::{FrameInputs, NamedImage, Technique, TechniqueReport};
+use crate::technique::{FrameInputs, NamedImage, Technique, TechniqueReport};
+use crate::techniques::pictures::{count_image, depth_image};
 use crate::{raster, Gpu, GpuError};
 
 /// Signed picture of warp offsets (seed 000 Figure 4): yellow positive, blue negative, black 0.

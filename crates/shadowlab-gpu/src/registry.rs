@@ -1,0 +1,133 @@
+//! The one list of techniques: their registry entries, their shaders (with the shared
+//! passes', for the naga test) and spec resolution. Adding a technique means its folder under
+//! `techniques/` and one entry here (docs/adding-a-technique.md).
+
+use shadowlab_core::light::Light;
+use shadowlab_core::params::{ParamValues, TechniqueSpec};
+
+use crate::technique::TechniqueInfo;
+use crate::techniques::{csm, cube, dpsm, filtered, iasm, lt, mdsm, min_sm, sm, sv, warp};
+use crate::GpuError;
+
+/// Every technique, in listing order.
+pub static REGISTRY: &[&TechniqueInfo] = &[
+    &crate::reference::INFO,
+    &sm::INFO,
+    &sv::INFO,
+    &warp::RTW_INFO,
+    &warp::NOTW_INFO,
+    &warp::DV_INFO,
+    &min_sm::INFO,
+    &mdsm::INFO,
+    &filtered::VSM_INFO,
+    &filtered::ESM_INFO,
+    &filtered::EVSM_INFO,
+    &filtered::MSM_INFO,
+    &csm::INFO,
+    &iasm::INFO,
+    &cube::INFO,
+    &cube::NOTW_INFO,
+    &dpsm::INFO,
+    &dpsm::NOTW_INFO,
+    &lt::LT_INFO,
+    &lt::LTT_INFO,
+    &lt::HYBRID_INFO,
+];
+
+/// (file name, composed source) of every shader the crate uses: the shared passes' and every
+/// technique's, for the naga validation test.
+pub fn shaders() -> Vec<(&'static str, String)> {
+    let mut v = vec![];
+    v.extend(crate::gbuffer::shaders());
+    v.extend(crate::host::shaders());
+    v.extend(crate::reference::shaders());
+    v.extend(crate::shade::shaders());
+    v.extend(crate::reduce::shaders());
+    v.extend(crate::blur::shaders());
+    v.extend(crate::prefix_sum::shaders());
+    v.extend(sm::shaders());
+    v.extend(mdsm::shaders());
+    v.extend(sv::shaders());
+    v.extend(csm::shaders());
+    v.extend(iasm::shaders());
+    v.extend(filtered::shaders());
+    v.extend(min_sm::shaders());
+    v.extend(warp::shaders());
+    v.extend(cube::shaders());
+    v.extend(lt::shaders());
+    v
+}
+
+pub fn find(name: &str) -> Result<&'static TechniqueInfo, GpuError> {
+    REGISTRY.iter().copied().find(|t| t.name == name).ok_or_else(|| {
+        let names: Vec<_> = REGISTRY.iter().map(|t| t.name).collect();
+        GpuError::Invalid(format!("unknown technique '{name}' (known: {})", names.join(", ")))
+    })
+}
+
+/// A spec checked against the registry once: the technique, every parameter's value, the label.
+/// The CLI, the lab and the reports carry this; nothing resolves a spec twice.
+#[derive(Clone)]
+pub struct Resolved {
+    pub info: &'static TechniqueInfo,
+    pub values: ParamValues,
+    pub label: String,
+    /// The spec as the user wrote it.
+    pub text: String,
+}
+
+impl std::fmt::Debug for Resolved {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Resolved").field("technique", &self.info.name).field("values", &self.values).field("label", &self.label).finish()
+    }
+}
+
+impl Resolved {
+    /// Values already resolved against `info.params`, under `label`.
+    pub fn new(info: &'static TechniqueInfo, values: ParamValues, label: impl Into<String>) -> Resolved {
+        let label = label.into();
+        Resolved { info, values, text: label.clone(), label }
+    }
+
+    /// Whether the technique supports `light`'s type; the error names the types it supports.
+    pub fn check_light(&self, light: &Light) -> Result<(), GpuError> {
+        let info = self.info;
+        if info.lights.contains(&light.kind()) {
+            return Ok(());
+        }
+        Err(GpuError::Invalid(format!(
+            "technique '{}' does not support {} lights (it supports: {})",
+            info.name,
+            light.kind(),
+            info.lights.join(", ")
+        )))
+    }
+}
+
+/// Checks a spec against the registry without a GPU: its name, its parameters, and with
+/// `light` the light type.
+pub fn resolve(spec: &TechniqueSpec, light: Option<&Light>) -> Result<Resolved, GpuError> {
+    let info = find(&spec.name)?;
+    let values = spec.resolve(info.params).map_err(GpuError::Invalid)?;
+    let r = Resolved { info, values, label: spec.label(), text: spec.text.clone() };
+    if let Some(l) = light {
+        r.check_light(l)?;
+    }
+    Ok(r)
+}
+
+/// The reference `rt` as a resolved spec (it has no parameters).
+pub fn reference() -> Resolved {
+    Resolved { info: &crate::reference::INFO, values: ParamValues::default(), label: "rt".into(), text: "rt".into() }
+}
+
+/// The specs `compare` runs when given none: every registry entry's [`TechniqueInfo::compare`].
+pub fn default_compare() -> Vec<String> {
+    let mut v = Vec::new();
+    for t in REGISTRY {
+        for args in t.compare {
+            v.push(if args.is_empty() { t.name.to_string() } else { format!("{}:{args}", t.name) });
+        }
+    }
+    v
+}
