@@ -37,12 +37,7 @@ pub fn techniques() -> Result<()> {
             println!("  parameters: none");
         }
         for p in t.params {
-            let range = if p.choices.is_empty() {
-                format!("{}..{}{}", p.min, p.max, if p.integer { ", whole" } else { "" })
-            } else {
-                p.choices.join("|")
-            };
-            println!("  {:<14} default {:<8} [{range}]  {}  (source: {})", p.key, p.default_text(), p.doc, p.source);
+            println!("  {:<14} default {:<8} [{}]  {}  (source: {})", p.key, p.default_text(), p.range_text(), p.doc, p.source);
         }
         println!();
     }

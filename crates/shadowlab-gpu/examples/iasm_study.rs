@@ -12,11 +12,11 @@
 use glam::{Vec2, Vec3};
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera};
-use shadowlab_core::iasm::{self as core, Anchor};
 use shadowlab_core::metrics::{compare, flicker_pct};
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
 use shadowlab_core::setup::{SceneSource, Setup};
+use shadowlab_core::techniques::iasm::{self as core, Anchor};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::Gpu;

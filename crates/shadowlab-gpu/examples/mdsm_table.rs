@@ -7,10 +7,10 @@
 
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::loaders;
-use shadowlab_core::mdsm::{crossover_fragments, crossover_measured, distinct_values, max_distinct, DEFAULT_Q, PCF_TAPS};
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::setup::{SceneSource, Setup};
+use shadowlab_core::techniques::mdsm::{crossover_fragments, crossover_measured, distinct_values, max_distinct, DEFAULT_Q, PCF_TAPS};
 use shadowlab_gpu::lab::{Lab, Run};
 use shadowlab_gpu::Gpu;
 

@@ -8,9 +8,9 @@ use std::time::Instant;
 
 use glam::{DVec2, Vec3};
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::calipers::frustum::{light_frame, Reduction};
-use shadowlab_core::calipers::{convex_hull, min_area_rect};
 use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::techniques::min_sm::frustum::{light_frame, Reduction};
+use shadowlab_core::techniques::min_sm::{convex_hull, min_area_rect};
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::Gpu;
 

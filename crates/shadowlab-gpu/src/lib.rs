@@ -1,8 +1,9 @@
 //! shadowlab-gpu: the wgpu side of shadowlab.
 //!
 //! Data flows one way: [`scene_gpu::GpuScene`] (buffers, BVH) -> [`gbuffer`] (position, normal,
-//! albedo, motion, evaluation mask) -> a [`technique::Technique`] (one of [`registry::REGISTRY`]) (its shadow data, then a
-//! visibility buffer) -> [`reference`] `rt` visibility on the same samples -> [`shade`].
+//! albedo, motion, evaluation mask) -> a [`technique::Technique`], one of
+//! [`registry::REGISTRY`] (its shadow data, then a visibility buffer) -> [`reference`] `rt`
+//! visibility on the same samples -> [`shade`].
 //! [`lab::Lab`] runs that flow for one view and hands back what metrics and reports need.
 
 pub mod binding;

@@ -40,21 +40,17 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     let mut v = vec![];
     v.extend(crate::gbuffer::shaders());
     v.extend(crate::host::shaders());
-    v.extend(crate::reference::shaders());
     v.extend(crate::shade::shaders());
     v.extend(crate::reduce::shaders());
     v.extend(crate::blur::shaders());
     v.extend(crate::prefix_sum::shaders());
-    v.extend(sm::shaders());
-    v.extend(mdsm::shaders());
-    v.extend(sv::shaders());
-    v.extend(csm::shaders());
-    v.extend(iasm::shaders());
-    v.extend(filtered::shaders());
-    v.extend(min_sm::shaders());
-    v.extend(warp::shaders());
-    v.extend(cube::shaders());
-    v.extend(lt::shaders());
+    for t in REGISTRY {
+        for (name, src) in (t.shaders)() {
+            if !v.iter().any(|(n, _)| *n == name) {
+                v.push((name, src));
+            }
+        }
+    }
     v
 }
 

@@ -197,5 +197,8 @@ pub struct TechniqueInfo {
     /// `"pcf=3"` = `name:pcf=3`); empty: not in the default set (the reference, variants the
     /// default set already covers).
     pub compare: &'static [&'static str],
+    /// (file name, composed source) of the shaders it uses, for the naga validation test
+    /// (variants of one folder share the list).
+    pub shaders: fn() -> Vec<(&'static str, String)>,
     pub create: CreateFn,
 }

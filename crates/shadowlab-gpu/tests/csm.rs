@@ -1,9 +1,9 @@
 //! GPU tests of `csm` and of the min/max reduction it shares (lavapipe in CI).
 
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::cascades::{depth_range, practical_splits};
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::techniques::csm::{depth_range, practical_splits};
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::reduce::MinMax;
 

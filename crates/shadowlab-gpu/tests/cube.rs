@@ -1,11 +1,11 @@
 //! GPU tests of the point-light cube maps (`cube`, `cube-notw`) against the exact reference and
-//! against the CPU rules of `shadowlab_core::cube`.
+//! against the CPU rules of `shadowlab_core::techniques::cube`.
 
 use glam::Vec3;
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::cube::{face_of, project, tap_texel, texel_size};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::techniques::cube::{face_of, project, tap_texel, texel_size};
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::submit_frame;
@@ -63,7 +63,7 @@ fn cube_rejects_other_lights() {
     }
 }
 
-/// The GPU's lookup follows the CPU rules of `shadowlab_core::cube` on every pixel, in
+/// The GPU's lookup follows the CPU rules of `shadowlab_core::techniques::cube` on every pixel, in
 /// particular where the 3x3 PCF kernel crosses a face edge and reads the neighbour face.
 #[test]
 fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {

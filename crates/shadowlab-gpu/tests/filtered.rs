@@ -179,7 +179,7 @@ fn spot_light_maps_at_high_resolution_match_rt() {
     }
 }
 
-/// The WGSL of `moments.wgsl` (f32) against `shadowlab_core::moments` (f64) on random 2x2
+/// The WGSL of `moments.wgsl` (f32) against `shadowlab_core::techniques::filtered` (f64) on random 2x2
 /// regions: both the full form (moments interpolated on the CPU, stored as f32) and the
 /// single-depth gather form. Where the depths differ by at least 1e-3 the two must agree
 /// closely; with near-equal depths f32 cancellation in `E[z^2] - E[z]^2` dominates (that is what
@@ -189,7 +189,7 @@ const MSM_F32_TOLERANCE: f64 = 0.1;
 
 #[test]
 fn wgsl_moment_functions_match_the_cpu_math() {
-    use shadowlab_core::moments::*;
+    use shadowlab_core::techniques::filtered::*;
     use shadowlab_gpu::binding;
     let Some(gpu) = gpu() else { return };
     const KERNEL: &str = r#"

@@ -2,8 +2,8 @@
 
 use glam::Vec2;
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS};
 use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::techniques::iasm::{self as core, THESIS_RESOLUTIONS};
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::registry;
 use shadowlab_gpu::techniques::iasm::Iasm;

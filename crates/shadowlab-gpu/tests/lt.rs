@@ -4,11 +4,11 @@ use std::collections::BTreeSet;
 
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera};
-use shadowlab_core::leak::{BIT_LTT, BIT_RS};
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
+use shadowlab_core::techniques::lt::{BIT_LTT, BIT_RS};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::{submit_frame, Technique};
@@ -273,7 +273,8 @@ fn cascades_trace_the_last_level_and_reuse_the_others() {
         let prev = if f == 0 { cam } else { &cams[f - 1] };
         let v = lab.view(cam, prev, &light, 128, 128).unwrap();
         frame(&lab, &mut t, &v);
-        let splits = shadowlab_core::cascades::practical_splits(cam.near, cam.far, 4, shadowlab_core::cascades::DEFAULT_LAMBDA);
+        let splits =
+            shadowlab_core::techniques::csm::practical_splits(cam.near, cam.far, 4, shadowlab_core::techniques::csm::DEFAULT_LAMBDA);
         let mask = t.mask(&gpu);
         for (i, m) in mask.iter().enumerate() {
             if v.mask[i] != 0 && v.position[i][3] > splits[3] * 1.0001 {
@@ -450,7 +451,9 @@ fn point_light_uses_a_cube_map() {
     let Light::Point { position } = light else { unreachable!() };
     let faces: BTreeSet<usize> = (0..v.mask.len())
         .filter(|&i| v.mask[i] != 0)
-        .map(|i| shadowlab_core::leak::cube_face(glam::Vec3::new(v.position[i][0], v.position[i][1], v.position[i][2]) - position))
+        .map(|i| {
+            shadowlab_core::techniques::lt::cube_face(glam::Vec3::new(v.position[i][0], v.position[i][1], v.position[i][2]) - position)
+        })
         .collect();
     assert!(faces.len() >= 4, "view samples on faces {faces:?}");
     for spec in ["lt:res=512", "lt"] {

@@ -1,11 +1,11 @@
 //! GPU tests of `mdsm` (multiple-depth shadow maps, seed 003) against `sm`, `rt` and the CPU
-//! functions of shadowlab_core::mdsm.
+//! functions of shadowlab_core::techniques::mdsm.
 
 use glam::{Mat4, Vec3, Vec4};
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::mdsm::{distinct_values, max_distinct, pcf, pcf_offsets, region, select, Select};
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::techniques::mdsm::{distinct_values, max_distinct, pcf, pcf_offsets, region, select, Select};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::technique::submit_frame;
 use shadowlab_gpu::techniques::mdsm::{MultiDepthMap, INFO};
@@ -240,7 +240,7 @@ fn bad_parameters_are_clear_errors() {
 /// search region, the texel the most depths).
 #[test]
 fn wgsl_constants_match_core() {
-    use shadowlab_core::mdsm::{MAX_DEPTHS, SEARCH_SIZES};
+    use shadowlab_core::techniques::mdsm::{MAX_DEPTHS, SEARCH_SIZES};
     let all = shadowlab_gpu::registry::shaders();
     let select = &all.iter().find(|(n, _)| *n == "mdsm/select.wgsl").unwrap().1;
     let max_q = SEARCH_SIZES.iter().max().unwrap();

@@ -40,7 +40,7 @@ fn every_wgsl_file_is_composed_somewhere() {
                 stack.push(p);
             } else if p.extension().is_some_and(|x| x == "wgsl") {
                 let text = std::fs::read_to_string(&p).unwrap();
-                assert!(composed.contains(&text), "{} is not part of shaders::all(), so it is never validated", p.display());
+                assert!(composed.contains(&text), "{} is not part of registry::shaders(), so it is never validated", p.display());
                 seen += 1;
             }
         }
@@ -150,7 +150,7 @@ fn mdsm_params_layout_matches_wgsl() {
 
 #[test]
 fn sv_struct_layouts_match_rust() {
-    use shadowlab_core::edges::Edge;
+    use shadowlab_core::techniques::sv::Edge;
     use shadowlab_gpu::techniques::sv::SvParams;
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
@@ -262,13 +262,34 @@ fn warp_struct_layouts_match_rust() {
             "WarpParams",
             size_of::<WarpParams>(),
             &[
-                ("texel", offset_of!(WarpParams, texel)),
+                ("texel_world", offset_of!(WarpParams, texel_world)),
+                ("perspective", offset_of!(WarpParams, perspective)),
+                ("res", offset_of!(WarpParams, res)),
+                ("pcf", offset_of!(WarpParams, pcf)),
                 ("bias", offset_of!(WarpParams, bias)),
-                ("cfg", offset_of!(WarpParams, cfg)),
-                ("imp", offset_of!(WarpParams, imp)),
-                ("ints", offset_of!(WarpParams, ints)),
-                ("flags", offset_of!(WarpParams, flags)),
-                ("ext", offset_of!(WarpParams, ext)),
+                ("slope_bias", offset_of!(WarpParams, slope_bias)),
+                ("normal_offset", offset_of!(WarpParams, normal_offset)),
+                ("max_slope", offset_of!(WarpParams, max_slope)),
+                ("dv_margin", offset_of!(WarpParams, dv_margin)),
+                ("dv_mode", offset_of!(WarpParams, dv_mode)),
+                ("warped", offset_of!(WarpParams, warped)),
+                ("window", offset_of!(WarpParams, window)),
+                ("w_dv", offset_of!(WarpParams, w_dv)),
+                ("w_eye", offset_of!(WarpParams, w_eye)),
+                ("blur", offset_of!(WarpParams, blur)),
+                ("subdiv", offset_of!(WarpParams, subdiv)),
+                ("triangles", offset_of!(WarpParams, triangles)),
+                ("subdiv_levels", offset_of!(WarpParams, subdiv_levels)),
+                ("extra_capacity", offset_of!(WarpParams, extra_capacity)),
+                ("rtw_importance", offset_of!(WarpParams, rtw_importance)),
+                ("interp", offset_of!(WarpParams, interp)),
+                ("mix", offset_of!(WarpParams, mix)),
+                ("exact_depth", offset_of!(WarpParams, exact_depth)),
+                ("projection", offset_of!(WarpParams, projection)),
+                ("strength", offset_of!(WarpParams, strength)),
+                ("bias_mode", offset_of!(WarpParams, bias_mode)),
+                ("footprint_cap", offset_of!(WarpParams, footprint_cap)),
+                ("depth_clamp", offset_of!(WarpParams, depth_clamp)),
             ],
         );
     }

@@ -46,7 +46,7 @@ fn sv_agrees_with_rt_on_every_opaque_builtin_scene_and_light() {
 /// (shadowlab-core `edges`), for a directional, a spot and a point light.
 #[test]
 fn sv_silhouette_counts_match_the_cpu_edge_list() {
-    use shadowlab_core::edges::{facing, EdgeList};
+    use shadowlab_core::techniques::sv::{facing, EdgeList};
     let Some(gpu) = gpu() else { return };
     for (name, li) in [("courtyard", 0), ("room", 0), ("room", 1)] {
         let scene = builtin(name).unwrap();

@@ -5,7 +5,7 @@ use shadowlab_core::builtin::builtin;
 use shadowlab_core::lightspace;
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
-use shadowlab_core::warp;
+use shadowlab_core::techniques::warp;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::prefix_sum::{PrefixSum, ScanParams};
 use shadowlab_gpu::registry;

@@ -1,7 +1,7 @@
 //! Separable Gaussian blur in compute (shared plumbing): filterable shadow maps pre-filter their
 //! moments with it, and leak tracing can reuse it. Works on `R32Float`, `Rg32Float` and
 //! `Rgba32Float` textures (read as 4-channel floats, written in their own format). Kernel: odd
-//! width `k`, sigma = (k - 1) / 4 (`shadowlab_core::moments::gaussian_kernel`); `k = 1` is no blur.
+//! width `k`, sigma = (k - 1) / 4 (`shadowlab_core::techniques::filtered::gaussian_kernel`); `k = 1` is no blur.
 
 use bytemuck::{Pod, Zeroable};
 

@@ -1,6 +1,6 @@
 //! GPU prefix sums (inclusive scans) of many runs at once: the rows or the columns of a 2D map
 //! (warping functions of `notw`/`rtw`), or any strided runs of a buffer. `scan.wgsl`, one
-//! workgroup per run; the CPU reference is `shadowlab_core::warp::row_prefix`.
+//! workgroup per run; the CPU reference is `shadowlab_core::techniques::warp::row_prefix`.
 
 use bytemuck::{Pod, Zeroable};
 

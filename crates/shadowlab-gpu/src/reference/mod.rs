@@ -34,6 +34,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "9 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[],
+    shaders,
     create: |gpu, scene, _params, _light| Ok(Box::new(RayTraced::new(gpu, scene))),
 };
 

@@ -7,7 +7,7 @@
 //!
 //! Per frame: `prepare` (with `tighten`) reduces the G-buffer's linear depth to [min, max] on
 //! the GPU and reads it back (one device sync, timed as `csm.readback`), then fits the boxes to
-//! the view's camera on the CPU (`shadowlab_core::cascades`); `render` draws
+//! the view's camera on the CPU (`shadowlab_core::techniques::csm`); `render` draws
 //! the scene once per cascade; `evaluate` picks the cascade per pixel by view depth.
 
 mod params;
@@ -15,9 +15,9 @@ mod report;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use shadowlab_core::cascades::{self, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
+use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 
 pub use params::*;
 
@@ -47,6 +47,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         "with tighten=true (default): csm.readback, the view depth range read back before the fit; tighten=false, or delayed=true (the previous frame's range), records without a stall",
     needs: "",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, p, light)?)),
 };
 
@@ -134,7 +135,7 @@ impl Cascaded {
         let params = CsmParams {
             cascades: [CascadeU::zeroed(); MAX_CASCADES],
             cfg: [count as f32, res as f32, p.get("pcf") as f32, p.get("blend") as f32],
-            bias: [p.get("bias") as f32, p.get("normal_offset") as f32, MAX_SLOPE, 0.0],
+            bias: [p.get("bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32, 0.0],
         };
         let uniform = gpu.uniform("csm.params", &params);
         let depth_layout = binding::layout(d, "csm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
@@ -156,7 +157,7 @@ impl Cascaded {
             lambda: p.get("lambda") as f32,
             manual,
             snap: p.get_bool("snap"),
-            fit: if p.get_u32("fit") == 0 { Fit::Sphere } else { Fit::Box },
+            fit: if p.choice("fit") == "sphere" { Fit::Sphere } else { Fit::Box },
             tighten: p.get_bool("tighten"),
             delayed: (p.get_bool("tighten") && p.get_bool("delayed")).then(|| DelayedRead::new(gpu, "csm.delayed", PROBE_BYTES)),
             pcf: p.get_u32("pcf"),

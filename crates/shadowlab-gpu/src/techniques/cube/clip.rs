@@ -1,13 +1,13 @@
 //! cube-notw's per-face scenes: the scene's triangles clipped to each face's frustum (CPU,
-//! `shadowlab_core::cube::clip_to_face`), drawn with the scene's own materials and texels. The
+//! `shadowlab_core::techniques::cube::clip_to_face`), drawn with the scene's own materials and texels. The
 //! warped depth pass of `warp` moves each vertex by the warp of its projection, which is
 //! undefined for vertices behind the light; clipping at a near plane in front of it keeps every
 //! vertex inside the face's frustum. Done once per technique instance (static light, static
 //! triangles; moving triangles would need this per frame).
 
 use glam::Vec3;
-use shadowlab_core::cube::clip_to_face;
 use shadowlab_core::scene::Vertex;
+use shadowlab_core::techniques::cube::clip_to_face;
 
 use crate::scene_gpu::GpuScene;
 use crate::Gpu;

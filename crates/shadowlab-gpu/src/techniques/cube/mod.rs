@@ -5,7 +5,7 @@
 //!   per-face triangle culling in the vertex stage. Stored depth: linear distance to the light
 //!   divided by `far`, 0 at the light (so sm's bias model in texels behaves the same on every
 //!   face). Lookup: NxN nearest-texel PCF whose taps cross face edges onto the neighbour face.
-//!   The face math is `shadowlab_core::cube` (CPU, tested) and `faces.wgsl`.
+//!   The face math is `shadowlab_core::techniques::cube` (CPU, tested) and `faces.wgsl`.
 //! - `cube-notw` (notw.rs): NoTW per face: each face is a 90 degree square perspective frustum
 //!   (a spot light along the face axis) handled by `warp::Warped` with the face's view samples
 //!   only (its own desired view, count map and warps: 8 w^2 bytes per face).
@@ -16,18 +16,19 @@ pub use notw::CubeNotw;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use shadowlab_core::cube::{face_view_proj, FACES};
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::techniques::cube::{face_view_proj, FACES};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
 use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::techniques::pictures::{count_image, depth_image};
-use crate::techniques::sm::{BIAS, BIAS_WGSL, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
+use crate::techniques::sm::BIAS_WGSL;
 use crate::{binding, raster, Gpu, GpuError};
+use shadowlab_core::params::family::{BIAS, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
 
 const FACES_WGSL: &str = include_str!("faces.wgsl");
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
@@ -62,16 +63,7 @@ pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_
 /// conference light 1 and sponza-peer (1024x1024; res 512, pcf 3, res 1024): the same wrong %
 /// to three decimals on all four, `cube.render` 3-8x faster (docs/bench/recorded_frame.md).
 pub const DEFAULT_DEPTH: f64 = 1.0;
-pub const DEPTH: ParamDef = ParamDef {
-    key: "depth",
-    default: DEFAULT_DEPTH,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "face depth: distance (linear distance per fragment: a fragment shader on every fragment) or hardware (reversed near/z from the rasteriser, no fragment stage without cut-outs; distance recovered in the evaluation)",
-    source: "distance: seed 002 3.3.1; hardware: the NoTW authors' app (depth-only faces); measured in docs/bench/recorded_frame.md",
-    choices: &["distance", "hardware"],
-};
+pub const DEPTH: ParamDef = ParamDef::choice("depth", &["distance", "hardware"], DEFAULT_DEPTH as usize, "face depth: distance (linear distance per fragment: a fragment shader on every fragment) or hardware (reversed near/z from the rasteriser, no fragment stage without cut-outs; distance recovered in the evaluation)", "distance: seed 002 3.3.1; hardware: the NoTW authors' app (depth-only faces); measured in docs/bench/recorded_frame.md");
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "cube",
@@ -84,10 +76,11 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(CubeMap::new(gpu, scene, p, light)?)),
 };
 
-const W: &[ParamDef] = crate::techniques::warp::NOTW_PARAMS;
+use crate::techniques::warp as w;
 
 /// cube-notw's smoothing window (rows/columns averaged). notw's 16 bends shadow edges in the
 /// room (512 x 512 view, 256 per face: 1.04 % wrong at 16, 0.65 at 128, subdiv 2); too high
@@ -132,29 +125,29 @@ pub const DEFAULT_NOTW_BIAS_MODE: f64 = 0.0;
 const THREE_SETUPS: &str =
     "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md, point_quality.md)";
 
-const fn with_default(p: ParamDef, default: f64, source: &'static str) -> ParamDef {
-    ParamDef { default, source, ..p }
-}
-
-/// notw's parameters (same keys, order, ranges and docs), with the window, blur, mix, subdivision
-/// and normal offset defaults measured for cube faces (tests/cube.rs checks the keys against notw's).
+/// notw's parameters (same keys, order, ranges and docs), with the window, blur, mix, subdivision,
+/// normal offset and bias footprint defaults measured for cube faces (tests/cube.rs checks the
+/// keys against notw's).
 pub const NOTW_PARAMS: &[ParamDef] = &[
-    W[0],
-    with_default(W[1], DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"),
-    with_default(W[2], DEFAULT_NOTW_BLUR, THREE_SETUPS),
-    with_default(W[3], DEFAULT_NOTW_MIX, THREE_SETUPS),
-    W[4],
-    with_default(W[5], DEFAULT_NOTW_SUBDIV, THREE_SETUPS),
-    W[6],
-    W[7],
-    W[8],
-    W[9],
-    W[10],
-    W[11],
-    W[12],
-    with_default(W[13], DEFAULT_NOTW_NORMAL_OFFSET, THREE_SETUPS),
-    W[14],
-    with_default(crate::techniques::warp::BIAS_MODE, DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS),
+    w::RES,
+    w::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"),
+    w::NOTW_BLUR.with_default(DEFAULT_NOTW_BLUR, THREE_SETUPS),
+    w::MIX.with_default(DEFAULT_NOTW_MIX, THREE_SETUPS),
+    w::INTERP,
+    w::NOTW_SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, THREE_SETUPS),
+    w::SUBDIV_LEVELS,
+    w::CLOSE_CRACKS,
+    w::NOTW_EXACT,
+    w::PCF,
+    w::NOTW_BIAS,
+    w::SLOPE,
+    w::MAX_SLOPE,
+    w::NORMAL_OFFSET.with_default(DEFAULT_NOTW_NORMAL_OFFSET, THREE_SETUPS),
+    w::DV_MARGIN,
+    w::STRENGTH,
+    w::BIAS_MODE.with_default(DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS),
+    w::FOOTPRINT_CAP,
+    w::DEPTH_CLAMP,
 ];
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
@@ -168,6 +161,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "cube-notw.face_samples: the samples per face are read back to skip empty faces",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
 };
 
@@ -227,7 +221,7 @@ impl CubeMap {
         gpu.check_size(res, res, "cube face")?;
         let far = bounds_far(scene, pos);
         let near = (far * 1e-4).max(1e-5);
-        let hardware = p.get_u32("depth") == 1;
+        let hardware = p.choice("depth") == "hardware";
         let d = &gpu.device;
         let map = raster::depth_target(gpu, "cube.map", res, res, 6, wgpu::TextureUsages::empty());
         let face_layout = binding::layout(d, "cube.depth", wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
@@ -292,7 +286,7 @@ impl CubeMap {
             for (f, face) in faces.iter_mut().enumerate() {
                 for (i, v) in face.iter_mut().enumerate() {
                     let (x, y) = ((i % res) as f32 + 0.5, (i / res) as f32 + 0.5);
-                    let dc = shadowlab_core::cube::direction(f, x / res as f32, y / res as f32);
+                    let dc = shadowlab_core::techniques::cube::direction(f, x / res as f32, y / res as f32);
                     *v = if *v <= 0.0 { 1.0 } else { (self.near / *v * dc.length() / self.far).min(1.0) };
                 }
             }
@@ -432,7 +426,7 @@ fn static_face_lists(gpu: &Gpu, scene: &GpuScene, light: Vec3) -> Vec<(wgpu::Buf
             let idx: Vec<u32> = (0..scene.dynamic_first)
                 .filter(|&t| {
                     let v = &verts[3 * t as usize..3 * t as usize + 3];
-                    !shadowlab_core::cube::outside_face(&[v[0].pos.into(), v[1].pos.into(), v[2].pos.into()], light, f)
+                    !shadowlab_core::techniques::cube::outside_face(&[v[0].pos.into(), v[1].pos.into(), v[2].pos.into()], light, f)
                 })
                 .flat_map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
                 .collect();
@@ -475,7 +469,7 @@ fn face_pipeline(
         }),
         multisample: Default::default(),
         fragment: fragment.map(|entry| wgpu::FragmentState {
-            module: &module,
+            module,
             entry_point: Some(entry),
             compilation_options: options,
             targets: &[],

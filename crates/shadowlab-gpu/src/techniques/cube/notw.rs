@@ -8,10 +8,10 @@
 //! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
 //! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
 
-use shadowlab_core::cube::FACES;
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::ParamValues;
+use shadowlab_core::techniques::cube::FACES;
 
 use super::{clip, point_position, split_src};
 use crate::frame::LightUniform;

@@ -1,6 +1,6 @@
 //! Dual-paraboloid shadow maps for point lights (seed 002 section 3.3.2), two registry entries:
 //! - `dpsm`: two `res x res` depth maps, one per hemisphere of the split plane
-//!   (`shadowlab_core::paraboloid`: the plane through the light perpendicular to `split`, +Y by
+//!   (`shadowlab_core::techniques::dpsm`: the plane through the light perpendicular to `split`, +Y by
 //!   default), the paraboloid mapping of eq. 3.3-3.10 applied per vertex. The mapping is not
 //!   linear, so long edges are split first by the warping module's GPU subdivision
 //!   (warp/subdiv.wgsl, `subdiv` = largest bend in texels). Stored depth: linear, distance /
@@ -14,13 +14,13 @@
 
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::paraboloid::{split_axis, DualParaboloid, Hemisphere, SPLIT_AXES};
+use shadowlab_core::params::family;
 use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::techniques::dpsm::{split_axis, DualParaboloid, Hemisphere, SPLIT_AXES};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::techniques::sm;
 use crate::techniques::warp::{self, Projection, Variant, Warped};
 use crate::{Gpu, GpuError};
 
@@ -73,50 +73,26 @@ pub const DEFAULT_NOTW_NORMAL_OFFSET: f64 = 0.25;
 pub const DEFAULT_NOTW_BIAS_MODE: f64 = 0.0;
 pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
 
-pub const RES: ParamDef = ParamDef { default: DEFAULT_RES, doc: "side of each hemisphere's map (texels); two maps", ..sm::RES };
-pub const SPLIT: ParamDef = ParamDef {
-    key: "split",
-    default: DEFAULT_SPLIT,
-    min: 0.0,
-    max: 2.0,
-    integer: true,
-    doc: "axis of the front hemisphere: the split plane passes through the light perpendicular to it; pick one that keeps the seam off the important surfaces",
-    source: "seed 002 section 3.3.2 (the model-view matrix sets the split); y: shadowlab choice for indoor scenes",
-    choices: SPLIT_AXES,
-};
-const DPSM_SUBDIV: ParamDef = ParamDef {
-    default: DEFAULT_SUBDIV,
-    doc: "split triangles until the paraboloid mapping (and warp) bends no edge by more than this many texels from its rasterised chord; 0 = off (big triangles drawn as chords: wrong); low: many pieces",
-    source: "seed 002 section 3.3.2 (tessellation needed); value: shadowlab measurement (docs/bench/point.md)",
-    ..warp::SUBDIV
-};
-const NOTW_SUBDIV: ParamDef = ParamDef {
-    default: DEFAULT_NOTW_SUBDIV,
-    source: "shadowlab measurement on room, courtyard lantern, conference point lights (docs/bench/point.md, point_quality.md)",
-    ..DPSM_SUBDIV
-};
-const NOTW_BLUR: ParamDef = ParamDef {
-    default: DEFAULT_NOTW_BLUR,
-    source: "shadowlab measurement on room, courtyard lantern, conference point lights (docs/bench/point.md, point_quality.md)",
-    ..warp::NOTW_BLUR
-};
+pub const RES: ParamDef =
+    family::RES.with_default(DEFAULT_RES, family::RES.source).with_doc("side of each hemisphere's map (texels); two maps");
+pub const SPLIT: ParamDef = ParamDef::choice("split", SPLIT_AXES, DEFAULT_SPLIT as usize, "axis of the front hemisphere: the split plane passes through the light perpendicular to it; pick one that keeps the seam off the important surfaces", "seed 002 section 3.3.2 (the model-view matrix sets the split); y: shadowlab choice for indoor scenes");
+const DPSM_SUBDIV: ParamDef = warp::SUBDIV.with_default(DEFAULT_SUBDIV, "seed 002 section 3.3.2 (tessellation needed); value: shadowlab measurement (docs/bench/point.md)").with_doc("split triangles until the paraboloid mapping (and warp) bends no edge by more than this many texels from its rasterised chord; 0 = off (big triangles drawn as chords: wrong); low: many pieces");
+const NOTW_SUBDIV: ParamDef = DPSM_SUBDIV.with_default(
+    DEFAULT_NOTW_SUBDIV,
+    "shadowlab measurement on room, courtyard lantern, conference point lights (docs/bench/point.md, point_quality.md)",
+);
+const NOTW_BLUR: ParamDef = warp::NOTW_BLUR.with_default(
+    DEFAULT_NOTW_BLUR,
+    "shadowlab measurement on room, courtyard lantern, conference point lights (docs/bench/point.md, point_quality.md)",
+);
 const DPSM_BIAS: ParamDef =
-    ParamDef { default: DEFAULT_BIAS, source: "shadowlab sweep on room/conference point lights (docs/bench/point.md)", ..sm::BIAS };
-const NOTW_BIAS: ParamDef = ParamDef {
-    default: DEFAULT_NOTW_BIAS,
-    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)",
-    ..sm::BIAS
-};
-const NOTW_WINDOW: ParamDef = ParamDef {
-    default: DEFAULT_NOTW_WINDOW,
-    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)",
-    ..warp::WINDOW
-};
-const NOTW_NORMAL_OFFSET: ParamDef = ParamDef {
-    default: DEFAULT_NOTW_NORMAL_OFFSET,
-    source: "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)",
-    ..sm::NORMAL_OFFSET
-};
+    family::BIAS.with_default(DEFAULT_BIAS, "shadowlab sweep on room/conference point lights (docs/bench/point.md)");
+const NOTW_BIAS: ParamDef =
+    family::BIAS.with_default(DEFAULT_NOTW_BIAS, "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)");
+const NOTW_WINDOW: ParamDef =
+    warp::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)");
+const NOTW_NORMAL_OFFSET: ParamDef = family::NORMAL_OFFSET
+    .with_default(DEFAULT_NOTW_NORMAL_OFFSET, "shadowlab sweep on room, conference, courtyard lantern (docs/bench/point.md)");
 
 /// Exact depth per fragment (the fragment's direction intersected with its triangle's plane,
 /// through the inverted warp for `dpsm-notw`) instead of the depth interpolated along the chords
@@ -124,15 +100,23 @@ const NOTW_NORMAL_OFFSET: ParamDef = ParamDef {
 /// dpsm-notw at subdiv 0.25 0.537 -> 0.543) and it disables early depth tests; with fine
 /// subdivision the chords are short. See docs/bench/point.md.
 pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
-const EXACT: ParamDef = ParamDef {
-    default: DEFAULT_EXACT_DEPTH,
-    doc: "write the exact depth per fragment: the distance along the fragment's direction (warp inverted by Newton steps for dpsm-notw) to its triangle's plane; false = depth interpolated between (warped) vertices, off along chords of the paraboloid; disables early depth test",
-    source: "shadowlab (docs/bench/point.md)",
-    ..warp::EXACT_DEPTH
-};
+const EXACT: ParamDef = warp::EXACT_DEPTH.with_default(DEFAULT_EXACT_DEPTH, "shadowlab (docs/bench/point.md)").with_doc("write the exact depth per fragment: the distance along the fragment's direction (warp inverted by Newton steps for dpsm-notw) to its triangle's plane; false = depth interpolated between (warped) vertices, off along chords of the paraboloid; disables early depth test");
 
-pub const DPSM_PARAMS: &[ParamDef] =
-    &[RES, SPLIT, DPSM_SUBDIV, warp::SUBDIV_LEVELS, EXACT, sm::PCF, DPSM_BIAS, sm::SLOPE_BIAS, sm::MAX_SLOPE, sm::NORMAL_OFFSET];
+pub const DPSM_PARAMS: &[ParamDef] = &[
+    RES,
+    SPLIT,
+    DPSM_SUBDIV,
+    warp::SUBDIV_LEVELS,
+    EXACT,
+    family::PCF,
+    DPSM_BIAS,
+    family::SLOPE_BIAS,
+    family::MAX_SLOPE,
+    family::NORMAL_OFFSET,
+    warp::BIAS_MODE_ISOTROPIC,
+    warp::FOOTPRINT_CAP,
+    warp::DEPTH_CLAMP,
+];
 pub const NOTW_PARAMS: &[ParamDef] = &[
     RES,
     SPLIT,
@@ -142,18 +126,21 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     warp::INTERP,
     NOTW_SUBDIV,
     warp::SUBDIV_LEVELS,
+    warp::CLOSE_CRACKS,
     EXACT,
-    sm::PCF,
+    family::PCF,
     NOTW_BIAS,
-    sm::SLOPE_BIAS,
-    sm::MAX_SLOPE,
+    family::SLOPE_BIAS,
+    family::MAX_SLOPE,
     NOTW_NORMAL_OFFSET,
     warp::DV_MARGIN,
-    ParamDef {
-        default: DEFAULT_NOTW_BIAS_MODE,
-        source: "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point_quality.md)",
-        ..warp::BIAS_MODE
-    },
+    warp::STRENGTH,
+    warp::BIAS_MODE.with_default(
+        DEFAULT_NOTW_BIAS_MODE,
+        "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point_quality.md)",
+    ),
+    warp::FOOTPRINT_CAP,
+    warp::DEPTH_CLAMP,
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -167,6 +154,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     compare: &[""],
+    shaders: crate::techniques::warp::shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, false)?)),
 };
 
@@ -181,6 +169,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     compare: &[""],
+    shaders: crate::techniques::warp::shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, true)?)),
 };
 
@@ -203,7 +192,7 @@ impl Dpsm {
         if warped && p.get("window") >= res as f64 {
             return Err(GpuError::Invalid(format!("{name}: window {} must be below res {res}", p.get("window"))));
         }
-        let axis = split_axis(p.get_u32("split") as usize).ok_or_else(|| GpuError::Invalid(format!("{name}: bad split axis")))?;
+        let axis = split_axis(p.choice_index("split", SPLIT_AXES)).ok_or_else(|| GpuError::Invalid(format!("{name}: bad split axis")))?;
         let dp = DualParaboloid::fit(position, axis, &scene.bounds)
             .ok_or_else(|| GpuError::Invalid(format!("{name}: light position {position} or scene bounds not usable")))?;
         let labels: [&'static str; 2] = if warped { ["dpsm-notw.front", "dpsm-notw.back"] } else { ["dpsm.front", "dpsm.back"] };

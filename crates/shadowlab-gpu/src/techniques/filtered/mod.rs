@@ -15,14 +15,15 @@
 //! Stored depth: linear light-space depth in [0, 1], 0 = near the light (orthographic: the
 //! post-projective depth; spot: view depth / far, far = the farthest scene-bounds corner).
 //! Map formats: VSM RG32Float (8 B/texel), ESM R32Float (4), EVSM and MSM RGBA32Float (16),
-//! sd R32Float (4). The CPU math is `shadowlab_core::moments`.
+//! sd R32Float (4). The CPU math is `shadowlab_core::techniques::filtered`.
 
 mod mips;
 mod technique;
 
 use bytemuck::{Pod, Zeroable};
-use shadowlab_core::moments as cpu;
-use shadowlab_core::params::{ParamDef, BOOL};
+use shadowlab_core::params::family;
+use shadowlab_core::params::ParamDef;
+use shadowlab_core::techniques::filtered as cpu;
 
 use crate::shaders::compose;
 use crate::technique::{compose_view, TechniqueInfo};
@@ -80,86 +81,59 @@ pub const DEFAULT_BLUR: f64 = 1.0;
 pub const DEFAULT_BIAS: f64 = 0.0;
 pub const DEFAULT_NORMAL_OFFSET: f64 = 0.0;
 
-const fn p(key: &'static str, default: f64, min: f64, max: f64, integer: bool, doc: &'static str, source: &'static str) -> ParamDef {
-    ParamDef { key, default, min, max, integer, doc, source, choices: &[] }
-}
-
-const RES: ParamDef = p("res", 512.0, 16.0, 16384.0, true, "shadow map side (texels)", "seeds' evaluation: 512 with 1024x1024 output");
-const BLUR: ParamDef = p(
+const RES: ParamDef = family::RES.with_doc("shadow map side (texels)");
+const BLUR: ParamDef = ParamDef::integer(
     "blur",
     DEFAULT_BLUR,
     1.0,
     15.0,
-    true,
     "Gaussian pre-filter kernel width (odd; 1 = none; sigma = (width-1)/4); ignored with sd=true; high: wider leaks and softer edges",
     "seed 004 section 2.1 eq. 2; default: shadowlab measurement (docs/bench/filtered.md)",
 );
-const SD: ParamDef = ParamDef {
-    key: "sd",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "single depth: store linear depth only (R32Float), gather 2x2 and convert in the shader",
-    source: "seed 004 section 3.2",
-    choices: BOOL,
-};
-const MIPS: ParamDef = ParamDef {
-    key: "mips",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "box-filtered mip chain (+1/3 memory) read trilinearly at the pixel's footprint; ignored with sd=true; softer, wider leaks where texels are small on screen",
-    source: "Donnelly and Lauritzen 2006 (filtering with mipmaps); issue 5",
-    choices: BOOL,
-};
-const BIAS: ParamDef = p(
-    "bias",
-    DEFAULT_BIAS,
-    0.0,
-    100.0,
+const SD: ParamDef = ParamDef::flag(
+    "sd",
     false,
-    "constant depth bias, texels; high: peter-panning",
-    "shadowlab measurement (docs/bench/filtered.md)",
+    "single depth: store linear depth only (R32Float), gather 2x2 and convert in the shader",
+    "seed 004 section 3.2",
 );
-const NORMAL_OFFSET: ParamDef = p(
-    "normal_offset",
-    DEFAULT_NORMAL_OFFSET,
-    0.0,
-    100.0,
-    false,
-    "offset along the normal, texels; low: self-shadowing on curved/grazing receivers, high: shifted shadows",
-    "Holbert 2011; value: shadowlab measurement (docs/bench/filtered.md)",
-);
-const MIN_VARIANCE: ParamDef = p(
+const MIPS: ParamDef = ParamDef::flag("mips", false, "box-filtered mip chain (+1/3 memory) read trilinearly at the pixel's footprint; ignored with sd=true; softer, wider leaks where texels are small on screen", "Donnelly and Lauritzen 2006 (filtering with mipmaps); issue 5");
+const BIAS: ParamDef = family::BIAS
+    .with_default(DEFAULT_BIAS, "shadowlab measurement (docs/bench/filtered.md)")
+    .with_doc("constant depth bias, texels; high: peter-panning");
+const NORMAL_OFFSET: ParamDef = family::NORMAL_OFFSET
+    .with_default(DEFAULT_NORMAL_OFFSET, "Holbert 2011; value: shadowlab measurement (docs/bench/filtered.md)")
+    .with_doc("offset along the normal, texels; low: self-shadowing on curved/grazing receivers, high: shifted shadows");
+const MIN_VARIANCE: ParamDef = ParamDef::number(
     "min_variance",
     cpu::DEFAULT_MIN_VARIANCE,
     0.0,
     1.0,
-    false,
     "minimum variance (depth units^2; EVSM: scaled by each warp's slope); low: acne, high: leaks",
     "seed 004 section 4 (1e-10)",
 );
-const ESM_C: ParamDef =
-    p("c", cpu::DEFAULT_ESM_C, 0.0, 88.0, false, "ESM exponent; low: leaks near contact, > 88: f32 overflow", "seed 004 section 4 (80)");
-const C_POS: ParamDef = p(
+const ESM_C: ParamDef = ParamDef::number(
+    "c",
+    cpu::DEFAULT_ESM_C,
+    0.0,
+    88.0,
+    "ESM exponent; low: leaks near contact, > 88: f32 overflow",
+    "seed 004 section 4 (80)",
+);
+const C_POS: ParamDef = ParamDef::number(
     "c_pos",
     cpu::DEFAULT_EVSM_C_POS,
     0.0,
     42.0,
-    false,
     "EVSM positive exponent (depth in [-1,1]); high: f32 overflow of e^{2c}",
     "seed 004 section 4 (20)",
 );
 const C_NEG: ParamDef =
-    p("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, false, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
-const MOMENT_BIAS: ParamDef = p(
+    ParamDef::number("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
+const MOMENT_BIAS: ParamDef = ParamDef::number(
     "moment_bias",
     cpu::DEFAULT_MOMENT_BIAS,
     0.0,
     1.0,
-    false,
     "MSM blend of the moments towards 0.5; low: unstable (singular Hankel matrix), high: leaks",
     "seed 004 section 4 (3e-6 with 32-bit floats)",
 );
@@ -183,6 +157,7 @@ pub const VSM_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Vsm)?)),
 };
 pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
@@ -196,6 +171,7 @@ pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "",
     compare: &[],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Esm)?)),
 };
 pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
@@ -209,6 +185,7 @@ pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "",
     compare: &["", "sd=true"],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Evsm)?)),
 };
 pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
@@ -222,6 +199,7 @@ pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Msm)?)),
 };
 

@@ -3,8 +3,8 @@
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::moments as cpu;
 use shadowlab_core::params::ParamValues;
+use shadowlab_core::techniques::filtered as cpu;
 
 use super::mips::{self, MipChain};
 use super::{eval_source, render_source, FilteredParams, Kind};
@@ -37,10 +37,6 @@ pub struct Filtered {
     sampler: wgpu::Sampler,
 }
 
-fn get(p: &ParamValues, key: &str, default: f64) -> f64 {
-    p.0.get(key).copied().unwrap_or(default)
-}
-
 impl Filtered {
     pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, kind: Kind) -> Result<Filtered, GpuError> {
         let name = kind.name();
@@ -61,14 +57,16 @@ impl Filtered {
             }
             _ => 0.0,
         };
-        let (c, c_pos, c_neg) =
-            (get(p, "c", cpu::DEFAULT_ESM_C), get(p, "c_pos", cpu::DEFAULT_EVSM_C_POS), get(p, "c_neg", cpu::DEFAULT_EVSM_C_NEG));
+        // each kind reads what it declares (mod.rs); the shaders read no slot left at 0
+        let num = |key: &str, used: bool| if used { p.get(key) } else { 0.0 };
+        let (vsm, esm, evsm, msm) = (kind == Kind::Vsm, kind == Kind::Esm, kind == Kind::Evsm, kind == Kind::Msm);
+        let (c, c_pos, c_neg) = (num("c", esm), num("c_pos", evsm), num("c_neg", evsm));
         let params = FilteredParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
             texel: [lp.texel, lp.perspective as u32 as f32, res as f32, inv_far],
             mode: [kind as u32, sd as u32, levels, 0],
-            shape: [get(p, "min_variance", cpu::DEFAULT_MIN_VARIANCE) as f32, c as f32, c_pos as f32, c_neg as f32],
-            bias: [get(p, "moment_bias", cpu::DEFAULT_MOMENT_BIAS) as f32, p.get("bias") as f32, p.get("normal_offset") as f32, 0.0],
+            shape: [num("min_variance", vsm || evsm) as f32, c as f32, c_pos as f32, c_neg as f32],
+            bias: [num("moment_bias", msm) as f32, p.get("bias") as f32, p.get("normal_offset") as f32, 0.0],
         };
         // the map's clear value: b(1), the farthest depth
         let far: [f64; 4] = match (sd, kind) {

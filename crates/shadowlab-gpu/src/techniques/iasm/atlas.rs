@@ -1,9 +1,9 @@
 //! `store=atlas`, the conventional alternative to the linear buffer (issue 6): the same tiles,
 //! frusta and depths as squares of one Depth32Float atlas (buddy-packed by rank, see
-//! `shadowlab_core::iasm::atlas_layout`), rendered with the hardware depth test and read with
+//! `shadowlab_core::techniques::iasm::atlas_layout`), rendered with the hardware depth test and read with
 //! `textureLoad` in eval_atlas.wgsl.
 
-use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
+use shadowlab_core::techniques::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::gpu::Iasm;
 use super::{eval_atlas_src, ATLAS_WGSL};

@@ -4,9 +4,9 @@
 //! `iasm.shadows.clear`, `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
 
 use glam::Vec3;
-use shadowlab_core::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
+use shadowlab_core::techniques::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::atlas::{make_atlas, Atlas};
 use super::chunks::chunk_bounds;
@@ -129,7 +129,8 @@ impl Iasm {
         let eval = gpu.compute_pipeline("iasm.evaluate", &eval_src(), "main", &[&eval_layout]);
         let eval_count = gpu.compute_pipeline_with("iasm.evaluate", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
-        let atlas = (p.get_u32("store") == 1).then(|| make_atlas(gpu, &[&render_layout, &scene.layout], scene.has_cutouts)).transpose()?;
+        let atlas =
+            (p.choice("store") == "atlas").then(|| make_atlas(gpu, &[&render_layout, &scene.layout], scene.has_cutouts)).transpose()?;
         Ok(Iasm {
             m: p.get("m") as f32,
             k: p.get("k") as f32,
@@ -138,7 +139,7 @@ impl Iasm {
             normal_offset: p.get("normal_offset") as f32,
             delayed: p.get_bool("delayed"),
             snap: p.get_bool("snap"),
-            anchor: if p.get_u32("anchor") == 1 { Anchor::TileCentre } else { Anchor::Circle },
+            anchor: if p.choice("anchor") == "tile" { Anchor::TileCentre } else { Anchor::Circle },
             chunk,
             triangles,
             light_dir: direction,

@@ -1,8 +1,8 @@
 //! `iasm` report: memory, per-tile counters, sampling statistics, and two pictures (the tiles'
 //! depth as a 4x4 mosaic at a common size, and the tile resolutions with their importance).
 
-use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 use shadowlab_core::metrics::sampling_stats;
+use shadowlab_core::techniques::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::gpu::Iasm;
 use crate::technique::{NamedImage, TechniqueReport};

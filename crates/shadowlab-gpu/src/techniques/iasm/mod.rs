@@ -9,7 +9,7 @@
 //! 3.2-3.5. Depth z = (light depth - near_t) / (far_t - near_t), linear, 0 = the tile's near
 //! plane (nearest the light); the buffer stores the bits of 1 - z (cleared 0 reads z = 1), the
 //! atlas stores z (cleared to 1). A cleared texel is lit.
-//! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::iasm`.
+//! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::techniques::iasm`.
 
 mod atlas;
 mod chunks;
@@ -18,11 +18,11 @@ mod images;
 mod plan;
 
 use bytemuck::{Pod, Zeroable};
-use shadowlab_core::params::{ParamDef, BOOL};
+use shadowlab_core::params::family;
+use shadowlab_core::params::ParamDef;
 
 use crate::shaders::{compose, compose_depth};
 use crate::technique::{compose_view, TechniqueInfo};
-use crate::techniques::sm;
 
 pub use gpu::Iasm;
 
@@ -74,10 +74,10 @@ pub const DEFAULT_K: f64 = 0.0;
 /// Too small: geometry ahead falls outside (lit); too large: coarse tiles.
 pub const DEFAULT_SIZE: f64 = 0.0;
 /// Constant bias in texels of the tile (as `sm`); 0.5 from `sm`'s sweep.
-pub const DEFAULT_BIAS: f64 = sm::DEFAULT_BIAS;
+pub const DEFAULT_BIAS: f64 = family::DEFAULT_BIAS;
 /// Normal offset in texels of the tile (as `sm`); 0.5 from `sm`'s sweep; low: acne at grazing
 /// light, high: shifted shadows.
-pub const DEFAULT_NORMAL_OFFSET: f64 = sm::DEFAULT_NORMAL_OFFSET;
+pub const DEFAULT_NORMAL_OFFSET: f64 = family::DEFAULT_NORMAL_OFFSET;
 /// Where the tiles' depth lives: 0 = buffer (the thesis's linear storage buffer, exactly the
 /// set's 6,860,800 bytes, fragments write by atomic max: no early depth test), 1 = atlas (the
 /// same tiles in a 2048 x 1024 Depth32Float atlas, 8,388,608 bytes, hardware depth test). The
@@ -89,106 +89,16 @@ pub const DEFAULT_STORE: f64 = 1.0;
 pub const DEFAULT_CHUNK: f64 = 256.0;
 
 pub const PARAMS: &[ParamDef] = &[
-    ParamDef {
-        key: "m",
-        default: DEFAULT_M,
-        min: 0.0,
-        max: 1000.0,
-        integer: false,
-        doc: "importance weight of near samples, p = 1 + m clamp(1 - w/k, 0, 1)",
-        source: "seed 001 eq. 3.1 (no value given; shadowlab choice)",
-        choices: &[],
-    },
-    ParamDef {
-        key: "k",
-        default: DEFAULT_K,
-        min: 0.0,
-        max: 1e6,
-        integer: false,
-        doc: "importance range (world units); 0 = half the light square's side",
-        source: "seed 001 eq. 3.1 (no value given; shadowlab choice)",
-        choices: &[],
-    },
-    ParamDef {
-        key: "size",
-        default: DEFAULT_SIZE,
-        min: 0.0,
-        max: 1e6,
-        integer: false,
-        doc: "side of the light square (world units); 0 = scene extent across the light",
-        source: "seed 001 ch. 5: sides chosen to encompass all geometry",
-        choices: &[],
-    },
-    ParamDef {
-        key: "bias",
-        default: DEFAULT_BIAS,
-        min: 0.0,
-        max: 100.0,
-        integer: false,
-        doc: "constant depth bias, texels of the sample's tile; low: acne, high: peter-panning",
-        source: "sm's sweep 2026-11-22",
-        choices: &[],
-    },
-    ParamDef {
-        key: "normal_offset",
-        default: DEFAULT_NORMAL_OFFSET,
-        min: 0.0,
-        max: 100.0,
-        integer: false,
-        doc: "offset along the normal, texels of the sample's tile",
-        source: "Holbert 2011; sm's sweep 2026-11-22",
-        choices: &[],
-    },
-    ParamDef {
-        key: "delayed",
-        default: 0.0,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "use the previous frame's importance and near/far planes (no readback stall)",
-        source: "seed 001 4.3, deferred delayed IASM",
-        choices: BOOL,
-    },
-    ParamDef {
-        key: "snap",
-        default: 1.0,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "move the square in steps of the coarsest texel (tile/16) so texel grids do not shimmer",
-        source: "shadowlab addition (not in seed 001)",
-        choices: BOOL,
-    },
-    ParamDef {
-        key: "anchor",
-        default: 0.0,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "circle: camera on the inscribed circle (Fig. 3.1); tile: then shifted so the camera sits at a tile centre (no four-tile corner at the camera)",
-        source: "seed 001 3.2 / ch. 5 suggested fix",
-        choices: &["circle", "tile"],
-    },
-    ParamDef {
-        key: "store",
-        default: DEFAULT_STORE,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)",
-        source: "seed 001 3.2/3.5; default = the faster on lavapipe (docs/bench/iasm.md)",
-        choices: &["buffer", "atlas"],
-    },
-    ParamDef {
-        key: "chunk",
-        default: DEFAULT_CHUNK,
-        min: 1.0,
-        max: 1e7,
-        integer: true,
-        doc: "triangles per culling chunk (vertex order)",
-        source: "shadowlab choice; seed 001 4.3: culling decides the cost",
-        choices: &[],
-    },
+    ParamDef::number("m", DEFAULT_M, 0.0, 1000.0, "importance weight of near samples, p = 1 + m clamp(1 - w/k, 0, 1)", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
+    ParamDef::number("k", DEFAULT_K, 0.0, 1e6, "importance range (world units); 0 = half the light square's side", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
+    ParamDef::number("size", DEFAULT_SIZE, 0.0, 1e6, "side of the light square (world units); 0 = scene extent across the light", "seed 001 ch. 5: sides chosen to encompass all geometry"),
+    family::BIAS.with_doc("constant depth bias, texels of the sample's tile; low: acne, high: peter-panning"),
+    family::NORMAL_OFFSET.with_doc("offset along the normal, texels of the sample's tile"),
+    ParamDef::flag("delayed", false, "use the previous frame's importance and near/far planes (no readback stall)", "seed 001 4.3, deferred delayed IASM"),
+    ParamDef::flag("snap", true, "move the square in steps of the coarsest texel (tile/16) so texel grids do not shimmer", "shadowlab addition (not in seed 001)"),
+    ParamDef::choice("anchor", &["circle", "tile"], 0, "circle: camera on the inscribed circle (Fig. 3.1); tile: then shifted so the camera sits at a tile centre (no four-tile corner at the camera)", "seed 001 3.2 / ch. 5 suggested fix"),
+    ParamDef::choice("store", &["buffer", "atlas"], DEFAULT_STORE as usize, "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)", "seed 001 3.2/3.5; default = the faster on lavapipe (docs/bench/iasm.md)"),
+    ParamDef::integer("chunk", DEFAULT_CHUNK, 1.0, 1e7, "triangles per culling chunk (vertex order)", "shadowlab choice; seed 001 4.3: culling decides the cost"),
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -203,6 +113,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "iasm.readback: the tile statistics are read back for the plan; delayed=true plans with the previous frame's, read back without a stall (a sync only on the first frame, or when the previous frame has not finished)",
     needs: "",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, p, light)?)),
 };
 

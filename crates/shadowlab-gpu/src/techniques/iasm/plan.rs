@@ -1,9 +1,9 @@
 //! The per-frame plan of `iasm` from the analysis read back (thesis 3.4, 3.5): empty tiles,
 //! per-tile near/far planes (the receivers' depth range, extended towards the light to every
 //! chunk over the tile), culled draws, ranking, resolutions and offsets. The decisions
-//! themselves are `shadowlab_core::iasm`'s; this glues them to the GPU readback.
+//! themselves are `shadowlab_core::techniques::iasm`'s; this glues them to the GPU readback.
 
-use shadowlab_core::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
+use shadowlab_core::techniques::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::gpu::Iasm;
 

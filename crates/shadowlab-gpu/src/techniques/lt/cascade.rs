@@ -1,12 +1,12 @@
 //! Leak tracing's map levels: one whole-scene (or spot) map, or the hybrid cascades of a
-//! directional light with the reuse of seed 004 section 3.3 (`shadowlab_core::leak::reuse_box`,
+//! directional light with the reuse of seed 004 section 3.3 (`shadowlab_core::techniques::lt::reuse_box`,
 //! `reusable`): per frame the slices are fitted, each kept box is reused while it still holds
 //! its slice, else replaced by the enlarged fit and its layer marked for re-rendering.
 
 use glam::Vec3;
-use shadowlab_core::cascades::{self, CascadeBox, Fit, ViewFrustum};
-use shadowlab_core::leak;
 use shadowlab_core::scene::Bounds;
+use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFrustum};
+use shadowlab_core::techniques::lt as leak;
 
 use super::{LevelU, LtParams};
 use crate::technique::FrameInputs;

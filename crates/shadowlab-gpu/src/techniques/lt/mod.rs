@@ -24,12 +24,12 @@
 //! more than `depth_tol` (relative) or the normals differ by more than `normal_cos`; that needs
 //! 8 bytes per pixel of history (view depth + packed normal, ping-pong).
 //! Stored depth: linear light-space depth in [0, 1], 0 = near the light (filtered/'s `sd`
-//! maps, rendered with its render.wgsl). CPU half: `shadowlab_core::leak`.
+//! maps, rendered with its render.wgsl). CPU half: `shadowlab_core::techniques::lt`.
 //! Directional lights (`cascades` > 1, default 4): the view frustum split with the practical
 //! scheme, cascades 0..n-2 hybrid with maps fitted to their slices, enlarged by 15 % and
 //! re-rendered only when this frame's slice leaves the kept box (section 3.3); the last
 //! cascade is ray traced. `cascades=1`: one map fitted to the scene bounds. Spot: one map.
-//! Point: one cube map of six layers (`shadowlab_core::leak::cube_faces`: 90 degree faces
+//! Point: one cube map of six layers (`shadowlab_core::techniques::lt::cube_faces`: 90 degree faces
 //! widened by a texel, linear depth along the face axis), the face chosen per pixel by the
 //! dominant axis, then the same 2x2 gather as a spot map (no gather across faces).
 
@@ -39,9 +39,10 @@ mod report;
 mod screen;
 
 use bytemuck::{Pod, Zeroable};
-use shadowlab_core::leak;
-use shadowlab_core::moments as cpu;
-use shadowlab_core::params::{ParamDef, BOOL};
+use shadowlab_core::params::family;
+use shadowlab_core::params::ParamDef;
+use shadowlab_core::techniques::filtered as cpu;
+use shadowlab_core::techniques::lt as leak;
 
 use crate::reference::TRACE_WGSL;
 use crate::technique::{compose_view, TechniqueInfo};
@@ -78,7 +79,7 @@ impl Mode {
 
 /// Hybrid map levels at most (cascades 0-2; a 4th cascade is ray traced, seed 004 section 4).
 pub const MAX_LEVELS: usize = 3;
-/// Map layers at most: a point light's six cube faces (`shadowlab_core::leak::cube_faces`).
+/// Map layers at most: a point light's six cube faces (`shadowlab_core::techniques::lt::cube_faces`).
 pub const MAX_MAPS: usize = 6;
 
 /// WGSL `Level` (classify.wgsl): one cascade or the whole map.
@@ -130,40 +131,23 @@ pub const DEFAULT_NORMAL_COS: f64 = 0.9;
 pub const DEFAULT_PCF_BIAS: f64 = 0.5;
 pub const DEFAULT_PCF_NORMAL_OFFSET: f64 = 0.5;
 
-const fn p(key: &'static str, default: f64, min: f64, max: f64, doc: &'static str, source: &'static str) -> ParamDef {
-    ParamDef { key, default, min, max, integer: false, doc, source, choices: &[] }
-}
-const fn flag(key: &'static str, default: bool, doc: &'static str, source: &'static str) -> ParamDef {
-    ParamDef { key, default: default as u32 as f64, min: 0.0, max: 1.0, integer: true, doc, source, choices: BOOL }
-}
-
 /// Map side per cascade: the authors' 2048 (seed 004 section 4). Measured (docs/bench/lt.md,
 /// 1024x1024, foliage / sponza paths): 512 -> 2048 lowers the wrong pixels 0.078 -> 0.022 % /
 /// 0.013 -> 0.007 % and the rays by 26 % / 34 % at about the same time (the cascades are
 /// re-rendered rarely), for 48 MiB of maps instead of 3. Too low: wide uncertain bands (rays)
 /// and sub-texel casters missing from the map (wrong pixels the mask cannot find).
 pub const DEFAULT_RES: f64 = 2048.0;
-const RES: ParamDef = ParamDef {
-    key: "res",
-    default: DEFAULT_RES,
-    min: 16.0,
-    max: 16384.0,
-    integer: true,
-    doc: "shadow map side (texels, per cascade / spot map / cube face); low: more rays (wider uncertain bands) and missed thin occluders/gaps",
-    source: "seed 004 section 4 (2048 per cascade); shadowlab measurement (docs/bench/lt.md)",
-    choices: &[],
-};
-const BASE: ParamDef = ParamDef {
-    key: "base",
-    default: 2.0,
-    min: 0.0,
-    max: 3.0,
-    integer: true,
-    doc: "filterable representation rebuilt from the gathered depths: vsm, esm, evsm, msm",
-    source: "seed 004 section 4.1 (EVSM fastest, VSM close; ESM/MSM need more rays)",
-    choices: &["vsm", "esm", "evsm", "msm"],
-};
-const EPS: ParamDef = p(
+const RES: ParamDef = family::RES.with_default(DEFAULT_RES, "seed 004 section 4 (2048 per cascade); shadowlab measurement (docs/bench/lt.md)").with_doc("shadow map side (texels, per cascade / spot map / cube face); low: more rays (wider uncertain bands) and missed thin occluders/gaps");
+/// `base`'s names, in the order of the shaders' mode numbers (filtered's `Kind`).
+pub const BASES: &[&str] = &["vsm", "esm", "evsm", "msm"];
+const BASE: ParamDef = ParamDef::choice(
+    "base",
+    BASES,
+    2,
+    "filterable representation rebuilt from the gathered depths: vsm, esm, evsm, msm",
+    "seed 004 section 4.1 (EVSM fastest, VSM close; ESM/MSM need more rays)",
+);
+const EPS: ParamDef = ParamDef::number(
     "eps",
     leak::DEFAULT_EPS,
     0.0,
@@ -176,31 +160,31 @@ const EPS: ParamDef = p(
 /// frame 8 from 0.003 % to 0.11 % (courtyard) and 0.18 % to 0.30 % (foliage), at no measurable
 /// time gain. The paper uses it (1.05x speed-up, seed 004 table 3).
 pub const DEFAULT_RR: bool = false;
-const RR: ParamDef = flag(
+const RR: ParamDef = ParamDef::flag(
     "rr",
     DEFAULT_RR,
     "remove rays (eq. 8) where all reprojected neighbours confirmed the shadow test (removed rays snap to the test); on: fewer rays, edges that move under the camera can be lost",
     "seed 004 section 3.1.2 (on); default off: shadowlab measurement (docs/bench/lt.md)",
 );
-const REUSE: ParamDef = flag(
+const REUSE: ParamDef = ParamDef::flag(
     "reuse",
     true,
     "reuse the static maps: a cascade's enlarged map until its slice leaves it, the whole-scene/spot map forever (fixed light); off: every map refitted and re-rendered each frame",
     "seed 004 sections 3.3-3.4",
 );
-const FULL: ParamDef = flag(
+const FULL: ParamDef = ParamDef::flag(
     "full",
     false,
     "full 3x3 neighbourhood every frame instead of the jittered 2x2 that covers 3x3 over 4 frames",
     "seed 004 section 3.1.1 (2x2 jitter as good, cheaper)",
 );
-const HISTORY_TEST: ParamDef = flag(
+const HISTORY_TEST: ParamDef = ParamDef::flag(
     "history_test",
     true,
     "reprojection also fails (forcing a ray) where last frame's depth or normal differs (disocclusion); includes section 3.1.2's temporal depth test; off: only off-screen fails",
     "seed 004 sections 3.1 and 3.1.2 (temporal depth test)",
 );
-const DEPTH_TOL: ParamDef = p(
+const DEPTH_TOL: ParamDef = ParamDef::number(
     "depth_tol",
     DEFAULT_DEPTH_TOL,
     0.0,
@@ -208,7 +192,7 @@ const DEPTH_TOL: ParamDef = p(
     "relative view-depth tolerance of the reprojection test; low: rays on grazing surfaces, high: disocclusions reuse stale bits",
     "shadowlab choice (not in the paper)",
 );
-const NORMAL_COS: ParamDef = p(
+const NORMAL_COS: ParamDef = ParamDef::number(
     "normal_cos",
     DEFAULT_NORMAL_COS,
     -1.0,
@@ -216,19 +200,17 @@ const NORMAL_COS: ParamDef = p(
     "minimum cosine between current and last frame's normal in the reprojection test",
     "shadowlab choice (not in the paper)",
 );
-/// `shadowlab_core::cascades::DEFAULT_LAMBDA` (an f32) as written: the authors' 0.85.
+/// `shadowlab_core::techniques::csm::DEFAULT_LAMBDA` (an f32) as written: the authors' 0.85.
 pub const DEFAULT_LAMBDA: f64 = 0.85;
-const CASCADES: ParamDef = ParamDef {
-    key: "cascades",
-    default: 4.0,
-    min: 1.0,
-    max: (MAX_LEVELS + 1) as f64,
-    integer: true,
-    doc: "directional lights: cascades, the last one ray traced (1 = one map over the whole scene, no ray-traced level)",
-    source: "seed 004 section 4 (4 cascades, levels 0-2 hybrid, the last ray traced)",
-    choices: &[],
-};
-const LAMBDA: ParamDef = p(
+const CASCADES: ParamDef = ParamDef::integer(
+    "cascades",
+    4.0,
+    1.0,
+    (MAX_LEVELS + 1) as f64,
+    "directional lights: cascades, the last one ray traced (1 = one map over the whole scene, no ray-traced level)",
+    "seed 004 section 4 (4 cascades, levels 0-2 hybrid, the last ray traced)",
+);
+const LAMBDA: ParamDef = ParamDef::number(
     "lambda",
     DEFAULT_LAMBDA,
     0.0,
@@ -236,7 +218,7 @@ const LAMBDA: ParamDef = p(
     "practical split blend (1 = logarithmic); low: coarse near cascade, high: far cascades coarse and the ray-traced one large",
     "seed 004's code (0.85 log + 0.15 uniform)",
 );
-const ENLARGE: ParamDef = p(
+const ENLARGE: ParamDef = ParamDef::number(
     "enlarge",
     leak::DEFAULT_ENLARGE,
     0.0,
@@ -245,25 +227,27 @@ const ENLARGE: ParamDef = p(
     "seed 004 section 3.3 (15 %)",
 );
 const FORCE_ALL: ParamDef =
-    flag("force_all", false, "trace a ray for every evaluated pixel (equals rt; for tests)", "shadowlab test switch");
-const MIN_VARIANCE: ParamDef =
-    p("min_variance", cpu::DEFAULT_MIN_VARIANCE, 0.0, 1.0, "VSM/EVSM minimum variance (depth units^2)", "seed 004 section 4 (1e-10)");
-const ESM_C: ParamDef = p("c", cpu::DEFAULT_ESM_C, 0.0, 88.0, "ESM exponent", "seed 004 section 4 (80)");
-const C_POS: ParamDef =
-    p("c_pos", cpu::DEFAULT_EVSM_C_POS, 0.0, 42.0, "EVSM positive exponent (depth in [-1,1])", "seed 004 section 4 (20)");
-const C_NEG: ParamDef =
-    p("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
-const MOMENT_BIAS: ParamDef = p("moment_bias", cpu::DEFAULT_MOMENT_BIAS, 0.0, 1.0, "MSM moment bias", "seed 004 section 4 (3e-6)");
-const PCF_BIAS: ParamDef = p(
-    "bias",
-    DEFAULT_PCF_BIAS,
+    ParamDef::flag("force_all", false, "trace a ray for every evaluated pixel (equals rt; for tests)", "shadowlab test switch");
+const MIN_VARIANCE: ParamDef = ParamDef::number(
+    "min_variance",
+    cpu::DEFAULT_MIN_VARIANCE,
     0.0,
-    100.0,
-    "constant depth bias (texels); low: acne turns into rays, high: lit gaps missed",
-    "sm's default (shadowlab sweep); seed 004 section 4.2: HySM needs a tuned bias",
+    1.0,
+    "VSM/EVSM minimum variance (depth units^2)",
+    "seed 004 section 4 (1e-10)",
 );
+const ESM_C: ParamDef = ParamDef::number("c", cpu::DEFAULT_ESM_C, 0.0, 88.0, "ESM exponent", "seed 004 section 4 (80)");
+const C_POS: ParamDef =
+    ParamDef::number("c_pos", cpu::DEFAULT_EVSM_C_POS, 0.0, 42.0, "EVSM positive exponent (depth in [-1,1])", "seed 004 section 4 (20)");
+const C_NEG: ParamDef =
+    ParamDef::number("c_neg", cpu::DEFAULT_EVSM_C_NEG, 0.0, 42.0, "EVSM negative exponent (depth in [-1,1])", "seed 004 section 4 (5)");
+const MOMENT_BIAS: ParamDef =
+    ParamDef::number("moment_bias", cpu::DEFAULT_MOMENT_BIAS, 0.0, 1.0, "MSM moment bias", "seed 004 section 4 (3e-6)");
+const PCF_BIAS: ParamDef = family::BIAS
+    .with_default(DEFAULT_PCF_BIAS, "sm's default (shadowlab sweep); seed 004 section 4.2: HySM needs a tuned bias")
+    .with_doc("constant depth bias (texels); low: acne turns into rays, high: lit gaps missed");
 const PCF_NORMAL_OFFSET: ParamDef =
-    p("normal_offset", DEFAULT_PCF_NORMAL_OFFSET, 0.0, 100.0, "normal offset (texels)", "sm's default (shadowlab sweep)");
+    family::NORMAL_OFFSET.with_default(DEFAULT_PCF_NORMAL_OFFSET, "sm's default (shadowlab sweep)").with_doc("normal offset (texels)");
 
 pub const LT_PARAMS: &[ParamDef] = &[
     RES,
@@ -302,6 +286,7 @@ pub const LT_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Lt)?)),
 };
 pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
@@ -315,6 +300,7 @@ pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Ltt)?)),
 };
 pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
@@ -328,5 +314,6 @@ pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::HybridPcf)?)),
 };

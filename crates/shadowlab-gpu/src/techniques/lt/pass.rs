@@ -2,14 +2,14 @@
 //! compaction, indirect list tracing; the screen-sized state (temporal mask and history, ping-pong).
 
 use bytemuck::Zeroable;
-use shadowlab_core::leak;
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
 use shadowlab_core::params::ParamValues;
+use shadowlab_core::techniques::lt as leak;
 
 use super::cascade::{single_level, Cascades};
 use super::screen::Screen;
-use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, MAX_MAPS};
+use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, BASES, MAX_MAPS};
 use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_POINT, FLAG_RR};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -51,10 +51,6 @@ pub struct LeakTracing {
     pub(super) screen: Option<Screen>,
 }
 
-fn get(p: &ParamValues, key: &str, default: f64) -> f64 {
-    p.0.get(key).copied().unwrap_or(default)
-}
-
 impl LeakTracing {
     pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, mode: Mode) -> Result<LeakTracing, GpuError> {
         let name = mode.name();
@@ -78,18 +74,24 @@ impl LeakTracing {
             _ => 0.0,
         };
         let mask_bits = leak::mask_texel_bits(LIGHTS).map_err(GpuError::Invalid)?;
-        let flag = |key: &str, bit: u32| if get(p, key, 0.0) != 0.0 { bit } else { 0 };
+        // what each mode declares (mod.rs): lt all; ltt no temporal mask (rr, full,
+        // history_test, depth_tol, normal_cos); hybrid-pcf no filterable base (base, eps, the
+        // moment shape) but the PCF bias. The shader reads no slot a mode leaves at 0.
+        let temporal = mode == Mode::Lt;
+        let filterable = mode != Mode::HybridPcf;
+        let flag = |key: &str, bit: u32| if temporal && p.get_bool(key) { bit } else { 0 };
         let flags = flag("rr", FLAG_RR)
             | flag("full", FLAG_FULL)
-            | flag("force_all", FLAG_FORCE_ALL)
             | flag("history_test", FLAG_HISTORY_TEST)
+            | if p.get_bool("force_all") { FLAG_FORCE_ALL } else { 0 }
             | if faces.is_some() { FLAG_POINT } else { 0 };
         let (bias, normal_offset) = match mode {
             Mode::HybridPcf => (p.get("bias"), p.get("normal_offset")),
             _ => (0.0, 0.0),
         };
-        let shape =
-            [get(p, "min_variance", 1e-10) as f32, get(p, "c", 80.0) as f32, get(p, "c_pos", 20.0) as f32, get(p, "c_neg", 5.0) as f32];
+        let num = |key: &str, used: bool| if used { p.get(key) as f32 } else { 0.0 };
+        let shape = [num("min_variance", filterable), num("c", filterable), num("c_pos", filterable), num("c_neg", filterable)];
+        let base = if filterable { BASES.iter().position(|b| *b == p.choice("base")).expect("a declared base") as u32 } else { 0 };
         let cascades = match *light {
             Light::Directional { direction } if p.get_u32("cascades") > 1 => Some(Cascades {
                 count: p.get_u32("cascades") as usize,
@@ -109,10 +111,10 @@ impl LeakTracing {
         let params = LtParams {
             levels: level_u,
             texel: [levels as f32, lp.perspective as u32 as f32, res as f32, inv_far],
-            mode: [mode as u32, get(p, "base", 2.0) as u32, 0, flags],
+            mode: [mode as u32, base, 0, flags],
             shape,
-            bias: [get(p, "moment_bias", 3e-6) as f32, bias as f32, normal_offset as f32, get(p, "eps", 0.01) as f32],
-            history: [get(p, "depth_tol", 0.05) as f32, get(p, "normal_cos", 0.9) as f32, mask_bits as f32, 0.0],
+            bias: [num("moment_bias", filterable), bias as f32, normal_offset as f32, num("eps", filterable)],
+            history: [num("depth_tol", temporal), num("normal_cos", temporal), mask_bits as f32, 0.0],
         };
         // the raster of filtered/ in single-depth mode: linear depth into an R32Float target
         let map_params = FilteredParams {
@@ -175,7 +177,7 @@ impl LeakTracing {
         Ok(LeakTracing {
             mode,
             res,
-            reuse: get(p, "reuse", 1.0) != 0.0,
+            reuse: p.get_bool("reuse"),
             params,
             mask_bits,
             static_map,
@@ -247,7 +249,7 @@ impl LeakTracing {
         (read(&self.static_map), self.dynamic_map.as_ref().map(read))
     }
 
-    /// The temporal mask written in the last frame: 3 bits per pixel (`shadowlab_core::leak`).
+    /// The temporal mask written in the last frame: 3 bits per pixel (`shadowlab_core::techniques::lt`).
     pub fn mask(&self, gpu: &Gpu) -> Vec<u32> {
         let Some(s) = &self.screen else { return Vec::new() };
         let n = (s.width * s.height) as usize;

@@ -1,7 +1,7 @@
 //! Leak tracing's report: memory, counters, the static map, the temporal mask in Table 1's
 //! colours and where the rays went.
 
-use shadowlab_core::leak::{self, Class, Mask, BIT_LTT, BIT_RS};
+use shadowlab_core::techniques::lt::{self as leak, Class, Mask, BIT_LTT, BIT_RS};
 
 use super::pass::LeakTracing;
 use super::Mode;

@@ -3,17 +3,18 @@
 //! Three passes: the base depth map (exactly `sm`'s depth pass and projection; post-projective
 //! depth, 0 = near the light), a selection compute pass that writes the n sorted depths of
 //! every texel into one RGBA32F texel (`select.wgsl`, the WGSL twin of
-//! [`shadowlab_core::mdsm::select`]), and the evaluation (`eval.wgsl`): `sm`'s bias model, then
+//! [`shadowlab_core::techniques::mdsm::select`]), and the evaluation (`eval.wgsl`): `sm`'s bias model, then
 //! k taps on a sqrt(k) x sqrt(k) grid, one fetch and one n-shadow test each
-//! ([`shadowlab_core::mdsm::n_shadow_test`]), averaged to a lit fraction in steps of 1/(nk).
+//! ([`shadowlab_core::techniques::mdsm::n_shadow_test`]), averaged to a lit fraction in steps of 1/(nk).
 //! With n = 1 the selection is a copy (search width 1) and PCF(k, 1) is `sm:pcf=sqrt(k)`.
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
-use shadowlab_core::mdsm::{max_distinct, pcf_width, search_width, Select, DEFAULT_Q, MAX_DEPTHS, PCF_TAPS, SEARCH_SIZES};
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::params::{ParamDef, ParamValues, BOOL};
+use shadowlab_core::params::family;
+use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::techniques::mdsm::{max_distinct, pcf_width, search_width, Select, DEFAULT_Q, MAX_DEPTHS, PCF_TAPS, SEARCH_SIZES};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -44,106 +45,48 @@ pub const DEFAULT_K: f64 = 9.0;
 pub const SELECT_CHOICES: &[&str] = &["minmax", "sort"];
 
 pub const PARAMS: &[ParamDef] = &[
-    ParamDef {
-        key: "res",
-        default: sm::DEFAULT_RES,
-        min: 16.0,
-        max: 16384.0,
-        integer: true,
-        doc: "shadow map side (texels)",
-        source: "seed 003 section 5: 512^2 maps",
-        choices: &[],
-    },
-    ParamDef {
-        key: "n",
-        default: DEFAULT_N,
-        min: 1.0,
-        max: MAX_DEPTHS as f64,
-        integer: true,
-        doc: "depths per texel (1 = sm); the n-shadow test gives n+1 levels per tap",
-        source: "seed 003 sections 4.2-4.4 (2-SM, 3-SM; 4 fill one RGBA32F texel)",
-        choices: &[],
-    },
-    ParamDef {
-        key: "k",
-        default: DEFAULT_K,
-        min: 1.0,
-        max: 25.0,
-        integer: true,
-        doc: "PCF taps, one of 1, 4, 9, 16, 25 (sqrt(k) x sqrt(k) grid one texel apart, centred on the sample)",
-        source: "seed 003 Table 1, Figures 6-7 (PCF 2x2, 3x3, 4x4)",
-        choices: &[],
-    },
-    ParamDef {
-        key: "select",
-        default: 0.0,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "how the extra depths are chosen: minmax (region extremes, O(q)) or sort (medians of n groups, O(q log q))",
-        source: "seed 003 section 4.3; section 5 uses min and max",
-        choices: SELECT_CHOICES,
-    },
-    ParamDef {
-        key: "q",
-        default: DEFAULT_Q as f64,
-        min: 9.0,
-        max: 81.0,
-        integer: true,
-        doc: "search region samples, one of 9, 25, 49, 81 (centred square); larger: wider soft zone, more selection cost",
-        source: "seed 003 section 6 cost example implies q = 9 (f > 1.28 x 512^2 with r = 7)",
-        choices: &[],
-    },
-    ParamDef {
-        key: "bias",
-        default: sm::DEFAULT_BIAS,
-        min: 0.0,
-        max: 100.0,
-        integer: false,
-        doc: "constant depth bias, texels; low: acne, high: peter-panning",
-        source: "sm's default (shadowlab sweep 2026-11-22)",
-        choices: &[],
-    },
-    ParamDef {
-        key: "slope_bias",
-        default: sm::DEFAULT_SLOPE_BIAS,
-        min: 0.0,
-        max: 100.0,
-        integer: false,
-        doc: "slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope",
-        source: "sm's default",
-        choices: &[],
-    },
-    ParamDef {
-        key: "normal_offset",
-        default: sm::DEFAULT_NORMAL_OFFSET,
-        min: 0.0,
-        max: 100.0,
-        integer: false,
-        doc: "offset along the normal, texels; low: grazing acne, high: shifted shadows",
-        source: "sm's default (Holbert 2011)",
-        choices: &[],
-    },
-    ParamDef {
-        key: "max_slope",
-        default: sm::MAX_SLOPE.default,
-        min: 0.0,
-        max: 1000.0,
-        integer: false,
-        doc: "clamp on tan(angle to light) for the slope, kernel and region bias",
-        source: "sm's default",
-        choices: &[],
-    },
-    ParamDef {
-        key: "region_bias",
-        default: 1.0,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "add (sqrt(q)-1)/2 x tan texels of bias for the search region (n > 1); false: sloped lit surfaces self-shadow by up to 1/n",
-        source: "receiver-plane bias (Isidoro 2006) extended to the search region; shadowlab measurement (docs/bench/mdsm.md)",
-        choices: BOOL,
-    },
+    family::RES.with_doc("shadow map side (texels)"),
+    ParamDef::integer(
+        "n",
+        DEFAULT_N,
+        1.0,
+        MAX_DEPTHS as f64,
+        "depths per texel (1 = sm); the n-shadow test gives n+1 levels per tap",
+        "seed 003 sections 4.2-4.4 (2-SM, 3-SM; 4 fill one RGBA32F texel)",
+    ),
+    ParamDef::integer(
+        "k",
+        DEFAULT_K,
+        1.0,
+        25.0,
+        "PCF taps, one of 1, 4, 9, 16, 25 (sqrt(k) x sqrt(k) grid one texel apart, centred on the sample)",
+        "seed 003 Table 1, Figures 6-7 (PCF 2x2, 3x3, 4x4)",
+    ),
+    ParamDef::choice(
+        "select",
+        SELECT_CHOICES,
+        0,
+        "how the extra depths are chosen: minmax (region extremes, O(q)) or sort (medians of n groups, O(q log q))",
+        "seed 003 section 4.3; section 5 uses min and max",
+    ),
+    ParamDef::integer(
+        "q",
+        DEFAULT_Q as f64,
+        9.0,
+        81.0,
+        "search region samples, one of 9, 25, 49, 81 (centred square); larger: wider soft zone, more selection cost",
+        "seed 003 section 6 cost example implies q = 9 (f > 1.28 x 512^2 with r = 7)",
+    ),
+    family::BIAS.with_doc("constant depth bias, texels; low: acne, high: peter-panning"),
+    family::SLOPE_BIAS.with_doc("slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope"),
+    family::NORMAL_OFFSET.with_doc("offset along the normal, texels; low: grazing acne, high: shifted shadows"),
+    family::MAX_SLOPE.with_doc("clamp on tan(angle to light) for the slope, kernel and region bias"),
+    ParamDef::flag(
+        "region_bias",
+        true,
+        "add (sqrt(q)-1)/2 x tan texels of bias for the search region (n > 1); false: sloped lit surfaces self-shadow by up to 1/n",
+        "receiver-plane bias (Isidoro 2006) extended to the search region; shadowlab measurement (docs/bench/mdsm.md)",
+    ),
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -157,6 +100,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(MultiDepthMap::new(gpu, scene, p, light)?)),
 };
 
@@ -201,7 +145,7 @@ impl MultiDepthMap {
         if !(1..=MAX_DEPTHS as u32).contains(&n) {
             return Err(GpuError::Invalid(format!("mdsm: n={n} must be 1 to {MAX_DEPTHS}")));
         }
-        let strategy = p.get_u32("select");
+        let strategy = p.choice_index("select", SELECT_CHOICES) as u32;
         Select::from_index(strategy).ok_or_else(|| GpuError::Invalid(format!("mdsm: select index {strategy} unknown")))?;
         let lp =
             lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("mdsm does not support point lights".into()))?;

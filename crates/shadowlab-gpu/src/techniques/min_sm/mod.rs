@@ -3,23 +3,24 @@
 //! reduced on the GPU (bounding box, then per band of `grid` rows the least and greatest x;
 //! reduce.wgsl; in steady state one pass, banding over the previous frame's range with overflow
 //! slots), the few band corners are read back, the CPU takes their convex hull and the
-//! minimum-area rectangle by rotating calipers (`shadowlab_core::calipers`), and the map is
+//! minimum-area rectangle by rotating calipers (`shadowlab_core::techniques::min_sm`), and the map is
 //! rendered over that rectangle (rotated, padded by the bias reach) with near/far fitted to the
 //! scene towards the light and the farthest sample. Depth map and evaluation are `sm`'s shaders
 //! and bias model; the texel is the rectangle's larger texel side.
 //! Stored depth: post-projective, 0 = near the light (orthographic: linear).
 
 use bytemuck::Zeroable;
-use shadowlab_core::calipers::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace::{self, LightProjection};
+use shadowlab_core::params::family;
 use shadowlab_core::params::{ParamDef, ParamValues};
 use shadowlab_core::scene::Bounds;
+use shadowlab_core::techniques::min_sm::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::techniques::sm::{self, MapPass};
+use crate::techniques::sm::MapPass;
 use crate::{binding, Gpu, GpuError};
 
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
@@ -45,42 +46,15 @@ pub const PAD_MARGIN_TEXELS: f64 = 1.0;
 /// `sm`'s parameters (same keys, defaults, docs and sources; the order is checked by a test),
 /// then the reduction grid.
 pub const PARAMS: &[ParamDef] = &[
-    sm::RES,
-    sm::PCF,
-    sm::BIAS,
-    sm::SLOPE_BIAS,
-    sm::MAX_SLOPE,
-    sm::NORMAL_OFFSET,
-    ParamDef {
-        key: "grid",
-        default: DEFAULT_GRID,
-        min: 1.0,
-        max: 16384.0,
-        integer: true,
-        doc: "bands of the GPU reduction before the hull (hull overshoot <= 1/grid of the samples' extent)",
-        source: "shadowlab: exact hull up to one band; 1024 = 8 KB read back",
-        choices: &[],
-    },
-    ParamDef {
-        key: "fit",
-        default: 0.0,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "rectangle around the hull: area = minimum area (the seeds' MSF; texels may be stretched up to the rectangle's aspect), side = shortest longer side (smallest square texel)",
-        source: "seed 000 section 3.2 (area); side: shadowlab, see docs/bench/min_sm.md",
-        choices: &["area", "side"],
-    },
-    ParamDef {
-        key: "one_pass",
-        default: 1.0,
-        min: 0.0,
-        max: 1.0,
-        integer: true,
-        doc: "true: one pass over the G-buffer, bands over the previous frame's y range (samples outside it go to two overflow slots: always conservative, tight again next frame); false or first frame: two passes (bounds, then bands)",
-        source: "shadowlab: halves the G-buffer reads in steady state (docs/bench/min_sm.md)",
-        choices: shadowlab_core::params::BOOL,
-    },
+    family::RES,
+    family::PCF,
+    family::BIAS,
+    family::SLOPE_BIAS,
+    family::MAX_SLOPE,
+    family::NORMAL_OFFSET,
+    ParamDef::integer("grid", DEFAULT_GRID, 1.0, 16384.0, "bands of the GPU reduction before the hull (hull overshoot <= 1/grid of the samples' extent)", "shadowlab: exact hull up to one band; 1024 = 8 KB read back"),
+    ParamDef::choice("fit", &["area", "side"], 0, "rectangle around the hull: area = minimum area (the seeds' MSF; texels may be stretched up to the rectangle's aspect), side = shortest longer side (smallest square texel)", "seed 000 section 3.2 (area); side: shadowlab, see docs/bench/min_sm.md"),
+    ParamDef::flag("one_pass", true, "true: one pass over the G-buffer, bands over the previous frame's y range (samples outside it go to two overflow slots: always conservative, tight again next frame); false or first frame: two passes (bounds, then bands)", "shadowlab: halves the G-buffer reads in steady state (docs/bench/min_sm.md)"),
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -94,6 +68,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "min-sm.readback: the band reduction of the view samples is read back for the CPU hull and calipers",
     needs: "",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, p, light)?)),
 };
 
@@ -167,7 +142,7 @@ impl MinShadowMap {
             pass,
             res,
             grid,
-            shape: if p.get_u32("fit") == 1 { RectFit::Side } else { RectFit::Area },
+            shape: if p.choice("fit") == "side" { RectFit::Side } else { RectFit::Area },
             one_pass: p.get_bool("one_pass"),
             prior: None,
             last_passes: 0,

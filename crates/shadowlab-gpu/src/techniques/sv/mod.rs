@@ -16,9 +16,9 @@
 mod pipelines;
 
 use bytemuck::{Pod, Zeroable};
-use shadowlab_core::edges::EdgeList;
 use shadowlab_core::light::Light;
 use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::techniques::sv::EdgeList;
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -42,26 +42,8 @@ pub const DEFAULT_FAR: f64 = 0.0;
 pub const DEFAULT_DEPTH_OFFSET: f64 = 4.0;
 
 pub const PARAMS: &[ParamDef] = &[
-    ParamDef {
-        key: "far",
-        default: DEFAULT_FAR,
-        min: 0.0,
-        max: 1000.0,
-        integer: false,
-        doc: "extrusion distance in scene diagonals (>= 1); 0 = infinite (w = 0) with unclipped depth, or 2 where the adapter lacks DEPTH_CLIP_CONTROL",
-        source: "infinite extrusion: Everitt & Kilgard 2002; unclipped depth replaces their depth clamp",
-        choices: &[],
-    },
-    ParamDef {
-        key: "depth_offset",
-        default: DEFAULT_DEPTH_OFFSET,
-        min: 0.0,
-        max: 65536.0,
-        integer: true,
-        doc: "receiver depth moved towards the camera, f32 ulps; against self-shadowing of a surface by its own light cap",
-        source: "shadowlab sweep 0/4/16/64/1024 ulps, 2026-11-22 (docs/bench/sv.md)",
-        choices: &[],
-    },
+    ParamDef::number("far", DEFAULT_FAR, 0.0, 1000.0, "extrusion distance in scene diagonals (>= 1); 0 = infinite (w = 0) with unclipped depth, or 2 where the adapter lacks DEPTH_CLIP_CONTROL", "infinite extrusion: Everitt & Kilgard 2002; unclipped depth replaces their depth clamp"),
+    ParamDef::integer("depth_offset", DEFAULT_DEPTH_OFFSET, 0.0, 65536.0, "receiver depth moved towards the camera, f32 ulps; against self-shadowing of a surface by its own light cap", "shadowlab sweep 0/4/16/64/1024 ulps, 2026-11-22 (docs/bench/sv.md)"),
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -75,6 +57,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8); optional: DEPTH_CLIP_CONTROL (unclipped depth for the infinite extrusion) and DEPTH32FLOAT_STENCIL8, used where offered",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(ShadowVolumes::new(gpu, scene, p, light)?)),
 };
 

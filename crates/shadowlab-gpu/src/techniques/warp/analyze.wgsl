@@ -19,7 +19,7 @@
 var<workgroup> wg_bounds: array<atomic<u32>, 6>;
 
 fn res_u() -> u32 {
-    return u32(wp.texel.z);
+    return u32(wp.res);
 }
 
 fn dv_now() -> vec4<f32> {
@@ -84,10 +84,10 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = res_u();
     let t = texel_of(u.y, w) * w + texel_of(u.x, w);
     atomicAdd(&work[t], 1u);
-    if wp.ints.w != 0u {
+    if wp.rtw_importance != 0u {
         let maxd = bitcast<f32>(atomicLoad(&dv[4]));
         let d = distance(s.p, frame.camera_pos.xyz);
-        let imp = wp.imp.x + wp.imp.y * clamp((maxd - d) / max(maxd, 1e-20), 0.0, 1.0);
+        let imp = wp.w_dv + wp.w_eye * clamp((maxd - d) / max(maxd, 1e-20), 0.0, 1.0);
         atomicMax(&work[2u * w * w + t], bitcast<u32>(imp));
     }
 }
@@ -109,7 +109,7 @@ fn blur_along(axis: u32, src: u32, id: vec3<u32>) {
     if k >= w || r >= w {
         return;
     }
-    let rad = u32(wp.imp.z);
+    let rad = u32(wp.blur);
     let a = u32(max(i32(k) - i32(rad), 0));
     let b = min(k + rad, w - 1u);
     var sum = 0.0;
@@ -117,7 +117,7 @@ fn blur_along(axis: u32, src: u32, id: vec3<u32>) {
         sum += f32(atomicLoad(&work[src + at(axis, r, j)]));
     }
     // plus the uniform floor: `mix` x the mean count per texel of the whole map
-    let floor_density = bitcast<f32>(wp.flags.y) * f32(atomicLoad(&dv[5])) / f32(w * w);
+    let floor_density = wp.mix * f32(atomicLoad(&dv[5])) / f32(w * w);
     atomicStore(&work[2u * w * w + at(axis, r, k)], bitcast<u32>(sum / f32(b - a + 1u) + floor_density));
 }
 
@@ -167,7 +167,7 @@ fn offsets_cols(@builtin(global_invocation_id) id: vec3<u32>) {
 fn smoothed(axis: u32, r: u32, k: u32) -> f32 {
     let w = res_u();
     let n = w * w;
-    let half = u32(wp.cfg.w) / 2u;
+    let half = u32(wp.window) / 2u;
     let a = max(i32(r) - i32(half), 0);
     let b = min(r + half, w - 1u);
     var num = 0.0;
@@ -230,7 +230,7 @@ fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let w = res_u();
     let i = texel_of(u.y, w);
-    let a = neighbours(u.y, w, wp.flags.x != 0u);
+    let a = neighbours(u.y, w, wp.interp != 0u);
     let xw = u.x + mix(row_offset(u32(a.x), u.x), row_offset(u32(a.y), u.x), a.z);
     if xw >= 0.0 && xw < 1.0 {
         atomicAdd(&work[w * w + i * w + texel_of(xw, w)], 1u);
@@ -265,7 +265,7 @@ fn rtw_blur(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let k = t % w;
     let first = t - k;
-    let rad = u32(wp.imp.z);
+    let rad = u32(wp.blur);
     let a = max(i32(k) - i32(rad), 0);
     let b = min(k + rad, w - 1u);
     var sum = 0.0;

@@ -3,7 +3,7 @@
 // post-projective depth (0 = near the light; paraboloid: distance / far). With subdivision on,
 // the vertices come from the pieces of subdiv.wgsl.
 //
-// `exact_depth` (wp.flags.z): the rasteriser interpolates depth linearly between warped
+// `exact_depth` (wp.exact_depth): the rasteriser interpolates depth linearly between warped
 // vertices, which is wrong inside a piece by up to the subdivision threshold. The stored depth
 // d = clip_to_map(base_clip(p)).z of a point p on a plane is an affine function of its base
 // (cropped, unwarped) map coordinates u, for orthographic and perspective (spot) projections
@@ -77,7 +77,7 @@ fn depth_plane(a: array<vec4<f32>, 3>, r: vec4<f32>) -> vec4<f32> {
 fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     var v: Vertex;
     var piece = vec4<u32>(vi / 3u, 0u, 0xffffu, 0xffff0000u);
-    if wp.imp.w > 0.0 {
+    if wp.subdiv > 0.0 {
         piece = pieces[vi / 3u];
         v = piece_vertex(piece, vi % 3u);
     } else {
@@ -92,7 +92,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     o.plane = vec4<f32>(0.0);
     o.zrange = vec2<f32>(0.0, 1.0);
     o.side = hemisphere_side(wp, v.pos);
-    if wp.flags.z != 0u {
+    if wp.exact_depth != 0u {
         let a = base_clip(wp, v.pos);
         o.u = to_dv(clip_to_map(a).xy, r);
         // the whole triangle's plane (better conditioned than a small piece's), else the piece's
@@ -112,7 +112,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
         o.plane = plane;
         if plane.w != 0.0 {
             var z = vec3<f32>(clip_to_map(pc[0]).z, clip_to_map(pc[1]).z, clip_to_map(pc[2]).z);
-            if wp.ext.w > 0.5 {
+            if wp.depth_clamp > 0.5 {
                 // the whole triangle's corners: a piece's chords cover up to `subdiv` warped
                 // texels of its curved neighbours, whose plane depth lies outside its own range
                 z = vec3<f32>(clip_to_map(base_clip(wp, vertices[3u * t].pos)).z,

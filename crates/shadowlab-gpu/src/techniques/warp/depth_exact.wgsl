@@ -13,7 +13,7 @@ fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
     if in.plane.w == 0.0 {
         return in.clip.z;
     }
-    let res = wp.texel.z;
+    let res = wp.res;
     let inv = unwarp(in.clip.xy / res, in.u);
     // not converged: the rasterised depth
     if inv.z > FALLBACK {

@@ -48,8 +48,8 @@ fn singular_values(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
 // geometric mean T / sqrt(det J). Capped at `ext.z` cropped texels (0: 1 / MIN_WARP_SCALE).
 // `t`: world size of one cropped texel at p.
 fn gradient_footprint(p: vec3<f32>, n: vec3<f32>, l: vec3<f32>, r: vec4<f32>, j: mat2x2<f32>, t: f32) -> f32 {
-    let res = wp.texel.z;
-    let cap = select(1.0 / MIN_WARP_SCALE, wp.ext.z, wp.ext.z > 0.0) * t;
+    let res = wp.res;
+    let cap = select(1.0 / MIN_WARP_SCALE, wp.footprint_cap, wp.footprint_cap > 0.0) * t;
     let detj = j[0].x * j[1].y - j[1].x * j[0].y;
     let geo = t / sqrt(max(abs(detj), 1e-12));
     var a = vec3<f32>(1.0, 0.0, 0.0);
@@ -98,7 +98,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = s.p;
     let n = s.n;
     let l = to_light(light, p);
-    let res = wp.texel.z;
+    let res = wp.res;
     let r = dv_rect();
 
     let m0 = clip_to_map(base_clip(wp, p));
@@ -110,18 +110,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 
     // world size of one cropped texel at p, then of one warped texel
-    var texel = wp.texel.x * max(r.z - r.x, r.w - r.y);
-    if wp.texel.y > 0.5 {
+    var texel = wp.texel_world * max(r.z - r.x, r.w - r.y);
+    if wp.perspective > 0.5 {
         texel *= max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
     }
     if is_paraboloid(wp) {
         // texel.x = 2 / res radians per texel at the rim; (1 + n.z) x that in general
         texel *= distance(p, light.position.xyz) * (1.0 + max(hemisphere_side(wp, p), 0.0));
     }
-    if wp.cfg.z > 0.5 {
+    if wp.warped > 0.5 {
         let j = jacobian(u0, 0.5 / res);
         let sv = singular_values(j[0], j[1]);
-        if wp.ext.y > 2.5 {
+        if wp.bias_mode > 2.5 {
             // mode 3: the largest gradient footprint at u0 and one texel to each side (the
             // warp's kinks: the Jacobian changes within a texel)
             var f = gradient_footprint(p, n, l, r, j, texel);
@@ -130,9 +130,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 f = max(f, gradient_footprint(p, n, l, r, jacobian(u0 + o, 0.5 / res), texel));
             }
             texel = f;
-        } else if wp.ext.y > 1.5 {
+        } else if wp.bias_mode > 1.5 {
             texel = gradient_footprint(p, n, l, r, j, texel);
-        } else if wp.ext.y > 0.5 {
+        } else if wp.bias_mode > 0.5 {
             // the cropped texel, shrunk only where the warp magnifies in every direction
             texel /= clamp(sv.x, 1.0, 1e3);
         } else {
@@ -141,10 +141,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     let cos_t = clamp(dot(n, l), 1e-4, 1.0);
-    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, wp.bias.w);
-    let k = i32(wp.texel.w);
+    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, wp.max_slope);
+    let k = i32(wp.pcf);
     let half = f32(k - 1) * 0.5;
-    let q = p + n * (wp.bias.z * texel) + l * ((wp.bias.x + (wp.bias.y + half) * tan_t) * texel);
+    let q = p + n * (wp.normal_offset * texel) + l * ((wp.bias + (wp.slope_bias + half) * tan_t) * texel);
     let a = base_clip(wp, q);
     let m = clip_to_map(a);
     var u = warp(to_dv(m.xy, r));
@@ -161,7 +161,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var x = 0; x < k; x++) {
             let uv = u + (vec2<f32>(f32(x), f32(y)) - half) / res;
             let z = m.z;
-            if wp.cfg.y > 1.5 {
+            if wp.dv_mode > 1.5 {
                 lit += select(0.0, 1.0, z <= min_depth_3x3(uv, u32(res)));
             } else {
                 lit += textureSampleCompareLevel(shadow_map, cmp, uv, z);

@@ -52,13 +52,13 @@ fn offset_y(j: u32, y: f32) -> f32 {
 // `flags.x` the offsets are interpolated between the two nearest functions instead. The offsets
 // are scaled by the warp strength `ext.x` (1 = the seeds' warp; 0 = the identity, i.e. DV only).
 fn warp(u: vec2<f32>) -> vec2<f32> {
-    if wp.cfg.z < 0.5 {
+    if wp.warped < 0.5 {
         return u;
     }
-    let res = u32(wp.texel.z);
-    let interp = wp.flags.x != 0u;
+    let res = u32(wp.res);
+    let interp = wp.interp != 0u;
     let a = neighbours(u.y, res, interp);
-    let alpha = wp.ext.x;
+    let alpha = wp.strength;
     let xw = u.x + alpha * mix(offset_x(u32(a.x), u.x), offset_x(u32(a.y), u.x), a.z);
     let b = neighbours(xw, res, interp);
     return vec2<f32>(xw, u.y + alpha * mix(offset_y(u32(b.x), u.y), offset_y(u32(b.y), u.y), b.z));
@@ -82,7 +82,7 @@ fn warped_clip(p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
 // cropped texels; the warp has a kink per texel, so the best iterate is kept. Returns (u,
 // residual in warped texels). The exact depth pass (depth_exact.wgsl) uses it.
 fn unwarp(t: vec2<f32>, guess: vec2<f32>) -> vec3<f32> {
-    let res = wp.texel.z;
+    let res = wp.res;
     let h = 0.5 / res;
     var u = guess;
     var best = u;

@@ -12,7 +12,7 @@
 //!
 //! The shadow map is rendered with the warp applied per vertex (optionally after subdividing
 //! triangles whose warped edges are long, `subdiv`), and evaluated through the same warp. The
-//! CPU reference of the math is `shadowlab_core::warp`. Stored depth: post-projective, 0 = near
+//! CPU reference of the math is `shadowlab_core::techniques::warp`. Stored depth: post-projective, 0 = near
 //! the light (orthographic: linear), as in `sm`; with `exact_depth` (notw default) each fragment
 //! writes its triangle's depth at the warp's preimage of the fragment (depth_exact.wgsl) instead
 //! of the depth interpolated between warped vertices.
@@ -29,8 +29,8 @@ pub use params::*;
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
-use shadowlab_core::paraboloid::Hemisphere;
 use shadowlab_core::params::ParamValues;
+use shadowlab_core::techniques::dpsm::Hemisphere;
 
 use crate::prefix_sum::PrefixSum;
 use crate::scene_gpu::GpuScene;
@@ -85,6 +85,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Notw)?)),
 };
 
@@ -99,6 +100,7 @@ pub const RTW_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Rtw)?)),
 };
 
@@ -113,6 +115,7 @@ pub const DV_INFO: TechniqueInfo = TechniqueInfo {
     stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
     compare: &[""],
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Dv)?)),
 };
 
@@ -133,18 +136,47 @@ impl Variant {
     }
 }
 
-/// WGSL `WarpParams` (params.wgsl).
+/// `WarpParams::dv_mode`: the map is cropped to the desired view.
+pub const DV_CROP: f32 = 1.0;
+/// `WarpParams::dv_mode`: cropped, and subdivision cracks closed by a 3x3 depth minimum.
+pub const DV_CROP_CLOSED: f32 = 2.0;
+
+/// WGSL `WarpParams` (params.wgsl): one named field per value (the layout test checks each).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct WarpParams {
     pub light_view_proj: [[f32; 4]; 4],
-    pub texel: [f32; 4],
-    pub bias: [f32; 4],
-    pub cfg: [f32; 4],
-    pub imp: [f32; 4],
-    pub ints: [u32; 4],
-    pub flags: [u32; 4],
-    pub ext: [f32; 4],
+    pub texel_world: f32,
+    pub perspective: f32,
+    pub res: f32,
+    pub pcf: f32,
+    pub bias: f32,
+    pub slope_bias: f32,
+    pub normal_offset: f32,
+    pub max_slope: f32,
+    pub dv_margin: f32,
+    /// 0: no DV crop, [`DV_CROP`], [`DV_CROP_CLOSED`].
+    pub dv_mode: f32,
+    /// 1: the warp is on (0: the DV crop only).
+    pub warped: f32,
+    pub window: f32,
+    pub w_dv: f32,
+    pub w_eye: f32,
+    pub blur: f32,
+    pub subdiv: f32,
+    pub triangles: u32,
+    pub subdiv_levels: u32,
+    pub extra_capacity: u32,
+    pub rtw_importance: u32,
+    pub interp: u32,
+    pub mix: f32,
+    pub exact_depth: u32,
+    /// 0 planar, 1 + [`Hemisphere`] index for a paraboloid hemisphere.
+    pub projection: u32,
+    pub strength: f32,
+    pub bias_mode: f32,
+    pub footprint_cap: f32,
+    pub depth_clamp: f32,
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -292,41 +324,53 @@ impl Warped {
         let res = p.get_u32("res");
         let (view_proj, texel, perspective, kind) = match proj {
             Projection::Planar(lp) => (lp.view_proj, lp.texel, lp.perspective, 0),
-            // 2/res of the map plane per texel: 2 (1 + n.z) / res radians (paraboloid.rs)
+            // 2/res of the map plane per texel: 2 (1 + n.z) / res radians (core techniques::dpsm)
             Projection::Paraboloid { view, hemisphere } => (view, 2.0 / res as f32, false, 1 + (hemisphere == Hemisphere::Back) as u32),
         };
         let paraboloid = kind != 0;
-        let opt = |k: &str, d: f64| if p.0.contains_key(k) { p.get(k) } else { d };
-        let window = opt("window", 0.0);
-        if window >= res as f64 {
-            return Err(GpuError::Invalid(format!("{name}: window {window} must be below res {res}")));
+        let k = Knobs::read(p, variant, paraboloid, dv);
+        if k.window >= res {
+            return Err(GpuError::Invalid(format!("{name}: window {} must be below res {res}", k.window)));
         }
-        let subdiv = opt("subdiv", 0.0) as f32;
-        let exact = opt("exact_depth", 0.0) != 0.0 && (variant != Variant::Dv || paraboloid);
         let tris = scene.triangle_count;
         let limit = gpu.limits.max_storage_buffer_binding_size / 16;
-        let on = subdiv > 0.0 && (variant != Variant::Dv || paraboloid);
+        let on = k.subdiv > 0.0;
         let extra = if on { (8 * tris as u64).max(1 << 21).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
         let queue = if on { (tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
         let params = WarpParams {
             light_view_proj: view_proj.to_cols_array_2d(),
-            texel: [texel, perspective as u32 as f32, res as f32, p.get("pcf") as f32],
-            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
-            cfg: [
-                opt("dv_margin", 0.0) as f32,
-                if dv { 1.0 + opt("close_cracks", 0.0) as f32 } else { 0.0 },
-                (variant != Variant::Dv) as u32 as f32,
-                window as f32,
-            ],
-            imp: [opt("w_dv", 0.0) as f32, opt("w_eye", 0.0) as f32, opt("blur", 0.0) as f32, if on { subdiv } else { 0.0 }],
-            ints: [tris, opt("subdiv_levels", 1.0) as u32, extra, (variant == Variant::Rtw) as u32],
-            flags: [opt("interp", 1.0) as u32, (opt("mix", 0.0) as f32).to_bits(), exact as u32, kind],
-            ext: [
-                opt("strength", 1.0) as f32,
-                opt("bias_mode", 0.0) as f32,
-                opt("footprint_cap", 0.0) as f32,
-                opt("depth_clamp", 0.0) as f32,
-            ],
+            texel_world: texel,
+            perspective: perspective as u32 as f32,
+            res: res as f32,
+            pcf: p.get("pcf") as f32,
+            bias: p.get("bias") as f32,
+            slope_bias: p.get("slope_bias") as f32,
+            normal_offset: p.get("normal_offset") as f32,
+            max_slope: p.get("max_slope") as f32,
+            dv_margin: k.dv_margin,
+            dv_mode: match (dv, k.close_cracks) {
+                (false, _) => 0.0,
+                (true, false) => DV_CROP,
+                (true, true) => DV_CROP_CLOSED,
+            },
+            warped: (variant != Variant::Dv) as u32 as f32,
+            window: k.window as f32,
+            w_dv: k.w_dv,
+            w_eye: k.w_eye,
+            blur: k.blur as f32,
+            subdiv: k.subdiv,
+            triangles: tris,
+            subdiv_levels: k.subdiv_levels,
+            extra_capacity: extra,
+            rtw_importance: (variant == Variant::Rtw) as u32,
+            interp: k.interp as u32,
+            mix: k.mix,
+            exact_depth: k.exact_depth as u32,
+            projection: kind,
+            strength: k.strength,
+            bias_mode: k.bias_mode as f32,
+            footprint_cap: k.footprint_cap,
+            depth_clamp: k.depth_clamp as f32,
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;
@@ -358,7 +402,7 @@ impl Warped {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let levels = params.ints[1];
+        let levels = params.subdiv_levels;
         let level_uniforms =
             (1..=levels).map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue])).collect();
         let ro = binding::storage(true);
@@ -383,7 +427,7 @@ impl Warped {
         let lookup_layout =
             layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX_FRAGMENT, &[look[0], look[1], look[2], look[3], (10, ro)]);
         let depth_pipeline =
-            raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(exact), &[&lookup_layout, &scene.layout], &[]);
+            raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(k.exact_depth), &[&lookup_layout, &scene.layout], &[]);
         let split_layout = layout_at(
             gpu,
             &format!("{name}.subdivide"),

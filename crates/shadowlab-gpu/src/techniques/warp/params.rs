@@ -1,7 +1,9 @@
 //! The parameters of `rtw`, `notw` and `notw-dv`: defaults as named constants with where they
 //! come from and what goes wrong when too low or high.
 
-use shadowlab_core::params::ParamDef;
+use shadowlab_core::params::{family, ParamDef, ParamValues};
+
+use super::Variant;
 
 /// Smoothing window (functions averaged: [i - window/2, i + window/2]). 16 is the authors'
 /// public code (GUIDE). Too low: neighbouring rows warp differently and long triangles bend
@@ -47,144 +49,67 @@ pub const DEFAULT_INTERP: f64 = 1.0;
 /// DV margin (texels): samples moved by the bias offsets must stay inside the cropped map.
 pub const DEFAULT_DV_MARGIN: f64 = 2.0;
 
-const fn p(key: &'static str, default: f64, min: f64, max: f64, integer: bool, doc: &'static str, source: &'static str) -> ParamDef {
-    ParamDef { key, default, min, max, integer, doc, source, choices: &[] }
-}
-
-const RES: ParamDef = p(
-    "res",
-    512.0,
-    16.0,
-    8192.0,
-    true,
-    "shadow map side (texels); warps are res x res",
-    "seeds 000/002 evaluation: 512 with 1024x1024 output",
-);
-const PCF: ParamDef = p("pcf", 1.0, 1.0, 7.0, true, "PCF kernel width N in warped texels; 1 = hard test", "Reeves et al. 1987");
-const BIAS: ParamDef = p(
-    "bias",
-    0.5,
-    0.0,
-    100.0,
-    false,
-    "constant depth bias, warped texels; low: acne, high: peter-panning",
-    "as sm (shadowlab sweep 2026-11-22)",
-);
-const SLOPE: ParamDef =
-    p("slope_bias", 0.0, 0.0, 100.0, false, "slope-scaled bias, warped texels x tan(angle)", "as sm: 0 (normal offset covers slopes)");
-const MAX_SLOPE: ParamDef = p("max_slope", 4.0, 0.0, 1000.0, false, "clamp on tan(angle to light) for slope and PCF bias", "as sm");
-const NORMAL_OFFSET: ParamDef = p(
-    "normal_offset",
-    0.5,
-    0.0,
-    100.0,
-    false,
-    "offset along the normal in warped texels (local size from the warp's Jacobian); low: acne, high: shifted shadows",
-    "Holbert 2011; value as sm",
-);
-pub const DV_MARGIN: ParamDef = p(
+// the shared map size, PCF and bias family (shadowlab_core::params::family), in warped texels
+pub const RES: ParamDef = family::RES.with_range(16.0, 8192.0).with_doc("shadow map side (texels); warps are res x res");
+pub const PCF: ParamDef = family::PCF.with_doc("PCF kernel width N in warped texels; 1 = hard test");
+pub const BIAS: ParamDef = family::BIAS.with_doc("constant depth bias, warped texels; low: acne, high: peter-panning");
+pub const SLOPE: ParamDef = family::SLOPE_BIAS.with_doc("slope-scaled bias, warped texels x tan(angle)");
+pub const MAX_SLOPE: ParamDef = family::MAX_SLOPE;
+pub const NORMAL_OFFSET: ParamDef = family::NORMAL_OFFSET
+    .with_doc("offset along the normal in warped texels (local size from the warp's Jacobian); low: acne, high: shifted shadows");
+pub const DV_MARGIN: ParamDef = ParamDef::number(
     "dv_margin",
     DEFAULT_DV_MARGIN,
     0.0,
     64.0,
-    false,
     "texels added around the desired view; low: biased samples fall outside (lit)",
     "shadowlab: covers bias + normal offset",
 );
-pub const WINDOW: ParamDef = p(
+pub const WINDOW: ParamDef = ParamDef::integer(
     "window",
     DEFAULT_WINDOW,
     0.0,
     1024.0,
-    true,
     "NoTW smoothing window across rows/columns; low: bent edges, high: RTW-like",
     "authors' public code (GUIDE)",
 );
-const BLUR: ParamDef = p(
+pub const BLUR: ParamDef = ParamDef::integer(
     "blur",
     DEFAULT_BLUR,
     0.0,
     512.0,
-    true,
     "RTW blur half-width of the 1D importance; low: abrupt warps, high: flat warps",
     "window 16 (GUIDE)",
 );
-pub const NOTW_BLUR: ParamDef = p(
-    "blur",
-    DEFAULT_NOTW_BLUR,
-    0.0,
-    512.0,
-    true,
-    "NoTW box blur half-width of the counts along each row/column before the prefix sums; 0 = the seeds' method; low: a kink per texel that subdivision must follow, high: less even sampling",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-pub const MIX: ParamDef = p(
-    "mix",
-    DEFAULT_MIX,
-    0.0,
-    100.0,
-    false,
-    "NoTW uniform floor added to every texel's count, as a fraction of the mean count per texel; 0 = the seeds' method; low: rows with few samples warp wildly (extreme magnification, folds), high: the warp fades to the identity",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-const W_DV: ParamDef = p(
+pub const NOTW_BLUR: ParamDef = ParamDef::integer("blur", DEFAULT_NOTW_BLUR, 0.0, 512.0, "NoTW box blur half-width of the counts along each row/column before the prefix sums; 0 = the seeds' method; low: a kink per texel that subdivision must follow, high: less even sampling", "shadowlab measurement (docs/bench/warp.md)");
+pub const MIX: ParamDef = ParamDef::number("mix", DEFAULT_MIX, 0.0, 100.0, "NoTW uniform floor added to every texel's count, as a fraction of the mean count per texel; 0 = the seeds' method; low: rows with few samples warp wildly (extreme magnification, folds), high: the warp fades to the identity", "shadowlab measurement (docs/bench/warp.md)");
+pub const W_DV: ParamDef = ParamDef::number(
     "w_dv",
     1.0,
     0.0,
     100.0,
-    false,
     "RTW desired-view importance (every sampled texel)",
     "GUIDE: importance = DV mask + (maxDistance - distance)",
 );
-const W_EYE: ParamDef =
-    p("w_eye", 1.0, 0.0, 100.0, false, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
-pub const NOTW_SUBDIV: ParamDef = ParamDef { default: DEFAULT_NOTW_SUBDIV, ..SUBDIV };
-const NOTW_BIASP: ParamDef = ParamDef {
-    default: DEFAULT_NOTW_BIAS,
-    source: "shadowlab sweep 0.5/1/1.5/2 with exact depth on six setups (docs/bench/warp.md)",
-    ..BIAS
-};
-pub const SUBDIV: ParamDef = p(
-    "subdiv",
-    DEFAULT_SUBDIV,
-    0.0,
-    1024.0,
-    false,
-    "split triangles until the warp bends no edge (or centroid) by more than this many warped texels from the rasterised line; 0 = off; low: many pieces, high: bent edges",
-    "shadowlab measurement (docs/bench/warp.md)",
-);
-pub const INTERP: ParamDef = ParamDef {
-    key: "interp",
-    default: DEFAULT_INTERP,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "interpolate offsets between neighbouring row/column functions (a continuous warp); false = eq. 6 as printed (one function per texel row: a sub-triangle crossing rows is rasterised across an offset jump)",
-    source: "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard",
-    choices: shadowlab_core::params::BOOL,
-};
-pub const SUBDIV_LEVELS: ParamDef = p(
+pub const W_EYE: ParamDef =
+    ParamDef::number("w_eye", 1.0, 0.0, 100.0, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
+pub const NOTW_SUBDIV: ParamDef = SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, SUBDIV.source);
+pub const NOTW_BIAS: ParamDef =
+    BIAS.with_default(DEFAULT_NOTW_BIAS, "shadowlab sweep 0.5/1/1.5/2 with exact depth on six setups (docs/bench/warp.md)");
+pub const SUBDIV: ParamDef = ParamDef::number("subdiv", DEFAULT_SUBDIV, 0.0, 1024.0, "split triangles until the warp bends no edge (or centroid) by more than this many warped texels from the rasterised line; 0 = off; low: many pieces, high: bent edges", "shadowlab measurement (docs/bench/warp.md)");
+pub const INTERP: ParamDef = ParamDef::flag("interp", DEFAULT_INTERP != 0.0, "interpolate offsets between neighbouring row/column functions (a continuous warp); false = eq. 6 as printed (one function per texel row: a sub-triangle crossing rows is rasterised across an offset jump)", "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard");
+pub const SUBDIV_LEVELS: ParamDef = ParamDef::integer(
     "subdiv_levels",
     DEFAULT_SUBDIV_LEVELS,
     1.0,
     15.0,
-    true,
     "max edge halvings per triangle (4^levels pieces); low: big triangles stay bent",
     "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
 );
 
 /// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.
 pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
-pub const CLOSE_CRACKS: ParamDef = ParamDef {
-    key: "close_cracks",
-    default: DEFAULT_CLOSE_CRACKS,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap",
-    source: "shadowlab measurement (docs/bench/warp.md)",
-    choices: shadowlab_core::params::BOOL,
-};
+pub const CLOSE_CRACKS: ParamDef = ParamDef::flag("close_cracks", DEFAULT_CLOSE_CRACKS != 0.0, "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap", "shadowlab measurement (docs/bench/warp.md)");
 
 /// Exact depth per fragment (warp inverted by Newton steps, the triangle's plane evaluated);
 /// 0 = the rasterised depth interpolated between warped vertices. See `EXACT_DEPTH`. RTW: off;
@@ -195,29 +120,19 @@ pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
 /// 3.22 %, conference sun 0.64 -> 0.46) for 2.8-4.8x the depth-pass time, 1.1-1.8x the total
 /// (no early depth test, 9 warp evaluations per fragment). Too slow? `exact_depth=false,bias=2`.
 pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 1.0;
-pub const EXACT_DEPTH: ParamDef = ParamDef {
-    key: "exact_depth",
-    default: DEFAULT_EXACT_DEPTH,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    doc: "write the exact depth per fragment: invert the warp at the fragment (3 Newton steps, 9 warp lookups) and evaluate the triangle's depth plane there; false = depth interpolated between warped vertices (off by up to the subdivision bend); disables early depth test",
-    source: "shadowlab experiment (docs/bench/warp.md)",
-    choices: shadowlab_core::params::BOOL,
-};
+pub const EXACT_DEPTH: ParamDef = ParamDef::flag("exact_depth", DEFAULT_EXACT_DEPTH != 0.0, "write the exact depth per fragment: invert the warp at the fragment (3 Newton steps, 9 warp lookups) and evaluate the triangle's depth plane there; false = depth interpolated between warped vertices (off by up to the subdivision bend); disables early depth test", "shadowlab experiment (docs/bench/warp.md)");
 
-const NOTW_EXACT: ParamDef = ParamDef { default: DEFAULT_NOTW_EXACT_DEPTH, ..EXACT_DEPTH };
+pub const NOTW_EXACT: ParamDef = EXACT_DEPTH.with_default(DEFAULT_NOTW_EXACT_DEPTH, EXACT_DEPTH.source);
 
 /// Warp strength alpha: warp(u) = u + alpha * offsets (lookup.wgsl). 1 = the seeds' warp;
 /// 0 = the identity (the DV crop only, `notw-dv` through the warped pipeline). A diagnostic
 /// (docs/bench/warp_bias.md); not in the seeds.
 pub const DEFAULT_STRENGTH: f64 = 1.0;
-pub const STRENGTH: ParamDef = p(
+pub const STRENGTH: ParamDef = ParamDef::number(
     "strength",
     DEFAULT_STRENGTH,
     0.0,
     1.0,
-    false,
     "warp strength: offsets scaled by this (1 = the computed warp, 0 = identity, i.e. the DV crop only); low: less even sampling",
     "shadowlab diagnostic (docs/bench/warp_bias.md)",
 );
@@ -233,23 +148,14 @@ pub const STRENGTH: ParamDef = p(
 /// whiteboard streaks of conference sun). `cube-notw`/`dpsm-notw` keep mode 0: mode 2 brings
 /// acne to them (docs/bench/point_quality.md).
 pub const DEFAULT_BIAS_MODE: f64 = 2.0;
-pub const BIAS_MODE: ParamDef = p(
-    "bias_mode",
-    DEFAULT_BIAS_MODE,
-    0.0,
-    3.0,
-    true,
-    "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side",
-    "shadowlab measurement (docs/bench/warp_bias.md)",
-);
+pub const BIAS_MODE: ParamDef = ParamDef::integer("bias_mode", DEFAULT_BIAS_MODE, 0.0, 3.0, "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side", "shadowlab measurement (docs/bench/warp_bias.md)");
 /// Cap of bias mode 2's footprint, in cropped texels; 0 = 1 / MIN_WARP_SCALE (8, as mode 0).
 pub const DEFAULT_FOOTPRINT_CAP: f64 = 0.0;
-pub const FOOTPRINT_CAP: ParamDef = p(
+pub const FOOTPRINT_CAP: ParamDef = ParamDef::number(
     "footprint_cap",
     DEFAULT_FOOTPRINT_CAP,
     0.0,
     64.0,
-    false,
     "bias_mode 2: largest footprint in cropped texels (0 = 8); high: leaks under contacts where the warp compresses, low: acne there",
     "shadowlab measurement (docs/bench/warp_bias.md)",
 );
@@ -258,12 +164,11 @@ pub const FOOTPRINT_CAP: ParamDef = p(
 /// are chords of its curved warped edges, so it rasterises fragments up to `subdiv` warped
 /// texels inside its neighbours, whose exact (plane) depth may lie outside the piece's own range.
 pub const DEFAULT_DEPTH_CLAMP: f64 = 0.0;
-pub const DEPTH_CLAMP: ParamDef = p(
+pub const DEPTH_CLAMP: ParamDef = ParamDef::integer(
     "depth_clamp",
     DEFAULT_DEPTH_CLAMP,
     0.0,
     1.0,
-    true,
     "exact_depth: clamp the plane depth to the corner depths of 0 = the piece, 1 = the whole triangle",
     "shadowlab measurement (docs/bench/warp_bias.md)",
 );
@@ -280,7 +185,7 @@ const NOTW_SHARED: [ParamDef; 15] = [
     CLOSE_CRACKS,
     NOTW_EXACT,
     PCF,
-    NOTW_BIASP,
+    NOTW_BIAS,
     SLOPE,
     MAX_SLOPE,
     NORMAL_OFFSET,
@@ -303,6 +208,11 @@ const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A]
 /// notw's own list: `NOTW_PARAMS` plus the warp strength and the bias footprint parameters.
 pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<15, 4, 19>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP]);
 
+/// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
+/// run with; the gradient footprint (2) was measured for `notw` only.
+pub const BIAS_MODE_ISOTROPIC: ParamDef =
+    BIAS_MODE.with_default(0.0, "the isotropic footprint the gradient footprint was measured against (docs/bench/warp_bias.md)");
+
 pub const RTW_PARAMS: &[ParamDef] = &[
     RES,
     W_DV,
@@ -319,5 +229,59 @@ pub const RTW_PARAMS: &[ParamDef] = &[
     MAX_SLOPE,
     NORMAL_OFFSET,
     DV_MARGIN,
+    STRENGTH,
+    BIAS_MODE_ISOTROPIC,
+    FOOTPRINT_CAP,
+    DEPTH_CLAMP,
 ];
-pub const DV_PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN];
+pub const DV_PARAMS: &[ParamDef] =
+    &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN, BIAS_MODE_ISOTROPIC, FOOTPRINT_CAP, DEPTH_CLAMP];
+
+/// The settings a warped map runs with, read from the parameters each variant declares. What a
+/// variant's method does not have is fixed here, not defaulted: RTW has no smoothing window or
+/// uniform floor (its warps are 1D), NoTW no RTW importance, and the DV crop (`notw-dv`, and
+/// `dpsm`'s plain paraboloids) no warp at all (subdivision only on a paraboloid).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Knobs {
+    pub window: u32,
+    pub blur: u32,
+    pub mix: f32,
+    pub w_dv: f32,
+    pub w_eye: f32,
+    pub interp: bool,
+    /// Subdivision threshold (warped texels); 0 = off.
+    pub subdiv: f32,
+    pub subdiv_levels: u32,
+    pub exact_depth: bool,
+    pub close_cracks: bool,
+    pub dv_margin: f32,
+    pub strength: f32,
+    pub bias_mode: u32,
+    pub footprint_cap: f32,
+    pub depth_clamp: u32,
+}
+
+impl Knobs {
+    pub(super) fn read(p: &ParamValues, variant: Variant, paraboloid: bool, dv: bool) -> Knobs {
+        let (notw, rtw, warped) = (variant == Variant::Notw, variant == Variant::Rtw, variant != Variant::Dv);
+        let subdivides = warped || paraboloid;
+        let subdiv = if subdivides { p.get("subdiv") as f32 } else { 0.0 };
+        Knobs {
+            window: if notw { p.get_u32("window") } else { 0 },
+            blur: if warped { p.get_u32("blur") } else { 0 },
+            mix: if notw { p.get("mix") as f32 } else { 0.0 },
+            w_dv: if rtw { p.get("w_dv") as f32 } else { 0.0 },
+            w_eye: if rtw { p.get("w_eye") as f32 } else { 0.0 },
+            interp: !warped || p.get_bool("interp"),
+            subdiv,
+            subdiv_levels: if subdivides { p.get_u32("subdiv_levels") } else { 1 },
+            exact_depth: subdivides && p.get_bool("exact_depth"),
+            close_cracks: warped && dv && p.get_bool("close_cracks"),
+            dv_margin: if dv { p.get("dv_margin") as f32 } else { 0.0 },
+            strength: if warped { p.get("strength") as f32 } else { 1.0 },
+            bias_mode: p.get_u32("bias_mode"),
+            footprint_cap: p.get("footprint_cap") as f32,
+            depth_clamp: p.get_u32("depth_clamp"),
+        }
+    }
+}

@@ -7,35 +7,62 @@
 
 struct WarpParams {
     light_view_proj: mat4x4<f32>,
-    // x: world size of one texel of the full (un-cropped) map (perspective: per unit of depth)
-    // y: 1 if perspective; z: resolution; w: pcf kernel width
-    texel: vec4<f32>,
-    // x: constant bias, y: slope-scaled bias, z: normal offset (all in warped texels), w: max slope
-    bias: vec4<f32>,
-    // x: DV margin (texels), y: DV on (1; 2: DV on and cracks closed by a 3x3 depth minimum),
-    // z: warp on, w: smoothing window (functions)
-    cfg: vec4<f32>,
-    // x: RTW desired-view weight, y: RTW distance-to-eye weight, z: RTW blur radius, w: subdiv
-    // threshold (warped texels per edge)
-    imp: vec4<f32>,
-    // x: triangles, y: max subdivision level, z: extra sub-triangle capacity, w: 1 = RTW importance
-    ints: vec4<u32>,
-    // x: 1 = offsets interpolated linearly between neighbouring functions (continuous warp),
-    // 0 = eq. 6 as printed (function floor(y w) / floor(x' w)); y: NoTW uniform floor `mix`
-    // (f32 bits); z: 1 = exact depth per fragment (depth_exact.wgsl); w: projection kind
-    // (PLANAR, or PARABOLOID_FRONT / _BACK: one hemisphere of a point light, paraboloid.rs)
-    flags: vec4<u32>,
-    // x: warp strength alpha (warp(u) = u + alpha * offsets; 1 = the computed warp), y: bias
-    // footprint mode (0: isotropic, world texel / smallest singular value; see eval.wgsl), z:
-    // cap of mode 2's footprint (cropped texels; 0 = 1 / MIN_WARP_SCALE), w: 1 = exact depth
-    // clamped to the whole triangle's corner depths (0: the piece's corners)
-    ext: vec4<f32>,
+    // world size of one texel of the full (un-cropped) map (perspective: per unit of depth)
+    texel_world: f32,
+    // 1 if perspective
+    perspective: f32,
+    // map side (texels)
+    res: f32,
+    // PCF kernel width
+    pcf: f32,
+    // constant bias, slope-scaled bias, normal offset (all in warped texels), max slope
+    bias: f32,
+    slope_bias: f32,
+    normal_offset: f32,
+    max_slope: f32,
+    // DV margin (texels)
+    dv_margin: f32,
+    // 0: no DV crop, 1: DV crop (DV_CROP), 2: DV crop and cracks closed by a 3x3 depth
+    // minimum (DV_CROP_CLOSED)
+    dv_mode: f32,
+    // 1: the warp is on (0: the DV crop only)
+    warped: f32,
+    // NoTW smoothing window (functions)
+    window: f32,
+    // RTW desired-view weight, distance-to-eye weight, blur radius (texels)
+    w_dv: f32,
+    w_eye: f32,
+    blur: f32,
+    // subdivision threshold (warped texels per edge); 0: off
+    subdiv: f32,
+    // triangles, max subdivision level, extra sub-triangle capacity, 1 = RTW importance
+    triangles: u32,
+    subdiv_levels: u32,
+    extra_capacity: u32,
+    rtw_importance: u32,
+    // 1 = offsets interpolated linearly between neighbouring functions (continuous warp),
+    // 0 = eq. 6 as printed (function floor(y w) / floor(x' w))
+    interp: u32,
+    // NoTW uniform floor (fraction of the mean count per texel)
+    mix: f32,
+    // 1 = exact depth per fragment (depth_exact.wgsl)
+    exact_depth: u32,
+    // projection kind: PLANAR, or PARABOLOID_FRONT / _BACK (one hemisphere of a point light)
+    projection: u32,
+    // warp strength alpha (warp(u) = u + alpha * offsets; 1 = the computed warp)
+    strength: f32,
+    // bias footprint mode (0: isotropic, world texel / smallest singular value; see eval.wgsl)
+    bias_mode: f32,
+    // cap of mode 2's footprint (cropped texels; 0 = 1 / MIN_WARP_SCALE)
+    footprint_cap: f32,
+    // 1 = exact depth clamped to the whole triangle's corner depths (0: the piece's corners)
+    depth_clamp: f32,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.
 const DV_SCALE: f32 = 16777216.0;
 
-// Projection kinds (flags.w). PLANAR: light_view_proj is the light's view-projection.
+// Projection kinds (WarpParams.projection). PLANAR: light_view_proj is the light's view-projection.
 // PARABOLOID_FRONT / _BACK (seed 002 eq. 3.3-3.10): light_view_proj is world -> the hemisphere's light space
 // (+z = its axis) scaled by 1/far; the map plane point is (n.x, n.y) / (1 + n.z) for the unit
 // direction n, depth = distance / far (linear, 0 at the light).
@@ -44,7 +71,7 @@ const PARABOLOID_FRONT: u32 = 1u;
 const PARABOLOID_BACK: u32 = 2u;
 
 fn is_paraboloid(pw: WarpParams) -> bool {
-    return pw.flags.w != PLANAR;
+    return pw.projection != PLANAR;
 }
 
 // Base map coordinates (x, y) and depth of a world point as a clip position; w <= 0 behind a
@@ -82,7 +109,7 @@ const SPLIT_OVERLAP: f32 = 0.1;
 // owns the split plane (side >= 0), the back (whose +z is the opposite axis) only side > 0.
 fn owns_sample(pw: WarpParams, p: vec3<f32>) -> bool {
     let s = hemisphere_side(pw, p);
-    return !is_paraboloid(pw) || s > 0.0 || (s == 0.0 && pw.flags.w == PARABOLOID_FRONT);
+    return !is_paraboloid(pw) || s > 0.0 || (s == 0.0 && pw.projection == PARABOLOID_FRONT);
 }
 
 fn clip_to_map(c: vec4<f32>) -> vec3<f32> {
@@ -93,14 +120,14 @@ fn clip_to_map(c: vec4<f32>) -> vec3<f32> {
 // The DV rectangle (lo.xy, hi.xy) from the reduced fixed-point bounds: extent e = max(hi - lo,
 // 1/res), grown by margin * e / res per side (warp.rs `grow_rect`). Full map when off or empty.
 fn dv_from_bounds(pw: WarpParams, b: vec4<u32>) -> vec4<f32> {
-    if pw.cfg.y < 0.5 || b.x > b.z || b.y > b.w {
+    if pw.dv_mode < 0.5 || b.x > b.z || b.y > b.w {
         return vec4<f32>(0.0, 0.0, 1.0, 1.0);
     }
-    let res = pw.texel.z;
+    let res = pw.res;
     let lo = vec2<f32>(b.xy) / DV_SCALE;
     let hi = vec2<f32>(b.zw) / DV_SCALE;
     let e = max(hi - lo, vec2<f32>(1.0 / res));
-    let m = pw.cfg.x * e / res;
+    let m = pw.dv_margin * e / res;
     return vec4<f32>(lo - m, lo + e + m);
 }
 

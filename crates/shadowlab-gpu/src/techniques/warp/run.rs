@@ -1,9 +1,9 @@
 //! The per-frame passes of the warped techniques, their report, and readbacks for tests.
 
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::warp::Warp2D;
+use shadowlab_core::techniques::warp::Warp2D;
 
-use super::{Variant, Warped};
+use super::{Variant, Warped, DV_CROP_CLOSED};
 use crate::prefix_sum::ScanParams;
 use crate::record::Recorder;
 use crate::technique::{FrameInputs, NamedImage, Technique, TechniqueReport};
@@ -49,15 +49,15 @@ impl Warped {
     /// The DV rectangle (lo x, lo y, hi x, hi y) in base map coordinates, as the shaders use it.
     pub fn read_dv_rect(&self, gpu: &Gpu) -> [f32; 4] {
         let b: Vec<u32> = gpu.read_buffer_as(&self.dv, 4);
-        if self.params.cfg[1] < 0.5 || b[0] > b[2] || b[1] > b[3] {
+        if self.params.dv_mode == 0.0 || b[0] > b[2] || b[1] > b[3] {
             return [0.0, 0.0, 1.0, 1.0];
         }
         let s = 16777216.0f32;
-        let (lo, hi) = shadowlab_core::warp::grow_rect(
+        let (lo, hi) = shadowlab_core::techniques::warp::grow_rect(
             [b[0] as f32 / s, b[1] as f32 / s],
             [b[2] as f32 / s, b[3] as f32 / s],
             self.res as usize,
-            self.params.cfg[0],
+            self.params.dv_margin,
         );
         [lo[0], lo[1], hi[0], hi[1]]
     }
@@ -89,7 +89,7 @@ impl Warped {
             cols_y: self.warp_y.width() as usize,
             ox,
             oy,
-            interp: self.params.flags[0] != 0,
+            interp: self.params.interp != 0,
         }
     }
 
@@ -167,7 +167,7 @@ impl Technique for Warped {
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let name = self.name();
         let (xv, yv) = (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()));
-        let subdiv = self.params.imp[3] > 0.0;
+        let subdiv = self.params.subdiv > 0.0;
         let pieces = if subdiv { &self.pieces } else { &self.counters };
         let look = self.lookup_resources(&xv, &yv);
         let mut entries: Vec<wgpu::BindGroupEntry> =
@@ -189,7 +189,7 @@ impl Technique for Warped {
                     gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &e })
                 })
                 .collect();
-            let tris = self.params.ints[0];
+            let tris = self.params.triangles;
             let n = tris.div_ceil(64);
             rec.stage(&format!("{name}.subdivide"), |enc| {
                 enc.clear_buffer(&self.counters, 0, None);
@@ -249,14 +249,14 @@ impl Technique for Warped {
             ..Default::default()
         };
         let c = &mut r.counters;
-        let per_tap = if self.params.cfg[1] > 1.5 { 9.0 } else { 1.0 };
+        let per_tap = if self.params.dv_mode == DV_CROP_CLOSED { 9.0 } else { 1.0 };
         c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64 * per_tap);
         c.insert("shadow_map_texels".into(), n as f64);
         c.insert("warp_bytes".into(), self.warp_bytes() as f64);
         c.insert("scratch_bytes".into(), self.scratch_bytes() as f64);
         let dv = self.read_dv_rect(gpu);
         c.insert("dv_area_fraction".into(), ((dv[2] - dv[0]) * (dv[3] - dv[1])) as f64);
-        if self.params.imp[3] > 0.0 {
+        if self.params.subdiv > 0.0 {
             let a: Vec<u32> = gpu.read_buffer_as(&self.counters, 8);
             c.insert("subdiv_triangles_drawn".into(), (a[4] / 3) as f64);
             c.insert("subdiv_pieces_dropped".into(), a[1] as f64);

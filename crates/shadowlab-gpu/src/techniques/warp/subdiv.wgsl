@@ -46,7 +46,7 @@ fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32
         let t = f32(s) / 4.0;
         e = max(e, distance(warp(mix(ma, mb, t)), mix(wa, wb, t)));
     }
-    return e * wp.texel.z;
+    return e * wp.res;
 }
 
 // Whether an edge must be split: both ends in front of the light, the edge overlaps the
@@ -71,9 +71,9 @@ fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
         return false;
     }
     if is_paraboloid(wp) {
-        return paraboloid_edge_error(pa, pb, warp(ua), warp(ub), r) > wp.imp.w;
+        return paraboloid_edge_error(pa, pb, warp(ua), warp(ub), r) > wp.subdiv;
     }
-    return edge_error(ua, ub, warp(ua), warp(ub)) > wp.imp.w;
+    return edge_error(ua, ub, warp(ua), warp(ub)) > wp.subdiv;
 }
 
 // The paraboloid mapping bends straight world edges (seed 002 section 3.3.2: "the rendered scene
@@ -96,7 +96,7 @@ fn paraboloid_edge_error(pa: vec3<f32>, pb: vec3<f32>, wa: vec2<f32>, wb: vec2<f
         }
         e = max(e, d);
     }
-    return e * wp.texel.z;
+    return e * wp.res;
 }
 
 // A piece larger than BIG_PIECE of the cropped map that overlaps it splits all three edges even when
@@ -142,11 +142,11 @@ fn split_mask(p: vec4<u32>) -> u32 {
 
 fn finish(p: vec4<u32>) {
     let i = atomicAdd(&counters[0], 1u);
-    if i >= wp.ints.z {
+    if i >= wp.extra_capacity {
         atomicAdd(&counters[1], 1u);
         return;
     }
-    pieces[wp.ints.x + i] = p;
+    pieces[wp.triangles + i] = p;
 }
 
 fn enqueue(p: vec4<u32>, q: u32) {
@@ -182,7 +182,7 @@ fn mix_corner(a: u32, b: u32, t: f32) -> u32 {
 @compute @workgroup_size(64)
 fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
-    if tri >= wp.ints.x {
+    if tri >= wp.triangles {
         return;
     }
     let c = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
@@ -317,8 +317,8 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
 
 @compute @workgroup_size(1)
 fn draw_args() {
-    let appended = min(atomicLoad(&counters[0]), wp.ints.z);
-    atomicStore(&counters[4], 3u * (wp.ints.x + appended));
+    let appended = min(atomicLoad(&counters[0]), wp.extra_capacity);
+    atomicStore(&counters[4], 3u * (wp.triangles + appended));
     atomicStore(&counters[5], 1u);
     atomicStore(&counters[6], 0u);
     atomicStore(&counters[7], 0u);

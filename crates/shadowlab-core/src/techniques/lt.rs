@@ -9,9 +9,9 @@
 use glam::Vec4Swizzles;
 
 use crate::camera::{look_at, perspective};
-use crate::cascades::CascadeBox;
 use crate::lightspace::LightProjection;
 use crate::scene::Bounds;
+use crate::techniques::csm::CascadeBox;
 
 /// LTT epsilon: a ray where `eps < s < 1 - eps` (seed 004 eq. 3 and section 4: 0.01). Too low:
 /// numerical noise of the bounds flags whole lit/shadowed regions; too high: misses leaks whose
@@ -342,7 +342,7 @@ mod tests {
 mod cascade_tests {
     use super::*;
     use crate::camera::Camera;
-    use crate::cascades::{fit_cascade, Fit, ViewFrustum};
+    use crate::techniques::csm::{fit_cascade, Fit, ViewFrustum};
     use glam::Vec3;
 
     fn fit_at(x: f32, yaw: f32) -> (CascadeBox, [Vec3; 8]) {
