@@ -60,6 +60,20 @@ fn layout(module: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
     panic!("struct {name} not found");
 }
 
+/// `(name, offset)` of each listed field of a Rust struct.
+macro_rules! fields {
+    ($t:ty; $($f:ident),+ $(,)?) => { &[$((stringify!($f), offset_of!($t, $f))),+] };
+}
+
+/// [`check`], and every WGSL member is one of `offsets` (each value has its own named field).
+fn check_all(module: &naga::Module, name: &str, size: usize, offsets: &[(&str, usize)]) {
+    check(module, name, size, offsets);
+    let (_, members) = layout(module, name);
+    for (m, _) in &members {
+        assert!(offsets.iter().any(|(n, _)| n == m), "{name}.{m}: a WGSL member the Rust side does not name");
+    }
+}
+
 fn check(module: &naga::Module, name: &str, size: usize, offsets: &[(&str, usize)]) {
     let (span, members) = layout(module, name);
     assert_eq!(span as usize, size, "{name}: WGSL size {span} != Rust size {size}");
@@ -139,11 +153,11 @@ fn mdsm_params_layout_matches_wgsl() {
     let all = shadowlab_gpu::registry::shaders();
     for name in ["mdsm/select.wgsl", "mdsm/eval.wgsl"] {
         let src = &all.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("{name} not composed")).1;
-        check(
+        check_all(
             &parse(name, src),
             "MdsmParams",
             size_of::<MdsmParams>(),
-            &[("texel", offset_of!(MdsmParams, texel)), ("bias", offset_of!(MdsmParams, bias)), ("sel", offset_of!(MdsmParams, sel))],
+            fields!(MdsmParams; light_view_proj, texel, bias, n, region, select, region_bias),
         );
     }
 }
@@ -155,7 +169,13 @@ fn sv_struct_layouts_match_rust() {
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for f in ["sv/silhouette.wgsl", "sv/volume.wgsl", "sv/resolve.wgsl"] {
-        check(&get(f), "SvParams", size_of::<SvParams>(), &[("counts", 0), ("extrude", offset_of!(SvParams, extrude))]);
+        let f = get(f);
+        check_all(
+            &f,
+            "SvParams",
+            size_of::<SvParams>(),
+            fields!(SvParams; triangles, edges, side_vertices, depth_offset, extrude, pad0, pad1, pad2),
+        );
     }
     for f in ["sv/silhouette.wgsl", "sv/volume.wgsl"] {
         let offsets = [("a", 0), ("b", offset_of!(Edge, b)), ("first", offset_of!(Edge, first)), ("count", offset_of!(Edge, count))];
@@ -171,11 +191,11 @@ fn csm_and_reduce_layouts_match_rust() {
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     let eval = get("csm/eval.wgsl");
     check(&eval, "Cascade", size_of::<CascadeU>(), &[("view_proj", 0), ("info", offset_of!(CascadeU, info))]);
-    check(
+    check_all(
         &eval,
         "CsmParams",
         size_of::<CsmParams>(),
-        &[("cascades", 0), ("cfg", offset_of!(CsmParams, cfg)), ("bias", offset_of!(CsmParams, bias))],
+        fields!(CsmParams; cascades, count, res, pcf, blend, bias, normal_offset, max_slope, pad0),
     );
     check(&get("csm/depth.wgsl"), "CsmDepth", size_of::<[[f32; 4]; 4]>(), &[("view_proj", 0)]);
     check(&get("reduce/reduce.wgsl"), "ReduceParams", size_of::<ReduceParams>(), &[("channel", 0)]);
@@ -215,16 +235,12 @@ fn filtered_and_blur_layouts_match_rust() {
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for f in ["filtered/render.wgsl", "filtered/eval.wgsl"] {
-        check(
+        check_all(
             &get(f),
             "FilteredParams",
             size_of::<FilteredParams>(),
-            &[
-                ("texel", offset_of!(FilteredParams, texel)),
-                ("mode", offset_of!(FilteredParams, mode)),
-                ("shape", offset_of!(FilteredParams, shape)),
-                ("bias", offset_of!(FilteredParams, bias)),
-            ],
+            fields!(FilteredParams; light_view_proj, texel_world, perspective, res, inv_far, kind, single_depth, mip_levels, pad0,
+                min_variance, esm_c, evsm_c_pos, evsm_c_neg, moment_bias, depth_bias, normal_offset, pad1),
         );
     }
     for b in ["blur/blur.wgsl (r32float)", "blur/blur.wgsl (rgba32float)"] {
@@ -257,40 +273,13 @@ fn warp_struct_layouts_match_rust() {
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl"] {
-        check(
+        check_all(
             &get(w),
             "WarpParams",
             size_of::<WarpParams>(),
-            &[
-                ("texel_world", offset_of!(WarpParams, texel_world)),
-                ("perspective", offset_of!(WarpParams, perspective)),
-                ("res", offset_of!(WarpParams, res)),
-                ("pcf", offset_of!(WarpParams, pcf)),
-                ("bias", offset_of!(WarpParams, bias)),
-                ("slope_bias", offset_of!(WarpParams, slope_bias)),
-                ("normal_offset", offset_of!(WarpParams, normal_offset)),
-                ("max_slope", offset_of!(WarpParams, max_slope)),
-                ("dv_margin", offset_of!(WarpParams, dv_margin)),
-                ("dv_mode", offset_of!(WarpParams, dv_mode)),
-                ("warped", offset_of!(WarpParams, warped)),
-                ("window", offset_of!(WarpParams, window)),
-                ("w_dv", offset_of!(WarpParams, w_dv)),
-                ("w_eye", offset_of!(WarpParams, w_eye)),
-                ("blur", offset_of!(WarpParams, blur)),
-                ("subdiv", offset_of!(WarpParams, subdiv)),
-                ("triangles", offset_of!(WarpParams, triangles)),
-                ("subdiv_levels", offset_of!(WarpParams, subdiv_levels)),
-                ("extra_capacity", offset_of!(WarpParams, extra_capacity)),
-                ("rtw_importance", offset_of!(WarpParams, rtw_importance)),
-                ("interp", offset_of!(WarpParams, interp)),
-                ("mix", offset_of!(WarpParams, mix)),
-                ("exact_depth", offset_of!(WarpParams, exact_depth)),
-                ("projection", offset_of!(WarpParams, projection)),
-                ("strength", offset_of!(WarpParams, strength)),
-                ("bias_mode", offset_of!(WarpParams, bias_mode)),
-                ("footprint_cap", offset_of!(WarpParams, footprint_cap)),
-                ("depth_clamp", offset_of!(WarpParams, depth_clamp)),
-            ],
+            fields!(WarpParams; light_view_proj, texel_world, perspective, res, pcf, bias, slope_bias, normal_offset, max_slope,
+                dv_margin, dv_mode, warped, window, w_dv, w_eye, blur, subdiv, triangles, subdiv_levels, extra_capacity,
+                rtw_importance, interp, mix, exact_depth, projection, strength, bias_mode, footprint_cap, depth_clamp),
         );
     }
     check(
@@ -337,11 +326,11 @@ fn cube_layouts_match_wgsl() {
         size_of::<CubeFace>(),
         &[("light", offset_of!(CubeFace, light)), ("face", offset_of!(CubeFace, face))],
     );
-    check(
+    check_all(
         &get("cube/eval.wgsl"),
         "CubeParams",
         size_of::<CubeParams>(),
-        &[("cfg", offset_of!(CubeParams, cfg)), ("bias", offset_of!(CubeParams, bias))],
+        fields!(CubeParams; position, far, res, pcf, near, pad0, bias),
     );
 }
 
@@ -350,18 +339,12 @@ fn lt_params_layout_matches_wgsl() {
     use shadowlab_gpu::techniques::lt::{LevelU, LtParams, TraceParams};
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap_or_else(|| panic!("{n} not composed")).1);
-    check(
+    check_all(
         &get("lt/classify.wgsl"),
         "LtParams",
         size_of::<LtParams>(),
-        &[
-            ("levels", offset_of!(LtParams, levels)),
-            ("texel", offset_of!(LtParams, texel)),
-            ("mode", offset_of!(LtParams, mode)),
-            ("shape", offset_of!(LtParams, shape)),
-            ("bias", offset_of!(LtParams, bias)),
-            ("history", offset_of!(LtParams, history)),
-        ],
+        fields!(LtParams; levels, layers, perspective, res, inv_far, technique, base, frame, flags, min_variance, esm_c,
+            evsm_c_pos, evsm_c_neg, moment_bias, depth_bias, normal_offset, eps, depth_tol, normal_cos, mask_bits, pad0),
     );
     check(&get("lt/classify.wgsl"), "Level", size_of::<LevelU>(), &[("info", offset_of!(LevelU, info))]);
     for n in ["lt/trace.wgsl", "lt/args.wgsl"] {

@@ -13,10 +13,19 @@ struct Cascade {
 
 struct CsmParams {
     cascades: array<Cascade, 8>,
-    // x: cascade count, y: resolution, z: pcf kernel width, w: blend band (fraction of a slice)
-    cfg: vec4<f32>,
-    // x: constant bias, y: normal offset (texels), z: max slope for the kernel bias, w: unused
-    bias: vec4<f32>,
+    // cascades in use
+    count: f32,
+    // map side per cascade (texels)
+    res: f32,
+    // PCF kernel width
+    pcf: f32,
+    // blend band (fraction of a slice)
+    blend: f32,
+    // constant bias and normal offset (texels), max slope for the kernel bias
+    bias: f32,
+    normal_offset: f32,
+    max_slope: f32,
+    pad0: f32,
 }
 
 @group(0) @binding(6) var<uniform> csm: CsmParams;
@@ -38,12 +47,12 @@ fn inside(m: vec3<f32>) -> bool {
 // Visibility of p from cascade c, or -1 when p's offset position is outside its box.
 fn lookup(c: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     let texel = csm.cascades[c].info.x;
-    let res = csm.cfg.y;
-    let k = i32(csm.cfg.z);
+    let res = csm.res;
+    let k = i32(csm.pcf);
     let half = f32(k - 1) * 0.5;
     let cos_t = clamp(dot(n, l), 1e-4, 1.0);
-    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, csm.bias.z);
-    let q = p + n * (csm.bias.y * texel) + l * ((csm.bias.x + half * tan_t) * texel);
+    let tan_t = min(sqrt(1.0 - cos_t * cos_t) / cos_t, csm.max_slope);
+    let q = p + n * (csm.normal_offset * texel) + l * ((csm.bias + half * tan_t) * texel);
     let m = to_map(c, q);
     if !inside(m) {
         return -1.0;
@@ -60,7 +69,7 @@ fn lookup(c: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
 
 // First cascade from `first` on that covers p (-1 visibility: none), as (visibility, cascade).
 fn resolve(first: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
-    let count = u32(csm.cfg.x);
+    let count = u32(csm.count);
     for (var c = first; c < count; c++) {
         let v = lookup(c, p, n, l);
         if v >= 0.0 {
@@ -81,14 +90,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let depth = textureLoad(g_position, id.xy, 0).w;
     let l = to_light(light, s.p);
-    let count = u32(csm.cfg.x);
+    let count = u32(csm.count);
     var c = 0u;
     while c + 1u < count && depth > csm.cascades[c].info.z {
         c++;
     }
 
     // sampling statistics: the texel of the chosen cascade this sample lands in
-    let res = u32(csm.cfg.y);
+    let res = u32(csm.res);
     let m0 = to_map(c, s.p);
     if COUNT_SAMPLES && all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
         let t = vec2<u32>(m0.xy * f32(res));
@@ -100,7 +109,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var tag = 1u + u32(a.y);
     let d0 = csm.cascades[c].info.y;
     let d1 = csm.cascades[c].info.z;
-    let band = csm.cfg.w * (d1 - d0);
+    let band = csm.blend * (d1 - d0);
     if band > 0.0 && c + 1u < count && depth > d1 - band {
         let t = clamp((depth - (d1 - band)) / band, 0.0, 1.0);
         v = mix(v, resolve(c + 1u, s.p, s.n, l).x, t);

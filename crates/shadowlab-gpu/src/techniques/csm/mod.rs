@@ -65,10 +65,18 @@ pub struct CascadeU {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct CsmParams {
     pub cascades: [CascadeU; MAX_CASCADES],
-    /// x: count, y: res, z: pcf, w: blend band.
-    pub cfg: [f32; 4],
-    /// x: constant bias, y: normal offset, z: max slope.
-    pub bias: [f32; 4],
+    /// Cascades in use.
+    pub count: f32,
+    pub res: f32,
+    pub pcf: f32,
+    /// Blend band (fraction of a slice).
+    pub blend: f32,
+    /// Texels.
+    pub bias: f32,
+    /// Texels.
+    pub normal_offset: f32,
+    pub max_slope: f32,
+    pub pad0: f32,
 }
 
 /// Bytes of the probe buffer the CPU reads each frame with `tighten`: the min/max words.
@@ -134,8 +142,14 @@ impl Cascaded {
         let maps = raster::depth_target(gpu, "csm.maps", res, res, count as u32, wgpu::TextureUsages::empty());
         let params = CsmParams {
             cascades: [CascadeU::zeroed(); MAX_CASCADES],
-            cfg: [count as f32, res as f32, p.get("pcf") as f32, p.get("blend") as f32],
-            bias: [p.get("bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32, 0.0],
+            count: count as f32,
+            res: res as f32,
+            pcf: p.get("pcf") as f32,
+            blend: p.get("blend") as f32,
+            bias: p.get("bias") as f32,
+            normal_offset: p.get("normal_offset") as f32,
+            max_slope: p.get("max_slope") as f32,
+            pad0: 0.0,
         };
         let uniform = gpu.uniform("csm.params", &params);
         let depth_layout = binding::layout(d, "csm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);

@@ -6,11 +6,17 @@
 // texel of the six faces.
 
 struct CubeParams {
-    // xyz: light position, w: far
-    light: vec4<f32>,
-    // x: resolution per face, y: pcf kernel width, z: near (depth=hardware)
-    cfg: vec4<f32>,
-    // x: constant bias, y: slope-scaled bias, z: normal offset (texels), w: max slope
+    position: vec3<f32>,
+    // distance normalisation (the scene's farthest point from the light)
+    far: f32,
+    // map side per face (texels)
+    res: f32,
+    // PCF kernel width
+    pcf: f32,
+    // near plane (depth=hardware)
+    near: f32,
+    pad0: f32,
+    // constant bias, slope-scaled bias, normal offset (texels), max slope (sm's bias.wgsl)
     bias: vec4<f32>,
 }
 
@@ -28,7 +34,7 @@ fn stored_distance(g: u32, t: vec2<i32>, res: f32) -> f32 {
         return 2.0;
     }
     let dc = cube_direction(g, (vec2<f32>(t) + 0.5) / res);
-    return cube.cfg.z / v * length(dc) / cube.light.w;
+    return cube.near / v * length(dc) / cube.far;
 }
 @group(0) @binding(7) var faces: texture_depth_2d_array;
 @group(0) @binding(8) var<storage, read_write> counts: array<atomic<u32>>;
@@ -39,26 +45,26 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    let res = cube.cfg.x;
+    let res = cube.res;
     let ires = i32(res);
     let l = to_light(light, s.p);
 
     // sampling statistics: the texel of the unbiased sample
-    let d0 = s.p - cube.light.xyz;
+    let d0 = s.p - cube.position;
     let f0 = cube_face(d0);
     let t0 = clamp(vec2<i32>(floor(cube_project(f0, d0) * res)), vec2<i32>(0), vec2<i32>(ires - 1));
     if COUNT_SAMPLES {
         atomicAdd(&counts[(f0 * u32(ires) + u32(t0.y)) * u32(ires) + u32(t0.x)], 1u);
     }
 
-    let k = i32(cube.cfg.y);
+    let k = i32(cube.pcf);
     let half = f32(k - 1) * 0.5;
     let texel = 2.0 * dot(d0, cube_basis(f0)[0]) / res;
     let q = biased_point(s.p, s.n, l, texel, cube.bias, half);
-    let d = q - cube.light.xyz;
+    let d = q - cube.position;
     let f = cube_face(d);
     let m = cube_project(f, d);
-    let dist = length(d) / cube.light.w;
+    let dist = length(d) / cube.far;
     var lit = 0.0;
     for (var y = 0; y < k; y++) {
         for (var x = 0; x < k; x++) {

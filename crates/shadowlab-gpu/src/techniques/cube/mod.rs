@@ -187,8 +187,15 @@ pub struct CubeFace {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct CubeParams {
-    pub light: [f32; 4],
-    pub cfg: [f32; 4],
+    pub position: [f32; 3],
+    /// Distance normalisation (the scene's farthest point from the light).
+    pub far: f32,
+    pub res: f32,
+    pub pcf: f32,
+    /// Near plane (depth=hardware).
+    pub near: f32,
+    pub pad0: f32,
+    /// Constant bias, slope-scaled bias, normal offset (texels), max slope: sm's `biased_point`.
     pub bias: [f32; 4],
 }
 
@@ -242,8 +249,12 @@ impl CubeMap {
         let static_pipeline = face_pipeline(gpu, &module, "cube.render.static", &layouts, hardware, false, scene.has_cutouts);
         let face_indices = static_face_lists(gpu, scene, pos);
         let params = CubeParams {
-            light: pos.extend(far).into(),
-            cfg: [res as f32, pcf as f32, near, 0.0],
+            position: pos.into(),
+            far,
+            res: res as f32,
+            pcf: pcf as f32,
+            near,
+            pad0: 0.0,
             bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
         };
         let array = wgpu::BindingType::Texture {

@@ -9,10 +9,31 @@
 
 struct FilteredParams {
     light_view_proj: mat4x4<f32>,
-    texel: vec4<f32>,
-    mode: vec4<u32>,
-    shape: vec4<f32>,
-    bias: vec4<f32>,
+    // world size of one texel (orthographic) or per unit of light-view depth (perspective)
+    texel_world: f32,
+    // 1 if perspective
+    perspective: f32,
+    // map side (texels)
+    res: f32,
+    // 1 / far (perspective linear depth)
+    inv_far: f32,
+    // 0 vsm, 1 esm, 2 evsm, 3 msm
+    kind: u32,
+    // 1 = single depth (store z only)
+    single_depth: u32,
+    // mip levels (0 or 1 = no mips)
+    mip_levels: u32,
+    pad0: u32,
+    min_variance: f32,
+    esm_c: f32,
+    evsm_c_pos: f32,
+    evsm_c_neg: f32,
+    moment_bias: f32,
+    // texels
+    depth_bias: f32,
+    // texels
+    normal_offset: f32,
+    pad1: f32,
 }
 
 @group(0) @binding(6) var<uniform> fp: FilteredParams;
@@ -23,35 +44,35 @@ struct FilteredParams {
 fn to_map(p: vec3<f32>) -> vec3<f32> {
     let c = fp.light_view_proj * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
-    let depth = select(c.z, c.w * fp.texel.w, fp.texel.y > 0.5);
+    let depth = select(c.z, c.w * fp.inv_far, fp.perspective > 0.5);
     return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, depth);
 }
 
 fn visibility_of(m: vec4<f32>, d: f32) -> f32 {
-    switch fp.mode.x {
+    switch fp.kind {
         case 0u: {
-            return vsm_visibility(m, d, fp.shape.x);
+            return vsm_visibility(m, d, fp.min_variance);
         }
         case 1u: {
-            return esm_visibility(m, d, fp.shape.y);
+            return esm_visibility(m, d, fp.esm_c);
         }
         case 2u: {
-            return evsm_visibility(m, d, fp.shape.z, fp.shape.w, fp.shape.x);
+            return evsm_visibility(m, d, fp.evsm_c_pos, fp.evsm_c_neg, fp.min_variance);
         }
         default: {
-            return msm_visibility(m, d, fp.bias.x);
+            return msm_visibility(m, d, fp.moment_bias);
         }
     }
 }
 
 fn visibility_gather(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
-    return visibility_gather_of(fp.mode.x, z, w, d, fp.shape, fp.bias.x);
+    return visibility_gather_of(fp.kind, z, w, d, vec4<f32>(fp.min_variance, fp.esm_c, fp.evsm_c_pos, fp.evsm_c_neg), fp.moment_bias);
 }
 
 // The 2x2 texels around uv on mip `level`, interpolated bilinearly (same texels and weights
 // as the single-depth gather on level 0).
 fn bilinear_moments(uv: vec2<f32>, level: i32) -> vec4<f32> {
-    let r = max(i32(fp.texel.z) >> u32(level), 1);
+    let r = max(i32(fp.res) >> u32(level), 1);
     let w = gather_weights(uv, f32(r));
     let t0 = vec2<i32>(floor(uv * f32(r) - 0.5));
     let lo = vec2<i32>(0);
@@ -71,7 +92,7 @@ fn neighbour_distance(j: vec2<i32>, m0: vec2<f32>) -> f32 {
     if pn.w <= 0.0 {
         return 1e9;
     }
-    return length((to_map(pn.xyz).xy - m0) * fp.texel.z);
+    return length((to_map(pn.xyz).xy - m0) * fp.res);
 }
 
 // Texels of the map covered by one view pixel (no derivatives in compute): per axis the nearer
@@ -90,18 +111,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    let res = fp.texel.z;
+    let res = fp.res;
     let m0 = to_map(s.p);
     if COUNT_SAMPLES && all(m0.xy >= vec2<f32>(0.0)) && all(m0.xy < vec2<f32>(1.0)) {
         let t = vec2<u32>(m0.xy * res);
         atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
     }
-    var texel = fp.texel.x;
-    if fp.texel.y > 0.5 {
-        texel = fp.texel.x * max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
+    var texel = fp.texel_world;
+    if fp.perspective > 0.5 {
+        texel = fp.texel_world * max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
     }
     let l = to_light(light, s.p);
-    let q = s.p + s.n * (fp.bias.z * texel) + l * (fp.bias.y * texel);
+    let q = s.p + s.n * (fp.normal_offset * texel) + l * (fp.depth_bias * texel);
     let m = to_map(q);
     if any(m.xy < vec2<f32>(0.0)) || any(m.xy > vec2<f32>(1.0)) || m.z > 1.0 {
         visibility[s.i] = 1.0;
@@ -109,14 +130,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let d = max(m.z, 0.0);
     let w = gather_weights(m.xy, res);
-    if fp.mode.y != 0u {
+    if fp.single_depth != 0u {
         let z = textureGather(0, shadow_map, gather_sampler, m.xy);
         visibility[s.i] = visibility_gather(z, w, d);
         return;
     }
-    if fp.mode.z > 1u {
+    if fp.mip_levels > 1u {
         // trilinear: the level whose texels match the pixel's footprint in the map
-        let top = f32(fp.mode.z - 1u);
+        let top = f32(fp.mip_levels - 1u);
         let lod = clamp(log2(max(footprint(vec2<i32>(id.xy), m0.xy), 1.0)), 0.0, top);
         let l0 = floor(lod);
         let mt = mix(bilinear_moments(m.xy, i32(l0)), bilinear_moments(m.xy, i32(min(l0 + 1.0, top))), lod - l0);

@@ -208,8 +208,28 @@ pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct FilteredParams {
     pub light_view_proj: [[f32; 4]; 4],
-    pub texel: [f32; 4],
-    pub mode: [u32; 4],
-    pub shape: [f32; 4],
-    pub bias: [f32; 4],
+    /// World size of one texel (orthographic) or per unit of light-view depth (perspective).
+    pub texel_world: f32,
+    /// 1 if perspective.
+    pub perspective: f32,
+    pub res: f32,
+    /// 1 / far (perspective linear depth).
+    pub inv_far: f32,
+    /// [`Kind`] as its index.
+    pub kind: u32,
+    /// 1: single depth (z only, the moments rebuilt from a 2x2 gather).
+    pub single_depth: u32,
+    /// Mip levels (0 or 1 = none).
+    pub mip_levels: u32,
+    pub pad0: u32,
+    pub min_variance: f32,
+    pub esm_c: f32,
+    pub evsm_c_pos: f32,
+    pub evsm_c_neg: f32,
+    pub moment_bias: f32,
+    /// Texels.
+    pub depth_bias: f32,
+    /// Texels.
+    pub normal_offset: f32,
+    pub pad1: f32,
 }

@@ -5,16 +5,31 @@
 
 struct FilteredParams {
     light_view_proj: mat4x4<f32>,
-    // x: world size of one texel (orthographic) or per unit of light-view depth (perspective)
-    // y: 1 if perspective; z: resolution; w: 1 / far (perspective linear depth)
-    texel: vec4<f32>,
-    // x: kind (0 vsm, 1 esm, 2 evsm, 3 msm); y: 1 = single depth (store z only);
-    // z: mip levels (0 or 1 = no mips)
-    mode: vec4<u32>,
-    // x: minimum variance, y: ESM c, z: EVSM c+, w: EVSM c-
-    shape: vec4<f32>,
-    // x: MSM moment bias, y: depth bias (texels), z: normal offset (texels)
-    bias: vec4<f32>,
+    // world size of one texel (orthographic) or per unit of light-view depth (perspective)
+    texel_world: f32,
+    // 1 if perspective
+    perspective: f32,
+    // map side (texels)
+    res: f32,
+    // 1 / far (perspective linear depth)
+    inv_far: f32,
+    // 0 vsm, 1 esm, 2 evsm, 3 msm
+    kind: u32,
+    // 1 = single depth (store z only)
+    single_depth: u32,
+    // mip levels (0 or 1 = no mips)
+    mip_levels: u32,
+    pad0: u32,
+    min_variance: f32,
+    esm_c: f32,
+    evsm_c_pos: f32,
+    evsm_c_neg: f32,
+    moment_bias: f32,
+    // texels
+    depth_bias: f32,
+    // texels
+    normal_offset: f32,
+    pad1: f32,
 }
 
 @group(0) @binding(0) var<uniform> fp: FilteredParams;
@@ -32,7 +47,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     var o: VsOut;
     o.clip = fp.light_view_proj * vec4<f32>(v.pos, 1.0);
     // orthographic: clip z is linear; perspective: clip w is the view depth
-    o.depth = select(o.clip.z, o.clip.w * fp.texel.w, fp.texel.y > 0.5);
+    o.depth = select(o.clip.z, o.clip.w * fp.inv_far, fp.perspective > 0.5);
     o.uv = v.uv;
     o.material = v.material;
     return o;
@@ -44,18 +59,18 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         discard;
     }
     let z = clamp(in.depth, 0.0, 1.0);
-    if fp.mode.y != 0u {
+    if fp.single_depth != 0u {
         return vec4<f32>(z, 0.0, 0.0, 0.0);
     }
-    switch fp.mode.x {
+    switch fp.kind {
         case 0u: {
             return vsm_encode(z);
         }
         case 1u: {
-            return esm_encode(z, fp.shape.y);
+            return esm_encode(z, fp.esm_c);
         }
         case 2u: {
-            return evsm_encode(z, fp.shape.z, fp.shape.w);
+            return evsm_encode(z, fp.evsm_c_pos, fp.evsm_c_neg);
         }
         default: {
             return msm_encode(z);

@@ -63,10 +63,22 @@ impl Filtered {
         let (c, c_pos, c_neg) = (num("c", esm), num("c_pos", evsm), num("c_neg", evsm));
         let params = FilteredParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
-            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, inv_far],
-            mode: [kind as u32, sd as u32, levels, 0],
-            shape: [num("min_variance", vsm || evsm) as f32, c as f32, c_pos as f32, c_neg as f32],
-            bias: [num("moment_bias", msm) as f32, p.get("bias") as f32, p.get("normal_offset") as f32, 0.0],
+            texel_world: lp.texel,
+            perspective: lp.perspective as u32 as f32,
+            res: res as f32,
+            inv_far,
+            kind: kind as u32,
+            single_depth: sd as u32,
+            mip_levels: levels,
+            pad0: 0,
+            min_variance: num("min_variance", vsm || evsm) as f32,
+            esm_c: c as f32,
+            evsm_c_pos: c_pos as f32,
+            evsm_c_neg: c_neg as f32,
+            moment_bias: num("moment_bias", msm) as f32,
+            depth_bias: p.get("bias") as f32,
+            normal_offset: p.get("normal_offset") as f32,
+            pad1: 0.0,
         };
         // the map's clear value: b(1), the farthest depth
         let far: [f64; 4] = match (sd, kind) {
@@ -149,7 +161,7 @@ impl Filtered {
     /// Linear depth per texel recovered from the first channel (for the report picture).
     fn first_moment_as_depth(&self, texels: &[f32]) -> Vec<f32> {
         let ch = (self.bytes_per_texel() / 4) as usize;
-        let [_, c, cp, _] = self.params.shape;
+        let (c, cp) = (self.params.esm_c, self.params.evsm_c_pos);
         texels
             .chunks(ch)
             .map(|t| match (self.sd, self.kind) {

@@ -23,18 +23,39 @@ struct Level {
 struct LtParams {
     // directional: up to 3 cascades; spot: 1; point: the 6 cube faces (+x, -x, +y, -y, +z, -z)
     levels: array<Level, 6>,
-    // x: hybrid levels (map layers), y: 1 if perspective, z: resolution, w: 1 / far
-    texel: vec4<f32>,
-    // x: technique (0 lt, 1 ltt, 2 hybrid-pcf), y: base (0 vsm, 1 esm, 2 evsm, 3 msm),
-    // z: frame index, w: flags (FLAG_*)
-    mode: vec4<u32>,
-    // x: min variance, y: ESM c, z: EVSM c+, w: EVSM c-
-    shape: vec4<f32>,
-    // x: MSM moment bias, y: depth bias (texels), z: normal offset (texels), w: LTT eps
-    bias: vec4<f32>,
-    // x: relative depth tolerance, y: min normal cosine (reprojection test), z: mask bits per
-    // pixel, w: unused
-    history: vec4<f32>,
+    // hybrid levels (map layers)
+    layers: f32,
+    // 1 if perspective
+    perspective: f32,
+    // map side (texels)
+    res: f32,
+    // 1 / far
+    inv_far: f32,
+    // 0 lt, 1 ltt, 2 hybrid-pcf
+    technique: u32,
+    // 0 vsm, 1 esm, 2 evsm, 3 msm
+    base: u32,
+    // frame index
+    frame: u32,
+    // FLAG_*
+    flags: u32,
+    min_variance: f32,
+    esm_c: f32,
+    evsm_c_pos: f32,
+    evsm_c_neg: f32,
+    moment_bias: f32,
+    // texels
+    depth_bias: f32,
+    // texels
+    normal_offset: f32,
+    // LTT: a ray where eps < s < 1 - eps
+    eps: f32,
+    // relative depth tolerance and min normal cosine of the reprojection test
+    depth_tol: f32,
+    normal_cos: f32,
+    // mask bits per pixel
+    mask_bits: f32,
+    pad0: f32,
 }
 
 const FLAG_RR: u32 = 1u;
@@ -63,7 +84,7 @@ const BIT_RS: u32 = 4u;
 fn to_map(level: u32, p: vec3<f32>) -> vec3<f32> {
     let c = lp.levels[level].view_proj * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
-    let depth = select(c.z, c.w * lp.texel.w, lp.texel.y > 0.5);
+    let depth = select(c.z, c.w * lp.inv_far, lp.perspective > 0.5);
     return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, depth);
 }
 
@@ -80,18 +101,18 @@ fn cube_face(d: vec3<f32>) -> u32 {
 }
 
 fn base_visibility(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
-    return visibility_gather_of(lp.mode.y, z, w, d, lp.shape, lp.bias.x);
+    return visibility_gather_of(lp.base, z, w, d, vec4<f32>(lp.min_variance, lp.esm_c, lp.evsm_c_pos, lp.evsm_c_neg), lp.moment_bias);
 }
 
 // Mask bits of pixel i (one light in the low 3 bits of a `history.z`-bit texel, packed in words).
 fn mask_load(i: u32) -> u32 {
-    let bits = u32(lp.history.z);
+    let bits = u32(lp.mask_bits);
     let per = 32u / bits;
     return (prev_mask[i / per] >> ((i % per) * bits)) & 7u;
 }
 
 fn mask_or(i: u32, b: u32) {
-    let bits = u32(lp.history.z);
+    let bits = u32(lp.mask_bits);
     let per = 32u / bits;
     atomicOr(&cur_mask[i / per], b << ((i % per) * bits));
 }
@@ -124,11 +145,11 @@ fn reproject(id: vec2<u32>, p: vec3<f32>, n: vec3<f32>) -> vec2<i32> {
         return vec2<i32>(-1);
     }
     let q = vec2<i32>(prev);
-    if (lp.mode.w & FLAG_HISTORY_TEST) != 0u {
+    if (lp.flags & FLAG_HISTORY_TEST) != 0u {
         let h = prev_history[u32(q.y) * frame.size.x + u32(q.x)];
         let expected = (frame.prev_view_proj * vec4<f32>(p, 1.0)).w;
         let prev_n = unpack4x8snorm(bitcast<u32>(h.y)).xyz;
-        if h.x <= 0.0 || abs(h.x - expected) > lp.history.x * expected || dot(prev_n, n) < lp.history.y {
+        if h.x <= 0.0 || abs(h.x - expected) > lp.depth_tol * expected || dot(prev_n, n) < lp.normal_cos {
             return vec2<i32>(-1);
         }
     }
@@ -137,7 +158,7 @@ fn reproject(id: vec2<u32>, p: vec3<f32>, n: vec3<f32>) -> vec2<i32> {
 
 // Steps 3-5 of section 3.1.3: does this pixel trace a ray?
 fn temporal(id: vec2<u32>, p: vec3<f32>, n: vec3<f32>, ltt0: bool, st: bool, may_remove: bool) -> bool {
-    if (lp.mode.w & FLAG_HAS_HISTORY) == 0u {
+    if (lp.flags & FLAG_HAS_HISTORY) == 0u {
         return true;
     }
     let q = reproject(id, p, n);
@@ -146,8 +167,8 @@ fn temporal(id: vec2<u32>, p: vec3<f32>, n: vec3<f32>, ltt0: bool, st: bool, may
     }
     var any_er = false;
     var all_rr = true;
-    let full = (lp.mode.w & FLAG_FULL) != 0u;
-    let k = i32(lp.mode.z % 4u);
+    let full = (lp.flags & FLAG_FULL) != 0u;
+    let k = i32(lp.frame % 4u);
     let o = select(vec2<i32>(-1 + (k & 1), -1 + (k >> 1u)), vec2<i32>(-1), full);
     let span = select(2, 3, full);
     for (var y = 0; y < span; y++) {
@@ -164,7 +185,7 @@ fn temporal(id: vec2<u32>, p: vec3<f32>, n: vec3<f32>, ltt0: bool, st: bool, may
     if !ltt0 {
         return any_er;
     }
-    return !((lp.mode.w & FLAG_RR) != 0u && may_remove && all_rr);
+    return !((lp.flags & FLAG_RR) != 0u && may_remove && all_rr);
 }
 
 @compute @workgroup_size(8, 8)
@@ -180,9 +201,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
     // the level serving this view depth; beyond the hybrid levels every pixel traces a ray
     let depth = textureLoad(g_position, id.xy, 0).w;
-    let levels = u32(lp.texel.x);
+    let levels = u32(lp.layers);
     var c = 0u;
-    if (lp.mode.w & FLAG_POINT) != 0u {
+    if (lp.flags & FLAG_POINT) != 0u {
         c = cube_face(s.p - light.position.xyz);
     } else {
         while c < levels && depth > lp.levels[c].info.z {
@@ -191,14 +212,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let level = min(c, levels - 1u);
     var texel = lp.levels[level].info.x;
-    if (lp.mode.w & FLAG_POINT) != 0u {
+    if (lp.flags & FLAG_POINT) != 0u {
         let a = abs(s.p - light.position.xyz);
         texel *= max(a.x, max(a.y, a.z));
-    } else if lp.texel.y > 0.5 {
+    } else if lp.perspective > 0.5 {
         texel *= max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
     }
     let l = to_light(light, s.p);
-    let m = to_map(level, s.p + s.n * (lp.bias.z * texel) + l * (lp.bias.y * texel));
+    let m = to_map(level, s.p + s.n * (lp.normal_offset * texel) + l * (lp.depth_bias * texel));
     var v = 1.0;
     var ray = true;
     var st = false;
@@ -207,25 +228,25 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if c < levels && all(m.xy >= vec2<f32>(0.0)) && all(m.xy <= vec2<f32>(1.0)) && m.z <= 1.0 {
         let d = max(m.z, 0.0);
         var z = textureGather(0, static_map, gather_sampler, m.xy, level);
-        if (lp.mode.w & FLAG_DYNAMIC) != 0u {
+        if (lp.flags & FLAG_DYNAMIC) != 0u {
             // section 3.4: minimum of both maps per gathered texel, no RR where dynamic won
             let zd = textureGather(0, dynamic_map, gather_sampler, m.xy, level);
             may_remove = !any(zd < z);
             z = min(z, zd);
         }
-        let eps = lp.bias.w;
-        if lp.mode.x == 2u {
+        let eps = lp.eps;
+        if lp.technique == 2u {
             // hybrid-pcf: 2x2 hard tests of the plain depth map (bias applied above)
             let lit = vec4<f32>(z >= vec4<f32>(d));
             let n_lit = dot(lit, vec4<f32>(1.0));
             v = n_lit * 0.25;
             ray = n_lit > 0.5 && n_lit < 3.5;
         } else {
-            v = base_visibility(z, gather_weights(m.xy, lp.texel.z), d);
+            v = base_visibility(z, gather_weights(m.xy, lp.res), d);
             ray = eps < v && v < 1.0 - eps;
         }
         st = v < 0.5;
-        if lp.mode.x == 0u {
+        if lp.technique == 0u {
             let ltt0 = ray;
             ray = temporal(id.xy, s.p, s.n, ltt0, st, may_remove);
             if ltt0 && !ray {
@@ -234,7 +255,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
-    ray = ray || (lp.mode.w & FLAG_FORCE_ALL) != 0u;
+    ray = ray || (lp.flags & FLAG_FORCE_ALL) != 0u;
     mask_or(s.i, select(0u, BIT_ST, st) | select(0u, BIT_LTT, ray));
     if ray {
         let slot = atomicAdd(&list[0], 1u);

@@ -96,11 +96,38 @@ pub struct LevelU {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct LtParams {
     pub levels: [LevelU; MAX_MAPS],
-    pub texel: [f32; 4],
-    pub mode: [u32; 4],
-    pub shape: [f32; 4],
-    pub bias: [f32; 4],
-    pub history: [f32; 4],
+    /// Hybrid levels (map layers).
+    pub layers: f32,
+    /// 1 if perspective.
+    pub perspective: f32,
+    pub res: f32,
+    /// 1 / far.
+    pub inv_far: f32,
+    /// [`Mode`] as its index.
+    pub technique: u32,
+    /// Index of `base` in [`BASES`].
+    pub base: u32,
+    /// Frame index (frames with history).
+    pub frame: u32,
+    /// `FLAG_*`.
+    pub flags: u32,
+    pub min_variance: f32,
+    pub esm_c: f32,
+    pub evsm_c_pos: f32,
+    pub evsm_c_neg: f32,
+    pub moment_bias: f32,
+    /// Texels (hybrid-pcf).
+    pub depth_bias: f32,
+    /// Texels (hybrid-pcf).
+    pub normal_offset: f32,
+    /// LTT: a ray where eps < s < 1 - eps.
+    pub eps: f32,
+    /// Reprojection test: relative depth tolerance and minimum normal cosine.
+    pub depth_tol: f32,
+    pub normal_cos: f32,
+    /// Temporal mask bits per pixel.
+    pub mask_bits: f32,
+    pub pad0: f32,
 }
 
 /// WGSL `TraceParams` (trace.wgsl, args.wgsl).

@@ -90,7 +90,8 @@ impl LeakTracing {
             _ => (0.0, 0.0),
         };
         let num = |key: &str, used: bool| if used { p.get(key) as f32 } else { 0.0 };
-        let shape = [num("min_variance", filterable), num("c", filterable), num("c_pos", filterable), num("c_neg", filterable)];
+        let (min_variance, esm_c, evsm_c_pos, evsm_c_neg) =
+            (num("min_variance", filterable), num("c", filterable), num("c_pos", filterable), num("c_neg", filterable));
         let base = if filterable { BASES.iter().position(|b| *b == p.choice("base")).expect("a declared base") as u32 } else { 0 };
         let cascades = match *light {
             Light::Directional { direction } if p.get_u32("cascades") > 1 => Some(Cascades {
@@ -110,19 +111,42 @@ impl LeakTracing {
         }
         let params = LtParams {
             levels: level_u,
-            texel: [levels as f32, lp.perspective as u32 as f32, res as f32, inv_far],
-            mode: [mode as u32, base, 0, flags],
-            shape,
-            bias: [num("moment_bias", filterable), bias as f32, normal_offset as f32, num("eps", filterable)],
-            history: [num("depth_tol", temporal), num("normal_cos", temporal), mask_bits as f32, 0.0],
+            layers: levels as f32,
+            perspective: lp.perspective as u32 as f32,
+            res: res as f32,
+            inv_far,
+            technique: mode as u32,
+            base,
+            frame: 0,
+            flags,
+            min_variance,
+            esm_c,
+            evsm_c_pos,
+            evsm_c_neg,
+            moment_bias: num("moment_bias", filterable),
+            depth_bias: bias as f32,
+            normal_offset: normal_offset as f32,
+            eps: num("eps", filterable),
+            depth_tol: num("depth_tol", temporal),
+            normal_cos: num("normal_cos", temporal),
+            mask_bits: mask_bits as f32,
+            pad0: 0.0,
         };
         // the raster of filtered/ in single-depth mode: linear depth into an R32Float target
         let map_params = FilteredParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
-            texel: [lp.texel, lp.perspective as u32 as f32, res as f32, inv_far],
-            mode: [0, 1, 1, 0],
-            shape,
-            bias: [0.0; 4],
+            texel_world: lp.texel,
+            perspective: lp.perspective as u32 as f32,
+            res: res as f32,
+            inv_far,
+            kind: 0,
+            single_depth: 1,
+            mip_levels: 1,
+            min_variance,
+            esm_c,
+            evsm_c_pos,
+            evsm_c_neg,
+            ..FilteredParams::zeroed()
         };
         let d = &gpu.device;
         use wgpu::TextureUsages as U;
@@ -268,7 +292,7 @@ impl Technique for LeakTracing {
             for (l, d) in dirty.into_iter().enumerate() {
                 if d {
                     self.map_params.light_view_proj = self.params.levels[l].view_proj;
-                    self.map_params.texel[0] = self.params.levels[l].info[0];
+                    self.map_params.texel_world = self.params.levels[l].info[0];
                     rec.write_buffer(&self.map_uniforms[l].0, 0, bytemuck::bytes_of(&self.map_params));
                     self.static_dirty[l] = true;
                 }
@@ -313,8 +337,8 @@ impl Technique for LeakTracing {
         let has_dynamic = self.dynamic_map.is_some() && f.scene.dynamic_first < f.scene.triangle_count;
         let frames = self.screen(gpu, w, h).frames;
         let mut params = self.params;
-        params.mode[2] = frames;
-        params.mode[3] |= if frames > 0 { FLAG_HAS_HISTORY } else { 0 } | if has_dynamic { FLAG_DYNAMIC } else { 0 };
+        params.frame = frames;
+        params.flags |= if frames > 0 { FLAG_HAS_HISTORY } else { 0 } | if has_dynamic { FLAG_DYNAMIC } else { 0 };
         rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&params));
         let trace = gpu.uniform(&format!("{name}.trace_params"), &TraceParams { cfg: [self.mask_bits, w * h, 0, 0] });
         let s = self.screen.as_ref().expect("allocated above");

@@ -34,7 +34,7 @@ pub(super) fn report(t: &LeakTracing, gpu: &Gpu) -> TechniqueReport {
     c.insert("dynamic_map_renders".into(), t.dynamic_renders as f64);
     c.insert("fetches_per_pixel".into(), 4.0 * (1 + t.dynamic_map.is_some() as u32) as f64);
     if temporal {
-        let full = t.params.mode[3] & super::FLAG_FULL != 0;
+        let full = t.params.flags & super::FLAG_FULL != 0;
         c.insert("mask_bits_per_pixel".into(), t.mask_bits as f64);
         c.insert("mask_bytes_per_light".into(), mask_bytes_per_light);
         c.insert("history_bytes".into(), history_bytes as f64);

@@ -8,9 +8,19 @@
 
 struct MdsmParams {
     light_view_proj: mat4x4<f32>,
+    // world size of one texel (orthographic) or per unit of light-view depth (perspective),
+    // 1 if perspective, resolution, PCF grid width sqrt(k) (sm's bias.wgsl reads it whole)
     texel: vec4<f32>,
+    // constant bias, slope-scaled bias, normal offset (all in texels), max slope (sm's bias.wgsl)
     bias: vec4<f32>,
-    sel: vec4<u32>,
+    // depths per texel
+    n: u32,
+    // search width sqrt(q) (1 when n = 1)
+    region: u32,
+    // SELECT_MINMAX or SELECT_SORT
+    select: u32,
+    // 1 if the slope bias covers the search region
+    region_bias: u32,
 }
 
 @group(0) @binding(6) var<uniform> md: MdsmParams;
@@ -52,8 +62,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let kw = i32(md.texel.w);
     let half = f32(kw - 1) * 0.5;
     var reach = half;
-    if md.sel.w == 1u {
-        reach += f32(md.sel.y - 1u) * 0.5;
+    if md.region_bias == 1u {
+        reach += f32(md.region - 1u) * 0.5;
     }
     let q = biased_point(p, nrm, l, texel_at(md.texel, p), md.bias, reach);
     let m = to_map(q);
@@ -61,7 +71,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         visibility[i] = 1.0;
         return;
     }
-    let n = md.sel.x;
+    let n = md.n;
     let lanes = vec4<u32>(vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(n));
     var lit = 0u;
     for (var y = 0; y < kw; y++) {

@@ -113,8 +113,14 @@ pub struct MdsmParams {
     pub texel: [f32; 4],
     /// constant bias, slope bias, normal offset (texels), max slope
     pub bias: [f32; 4],
-    /// n, search width sqrt(q) (1 when n = 1), select index, region bias flag
-    pub sel: [u32; 4],
+    /// Depths per texel.
+    pub n: u32,
+    /// Search width sqrt(q) (1 when n = 1).
+    pub region: u32,
+    /// `select`'s index in `SELECT_CHOICES`.
+    pub select: u32,
+    /// 1 if the slope bias covers the search region.
+    pub region_bias: u32,
 }
 
 pub struct MultiDepthMap {
@@ -156,7 +162,10 @@ impl MultiDepthMap {
             light_view_proj: sm_params.light_view_proj,
             texel: sm_params.texel,
             bias: sm_params.bias,
-            sel: [n, region, strategy, (p.get_bool("region_bias") && n > 1) as u32],
+            n,
+            region,
+            select: strategy,
+            region_bias: (p.get_bool("region_bias") && n > 1) as u32,
         };
         let d = &gpu.device;
         let depth = DepthPass::new(gpu, scene, "mdsm", res, &sm_params);
@@ -233,7 +242,7 @@ impl Technique for MultiDepthMap {
         // base Depth32Float map + the RGBA32F n-SM
         let bytes = texels as u64 * (4 + 16);
         let mut r = TechniqueReport { shadow_data_bytes: bytes, sampling: Some(sampling_stats(&counts)), ..Default::default() };
-        let region = self.params.sel[1];
+        let region = self.params.region;
         r.counters.insert("fetches_per_pixel".into(), self.k as f64);
         r.counters.insert("select_fetches_per_texel".into(), (region * region) as f64);
         r.counters.insert("max_distinct_values".into(), max_distinct(self.k, self.n) as f64);

@@ -5,14 +5,19 @@
 
 struct MdsmParams {
     light_view_proj: mat4x4<f32>,
-    // x: world size of one texel (orthographic) or per unit of light-view depth (perspective)
-    // y: 1 if perspective; z: resolution; w: PCF grid width sqrt(k)
+    // world size of one texel (orthographic) or per unit of light-view depth (perspective),
+    // 1 if perspective, resolution, PCF grid width sqrt(k) (sm's bias.wgsl reads it whole)
     texel: vec4<f32>,
-    // x: constant bias, y: slope-scaled bias, z: normal offset (all in texels), w: max slope
+    // constant bias, slope-scaled bias, normal offset (all in texels), max slope (sm's bias.wgsl)
     bias: vec4<f32>,
-    // x: n depths; y: search width sqrt(q) (1 when n = 1); z: 0 minmax, 1 sort;
-    // w: 1 if the slope bias covers the search region
-    sel: vec4<u32>,
+    // depths per texel
+    n: u32,
+    // search width sqrt(q) (1 when n = 1)
+    region: u32,
+    // SELECT_MINMAX or SELECT_SORT
+    select: u32,
+    // 1 if the slope bias covers the search region
+    region_bias: u32,
 }
 
 // Largest search region (SEARCH_SIZES in shadowlab_core::mdsm): 9x9.
@@ -32,7 +37,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= res || id.y >= res {
         return;
     }
-    let w = i32(md.sel.y);
+    let w = i32(md.region);
     let r = (w - 1) / 2;
     let q = u32(w * w);
     var j = 0u;
@@ -43,11 +48,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             j++;
         }
     }
-    let n = md.sel.x;
+    let n = md.n;
     let b = s[q / 2u];
     var z = array<f32, 4>(b, b, b, b);
     if n > 1u {
-        if md.sel.z == SELECT_MINMAX {
+        if md.select == SELECT_MINMAX {
             // O(q): the two smallest and the two largest, with multiplicity
             var lo = BIG;
             var lo2 = BIG;

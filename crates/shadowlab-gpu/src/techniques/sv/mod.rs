@@ -65,10 +65,17 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct SvParams {
-    /// triangles, edges, vertices per side record (3 or 6), depth offset (ulps)
-    pub counts: [u32; 4],
-    /// x: extrusion distance (world; 0 = infinite)
-    pub extrude: [f32; 4],
+    pub triangles: u32,
+    pub edges: u32,
+    /// Vertices per side record (3 or 6).
+    pub side_vertices: u32,
+    /// Receiver depth offset (f32 ulps).
+    pub depth_offset: u32,
+    /// Extrusion distance (world; 0 = infinite).
+    pub extrude: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+    pub pad2: f32,
 }
 
 /// Per-view targets, made for the G-buffer size.
@@ -116,8 +123,14 @@ impl ShadowVolumes {
         let list = EdgeList::build(&positions);
         let vps = if infinite && matches!(light, Light::Directional { .. }) { 3 } else { 6 };
         let params = SvParams {
-            counts: [scene.triangle_count, list.edges.len() as u32, vps, p.get_u32("depth_offset")],
-            extrude: [if infinite { 0.0 } else { (far * scene.bounds.diagonal() as f64) as f32 }, 0.0, 0.0, 0.0],
+            triangles: scene.triangle_count,
+            edges: list.edges.len() as u32,
+            side_vertices: vps,
+            depth_offset: p.get_u32("depth_offset"),
+            extrude: if infinite { 0.0 } else { (far * scene.bounds.diagonal() as f64) as f32 },
+            pad0: 0.0,
+            pad1: 0.0,
+            pad2: 0.0,
         };
         let max = gpu.limits.max_storage_buffer_binding_size;
         if list.bytes() > max || list.adj.len() as u64 * 4 > max {
@@ -222,7 +235,7 @@ impl Technique for ShadowVolumes {
                 self.stats.as_entire_binding(),
             ],
         );
-        let (tris, edges) = (self.params.counts[0], self.params.counts[1]);
+        let (tris, edges) = (self.params.triangles, self.params.edges);
         rec.stage("sv.silhouettes", |enc| {
             dispatch_1d(enc, "sv.facing", &self.p.facing, &[&group, &f.scene.group], tris);
             dispatch_1d(enc, "sv.edges", &self.p.edges, &[&group, &f.scene.group], edges);
@@ -317,7 +330,7 @@ impl Technique for ShadowVolumes {
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
         let stats: Vec<u32> = gpu.read_buffer_as(&self.stats, 4);
         let draw: Vec<u32> = gpu.read_buffer_as(&self.draw, 4);
-        let vps = self.params.counts[2];
+        let vps = self.params.side_vertices;
         let (open, manifold, more) = self.list.valence_counts();
         let casting = stats[1] as f64;
         let pixels = self.targets.as_ref().map_or(0, |t| t.width as u64 * t.height as u64);
@@ -339,7 +352,7 @@ impl Technique for ShadowVolumes {
         c("cap_triangles", if vps == 6 { 2.0 * casting } else { casting });
         c("cutout_triangles", stats[0] as f64);
         c("extrusion_infinite", self.infinite as u32 as f64);
-        c("depth_offset_ulps", self.params.counts[3] as f64);
+        c("depth_offset_ulps", self.params.depth_offset as f64);
         if let Some(fill) = self.fill_fragments(gpu) {
             c("volume_fragments_per_pixel", fill as f64 / pixels.max(1) as f64);
         }

@@ -4,8 +4,17 @@
 // drawn with the stencil test "equal 0": writes 1 where no volume contains the sample.
 
 struct SvParams {
-    counts: vec4<u32>,
-    extrude: vec4<f32>,
+    triangles: u32,
+    edges: u32,
+    // vertices per side record (3: one triangle to the point at infinity; 6: a quad)
+    side_vertices: u32,
+    // depth offset of the receivers (f32 ulps)
+    depth_offset: u32,
+    // extrusion distance (world units; 0 = to infinity, w = 0)
+    extrude: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 @group(0) @binding(0) var g_depth: texture_depth_2d;
@@ -24,7 +33,7 @@ fn fs_depth(@builtin(position) p: vec4<f32>) -> @builtin(frag_depth) f32 {
         return d;
     }
     let u = bitcast<u32>(d);
-    return bitcast<f32>(u - min(u, sv.counts.w));
+    return bitcast<f32>(u - min(u, sv.depth_offset));
 }
 
 @fragment

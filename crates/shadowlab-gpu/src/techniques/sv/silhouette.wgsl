@@ -6,11 +6,17 @@
 // draw's vertex count.
 
 struct SvParams {
-    // x: triangles, y: edges, z: vertices per side record (3: one triangle to the point at
-    // infinity; 6: a quad), w: depth offset of the receivers (f32 ulps)
-    counts: vec4<u32>,
-    // x: extrusion distance (world units; 0 = to infinity, w = 0)
-    extrude: vec4<f32>,
+    triangles: u32,
+    edges: u32,
+    // vertices per side record (3: one triangle to the point at infinity; 6: a quad)
+    side_vertices: u32,
+    // depth offset of the receivers (f32 ulps)
+    depth_offset: u32,
+    // extrusion distance (world units; 0 = to infinity, w = 0)
+    extrude: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 struct Edge {
@@ -46,7 +52,7 @@ fn thread_index(id: vec3<u32>, groups: vec3<u32>) -> u32 {
 @compute @workgroup_size(64)
 fn facing_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let t = thread_index(id, groups);
-    if t >= sv.counts.x {
+    if t >= sv.triangles {
         return;
     }
     let v0 = vertices[3u * t];
@@ -70,7 +76,7 @@ fn facing_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgr
 @compute @workgroup_size(64)
 fn edges_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let e = thread_index(id, groups);
-    if e >= sv.counts.y {
+    if e >= sv.edges {
         return;
     }
     let edge = edges[e];
@@ -84,7 +90,7 @@ fn edges_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
         return;
     }
     let n = u32(abs(m));
-    let vps = sv.counts.z;
+    let vps = sv.side_vertices;
     let base = atomicAdd(&draw.vertex_count, n * vps) / vps;
     atomicAdd(&stats[2], 1u);
     atomicAdd(&stats[3], n);

@@ -12,8 +12,17 @@
 //    the reverse; all other triangles collapse to a point.
 
 struct SvParams {
-    counts: vec4<u32>,
-    extrude: vec4<f32>,
+    triangles: u32,
+    edges: u32,
+    // vertices per side record (3: one triangle to the point at infinity; 6: a quad)
+    side_vertices: u32,
+    // depth offset of the receivers (f32 ulps)
+    depth_offset: u32,
+    // extrusion distance (world units; 0 = to infinity, w = 0)
+    extrude: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 struct Edge {
@@ -45,15 +54,15 @@ fn extruded(p: vec3<f32>) -> vec4<f32> {
     if light.kind != LIGHT_DIRECTIONAL {
         d = p - light.position.xyz;
     }
-    if sv.extrude.x <= 0.0 {
+    if sv.extrude <= 0.0 {
         return frame.view_proj * vec4<f32>(d, 0.0);
     }
-    return at(p + normalize(d) * sv.extrude.x);
+    return at(p + normalize(d) * sv.extrude);
 }
 
 @vertex
 fn vs_sides(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    let vps = sv.counts.z;
+    let vps = sv.side_vertices;
     let r = sides[vi / vps];
     let e = edges[r & ~REVERSED];
     var a = vertices[e.a].pos;
@@ -85,7 +94,7 @@ fn cap(vi: u32, s: i32) -> vec4<f32> {
         return frame.view_proj * vec4<f32>(vertices[vi].pos, 1.0);
     }
     // dark caps: at a directional light's point at infinity they have no area
-    if f == -s && sv.counts.z == 6u {
+    if f == -s && sv.side_vertices == 6u {
         return extruded(vertices[vi].pos);
     }
     return NOWHERE;
