@@ -10,6 +10,7 @@ pub mod light;
 pub mod lightspace;
 pub mod loaders;
 pub mod metrics;
+pub mod motion;
 pub mod params;
 pub mod scene;
 pub mod setup;

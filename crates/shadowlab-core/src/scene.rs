@@ -133,7 +133,7 @@ pub struct Scene {
     pub report: LoadReport,
     /// Moving objects (see `anim.rs`): each owns a contiguous triangle range, together the last
     /// triangles of `vertices` (`dynamic_first()..triangle_count()`); `vertices` hold t = 0.
-    pub animations: Vec<crate::anim::Animation>,
+    pub animations: Vec<crate::motion::Animation>,
 }
 
 impl Scene {
@@ -154,42 +154,6 @@ impl Scene {
     /// Ray-origin offset used by the reference tracer: a small fraction of the scene's size.
     pub fn ray_epsilon(&self) -> f32 {
         (self.bounds().diagonal() * 2e-5).max(1e-6)
-    }
-    /// First dynamic (animated) triangle; `triangle_count()` when nothing moves.
-    pub fn dynamic_first(&self) -> usize {
-        self.animations.iter().map(|a| a.first).min().unwrap_or(self.triangle_count())
-    }
-    /// The dynamic vertices (`3 * dynamic_first()..`) at time `t` (frames): positions and face
-    /// normals moved by each animation's transform. Empty when nothing moves.
-    pub fn animated_vertices(&self, t: f32) -> Vec<Vertex> {
-        let mut out = Vec::with_capacity(self.vertices.len() - 3 * self.dynamic_first());
-        let mut anims: Vec<&crate::anim::Animation> = self.animations.iter().collect();
-        anims.sort_by_key(|a| a.first);
-        for a in anims {
-            let m = a.motion.transform(t);
-            out.extend(self.vertices[3 * a.first..3 * (a.first + a.count)].iter().map(|v| crate::anim::move_vertex(v, &m)));
-        }
-        out
-    }
-    /// A copy of the scene with the moving objects where they are at time `t` (the CPU
-    /// reference of an animated frame: `Bvh::build(&scene.at_time(t))`).
-    pub fn at_time(&self, t: f32) -> Scene {
-        let mut s = self.clone();
-        let first = 3 * self.dynamic_first();
-        s.vertices.truncate(first);
-        s.vertices.extend(self.animated_vertices(t));
-        s
-    }
-    /// Bounds of the geometry over all time (static bounds grown by every animation's sweep);
-    /// equal to `bounds()` without animations.
-    pub fn swept_bounds(&self) -> Bounds {
-        let mut b = self.bounds();
-        for a in &self.animations {
-            let s = crate::anim::swept_bounds(self, a);
-            b.grow(s.min);
-            b.grow(s.max);
-        }
-        b
     }
     /// Whether any material is alpha-tested (shadow techniques must honour cut-outs).
     pub fn has_cutouts(&self) -> bool {
