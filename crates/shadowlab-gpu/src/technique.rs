@@ -126,6 +126,9 @@ pub struct TechniqueReport {
     pub counters: BTreeMap<String, f64>,
     /// How view samples land in the shadow map (shadow-map techniques).
     pub sampling: Option<SamplingStats>,
+    /// Where the technique hit a capacity limit and gave a coarser (but deterministic) result,
+    /// one line each; empty when the result is complete. The counters carry the numbers.
+    pub degraded: Vec<String>,
     #[serde(skip)]
     pub images: Vec<NamedImage>,
 }

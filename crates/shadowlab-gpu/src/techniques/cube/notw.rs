@@ -231,6 +231,7 @@ impl Technique for CubeNotw {
             active += 1;
             let fr = face.warped.report(gpu);
             r.shadow_data_bytes += fr.shadow_data_bytes;
+            r.degraded.extend(fr.degraded.iter().map(|d| format!("face {name}: {d}")));
             after.extend(face.warped.read_counts_final(gpu));
             for (k, v) in fr.counters {
                 if k == "fetches_per_pixel" {

@@ -107,6 +107,7 @@ pub const DPSM_PARAMS: &[ParamDef] = &[
     SPLIT,
     DPSM_SUBDIV,
     warp::SUBDIV_LEVELS,
+    warp::SUBDIV_CAPACITY,
     EXACT,
     family::PCF,
     DPSM_BIAS,
@@ -126,6 +127,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     warp::INTERP,
     NOTW_SUBDIV,
     warp::SUBDIV_LEVELS,
+    warp::SUBDIV_CAPACITY,
     warp::CLOSE_CRACKS,
     EXACT,
     family::PCF,
@@ -249,6 +251,7 @@ impl Technique for Dpsm {
         for (i, m) in self.maps.iter_mut().enumerate() {
             let h = Hemisphere::BOTH[i].name();
             let sub = m.report(gpu);
+            r.degraded.extend(sub.degraded.iter().map(|d| format!("{h} hemisphere: {d}")));
             let counts = m.read_counts_final(gpu);
             total_samples[i] = counts.iter().map(|&c| c as u64).sum();
             all_counts.extend_from_slice(&counts);

@@ -335,8 +335,20 @@ impl Warped {
         let tris = scene.triangle_count;
         let limit = gpu.limits.max_storage_buffer_binding_size / 16;
         let on = k.subdiv > 0.0;
-        let extra = if on { (8 * tris as u64).max(1 << 21).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
-        let queue = if on { (tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
+        let auto = (8 * tris as u64).max(1 << 21);
+        let wanted = if k.subdiv_capacity > 0 { k.subdiv_capacity as u64 } else { auto };
+        // at least one per triangle: the root finishes up to one extra piece per triangle (the
+        // second half of a triangle cut by the near plane) before any level can check
+        let extra = if on { wanted.max(tris as u64).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
+        // the root queues up to two pieces per triangle (a triangle cut by the near plane); the
+        // triangle index keeps 3 bits free for the split mask
+        let queue = if on { (2 * tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
+        if on && (2 * tris as u64 > queue as u64 || tris >= 1 << 29) {
+            return Err(GpuError::Invalid(format!(
+                "{name}: {tris} triangles need subdivision queues of {} entries, over this device's storage binding limit",
+                2 * tris as u64
+            )));
+        }
         let params = WarpParams {
             light_view_proj: view_proj.to_cols_array_2d(),
             texel_world: texel,
@@ -398,7 +410,7 @@ impl Warped {
         let queues = [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16));
         let counters = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some(&format!("{name}.counters")),
-            size: 64,
+            size: 96,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });

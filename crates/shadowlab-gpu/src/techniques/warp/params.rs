@@ -107,6 +107,20 @@ pub const SUBDIV_LEVELS: ParamDef = ParamDef::integer(
     "authors' tessellation factor 16 = 4 levels (GUIDE); 10 from shadowlab measurement",
 );
 
+/// Pieces the subdivision may add beyond the scene's triangles; 0 = automatic: 8 per triangle,
+/// at least 2^21 (32 MiB), within the device's storage binding limit. When a level's pieces do
+/// not fit, that level draws its inputs unsplit (coarser, the same on every run) and the result
+/// is flagged as degraded. Low: bent edges on dense scenes; high: memory (16 bytes a piece).
+pub const DEFAULT_SUBDIV_CAPACITY: f64 = 0.0;
+pub const SUBDIV_CAPACITY: ParamDef = ParamDef::integer(
+    "subdiv_capacity",
+    DEFAULT_SUBDIV_CAPACITY,
+    0.0,
+    268435456.0,
+    "pieces subdivision may add beyond the scene's triangles (16 bytes each; at least one per triangle); 0 = 8 per triangle, at least 2^21, within the device limit; a level whose pieces do not fit is drawn unsplit (flagged degraded)",
+    "shadowlab (deterministic capacity, issue 18)",
+);
+
 /// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.
 pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
 pub const CLOSE_CRACKS: ParamDef = ParamDef::flag("close_cracks", DEFAULT_CLOSE_CRACKS != 0.0, "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap", "shadowlab measurement (docs/bench/warp.md)");
@@ -174,7 +188,7 @@ pub const DEPTH_CLAMP: ParamDef = ParamDef::integer(
 );
 
 /// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
-const NOTW_SHARED: [ParamDef; 15] = [
+const NOTW_SHARED: [ParamDef; 16] = [
     RES,
     WINDOW,
     NOTW_BLUR,
@@ -182,6 +196,7 @@ const NOTW_SHARED: [ParamDef; 15] = [
     INTERP,
     NOTW_SUBDIV,
     SUBDIV_LEVELS,
+    SUBDIV_CAPACITY,
     CLOSE_CRACKS,
     NOTW_EXACT,
     PCF,
@@ -206,7 +221,7 @@ const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A]
 }
 
 /// notw's own list: `NOTW_PARAMS` plus the warp strength and the bias footprint parameters.
-pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<15, 4, 19>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP]);
+pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<16, 4, 20>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP]);
 
 /// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
 /// run with; the gradient footprint (2) was measured for `notw` only.
@@ -221,6 +236,7 @@ pub const RTW_PARAMS: &[ParamDef] = &[
     INTERP,
     SUBDIV,
     SUBDIV_LEVELS,
+    SUBDIV_CAPACITY,
     CLOSE_CRACKS,
     EXACT_DEPTH,
     PCF,
@@ -252,6 +268,8 @@ pub(super) struct Knobs {
     /// Subdivision threshold (warped texels); 0 = off.
     pub subdiv: f32,
     pub subdiv_levels: u32,
+    /// Pieces beyond the triangles; 0 = automatic.
+    pub subdiv_capacity: u32,
     pub exact_depth: bool,
     pub close_cracks: bool,
     pub dv_margin: f32,
@@ -275,6 +293,7 @@ impl Knobs {
             interp: !warped || p.get_bool("interp"),
             subdiv,
             subdiv_levels: if subdivides { p.get_u32("subdiv_levels") } else { 1 },
+            subdiv_capacity: if subdivides { p.get_u32("subdiv_capacity") } else { 0 },
             exact_depth: subdivides && p.get_bool("exact_depth"),
             close_cracks: warped && dv && p.get_bool("close_cracks"),
             dv_margin: if dv { p.get("dv_margin") as f32 } else { 0.0 },

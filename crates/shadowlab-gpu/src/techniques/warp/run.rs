@@ -257,10 +257,27 @@ impl Technique for Warped {
         let dv = self.read_dv_rect(gpu);
         c.insert("dv_area_fraction".into(), ((dv[2] - dv[0]) * (dv[3] - dv[1])) as f64);
         if self.params.subdiv > 0.0 {
-            let a: Vec<u32> = gpu.read_buffer_as(&self.counters, 8);
-            c.insert("subdiv_triangles_drawn".into(), (a[4] / 3) as f64);
+            let a: Vec<u32> = gpu.read_buffer_as(&self.counters, 24);
+            let drawn = a[4] / 3;
+            c.insert("subdiv_triangles_drawn".into(), drawn as f64);
+            c.insert("subdiv_pieces_per_texel".into(), drawn as f64 / n as f64);
             c.insert("subdiv_pieces_dropped".into(), a[1] as f64);
             c.insert("subdiv_queue_full_finishes".into(), a[2] as f64);
+            c.insert("subdiv_cut_level".into(), a[19] as f64);
+            c.insert("subdiv_pieces_unsplit".into(), a[20] as f64);
+            if a[19] > 0 {
+                r.degraded.push(format!(
+                    "{}: subdivision level {} of {} did not fit the piece capacity ({} pieces); {} pieces were drawn unsplit (bent edges)",
+                    self.name(),
+                    a[19],
+                    self.params.subdiv_levels,
+                    self.params.extra_capacity,
+                    a[20]
+                ));
+            }
+            if a[1] > 0 || a[2] > 0 {
+                r.degraded.push(format!("{}: {} pieces dropped, {} queue-full finishes", self.name(), a[1], a[2]));
+            }
         }
         if self.variant != Variant::Dv {
             let before = self.read_counts_before(gpu);

@@ -7,11 +7,19 @@
 // agree and no T-junction cracks appear (up to the level cap). split_root sorts the scene's triangles: kept whole
 // in their own slot of `pieces`, or queued. Each split_level pass halves the queued pieces'
 // edges (4 children), appends the finished ones after the triangles and queues the rest
-// (queue in/out ping-pong, indirect dispatch). The last level finishes everything. Full
-// queues finish early; a full piece list drops pieces (counted: holes in the map).
+// (queue in/out ping-pong, indirect dispatch). The last level finishes everything.
 //
-// counters: [appended, dropped, queue-full finishes, -, draw args (4), queue 0: count, groups
-// x, y, z, queue 1: count, groups x, y, z].
+// Capacity, deterministically: which pieces an atomic append order lets through must not decide
+// the map. A queued piece carries its split mask (computed once, when it was queued), so the
+// pieces a level will produce are known before it runs: split_args adds them up and the level
+// splits only if all of them fit (as finished pieces, and in the next queue); otherwise it
+// finishes its inputs unsplit (coarser, complete) and the cut is counted. The set of pieces,
+// and so the depth map (a minimum), is then the same on every run.
+//
+// counters: [appended, dropped (never: kept for the report), queue-full finishes (never), -,
+// draw args (4), queue 0: count, groups x, y, z, queue 1: count, groups x, y, z, children of
+// queue 0's pieces, of queue 1's, cut flag of the running level, first level cut (0: none),
+// pieces finished unsplit by the cut, -, -, -].
 
 struct Level {
     // x: level (1..), y: 1 on the last level, z: input queue (0 or 1), w: capacity per queue
@@ -19,7 +27,7 @@ struct Level {
 }
 
 @group(0) @binding(10) var<storage, read_write> pieces: array<vec4<u32>>;
-@group(0) @binding(11) var<storage, read_write> counters: array<atomic<u32>, 16>;
+@group(0) @binding(11) var<storage, read_write> counters: array<atomic<u32>, 24>;
 @group(0) @binding(12) var<storage, read_write> q_in: array<vec4<u32>>;
 @group(0) @binding(13) var<storage, read_write> q_out: array<vec4<u32>>;
 @group(0) @binding(14) var<uniform> lv: Level;
@@ -149,21 +157,47 @@ fn finish(p: vec4<u32>) {
     pieces[wp.triangles + i] = p;
 }
 
-fn enqueue(p: vec4<u32>, q: u32) {
+// Queue entries carry their split mask above the triangle index.
+const MASK_SHIFT: u32 = 29u;
+const TRI_BITS: u32 = 0x1fffffffu;
+
+// Pieces a split by `mask` makes (0: the piece itself, finished).
+fn children_of(mask: u32) -> u32 {
+    switch mask {
+        case 0u {
+            return 1u;
+        }
+        case 1u, 2u, 4u {
+            return 2u;
+        }
+        case 7u {
+            return 4u;
+        }
+        default {
+            return 3u;
+        }
+    }
+}
+
+fn enqueue(p: vec4<u32>, mask: u32, q: u32) {
     let i = atomicAdd(&counters[8u + 4u * q], 1u);
     if i >= lv.v.w {
+        // not reached: the root's queue holds two pieces per triangle, and a level splits
+        // only when its children fit (split_args)
         atomicAdd(&counters[2], 1u);
         finish(p);
         return;
     }
-    q_out[i] = p;
+    atomicAdd(&counters[16u + q], children_of(mask));
+    q_out[i] = vec4<u32>(p.x | (mask << MASK_SHIFT), p.y, p.z, p.w);
 }
 
 // A root piece in the triangle's own slot: kept, or queued (the slot then holds nothing).
 fn place_root(tri: u32, p: vec4<u32>) {
-    if split_mask(p) != 0u {
+    let m = split_mask(p);
+    if m != 0u {
         pieces[tri] = vec4<u32>(tri, 0u, 0u, 0u);
-        enqueue(p, 0u);
+        enqueue(p, m, 0u);
     } else {
         pieces[tri] = p;
     }
@@ -218,8 +252,9 @@ fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     place_root(tri, vec4<u32>(tri, poly[0], poly[1], poly[2]));
     if n == 4u {
         let q = vec4<u32>(tri, poly[0], poly[2], poly[3]);
-        if split_mask(q) != 0u {
-            enqueue(q, 0u);
+        let mq = split_mask(q);
+        if mq != 0u {
+            enqueue(q, mq, 0u);
         } else {
             finish(q);
         }
@@ -236,13 +271,27 @@ fn split_args() {
     atomicStore(&counters[qi + 2u], 1u);
     atomicStore(&counters[qi + 3u], 1u);
     atomicStore(&counters[qo], 0u);
+    atomicStore(&counters[16u + 1u - lv.v.z], 0u);
+    // split only if every child fits: as a finished piece, and before the last level in the
+    // next queue (a level's inputs always fit as finished pieces: the level before checked)
+    let children = atomicLoad(&counters[16u + lv.v.z]);
+    let cut = atomicLoad(&counters[0]) + children > wp.extra_capacity || (lv.v.y == 0u && children > lv.v.w);
+    atomicStore(&counters[18], select(0u, 1u, cut));
+    if cut && atomicLoad(&counters[19]) == 0u {
+        atomicStore(&counters[19], lv.v.x);
+    }
 }
 
 fn place(p: vec4<u32>) {
-    if lv.v.y != 0u || split_mask(p) == 0u {
+    if lv.v.y != 0u {
+        finish(p);
+        return;
+    }
+    let m = split_mask(p);
+    if m == 0u {
         finish(p);
     } else {
-        enqueue(p, 1u - lv.v.z);
+        enqueue(p, m, 1u - lv.v.z);
     }
 }
 
@@ -254,7 +303,15 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= n {
         return;
     }
-    let p = q_in[id.x];
+    let queued = q_in[id.x];
+    let mask = queued.x >> MASK_SHIFT;
+    let p = vec4<u32>(queued.x & TRI_BITS, queued.y, queued.z, queued.w);
+    if atomicLoad(&counters[18]) != 0u {
+        // the level's children do not fit: its inputs are drawn unsplit
+        atomicAdd(&counters[20], 1u);
+        finish(p);
+        return;
+    }
     let t = p.x;
     let a = p.y;
     let b = p.z;
@@ -265,7 +322,7 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
     // the children as corner triples (one place() loop: cheap on SIMD software rasterisers)
     var kids: array<vec3<u32>, 4>;
     var count = 0u;
-    switch split_mask(p) {
+    switch mask {
         case 1u {
             kids[0] = vec3<u32>(a, ab, c);
             kids[1] = vec3<u32>(ab, b, c);
