@@ -6,11 +6,11 @@ use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use shadowlab_core::metrics::{edge_pixels, error_image};
-use shadowlab_gpu::lab::{Lab, Run};
+use shadowlab_gpu::lab::path::{cameras, PathRun, PathSpec, Progress};
+use shadowlab_gpu::lab::{reference_total_ms, summarize, Lab, Run};
 use shadowlab_gpu::Gpu;
 
 use crate::config::{resolve, RunConfig};
-use crate::frames::{summarize, ReferenceFrame};
 use crate::output::{slug, StagedDir};
 use crate::{export, report, RunArgs};
 
@@ -53,7 +53,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
     pb.set_message("BVH + upload");
     let lab = Lab::new(&gpu, &cfg.scene)?;
     pb.inc(1);
-    let path = crate::frames::run(&lab, &cfg, frames, args.repeat, &pb)?;
+    let path = run_path(&lab, &cfg, frames, args.repeat, &pb)?;
     pb.finish_and_clear();
     let (view, rt) = (&path.view, &path.rt);
 
@@ -109,7 +109,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         }));
     }
     let runs: Vec<&Run> = path.techniques.iter().map(|t| &t.last).collect();
-    let rt_total = summarize_reference(&path.reference);
+    let rt_total = reference_total_ms(&path.reference);
     let metrics = json!({
         "scene": cfg.scene.name,
         "scene_source": cfg.source,
@@ -175,10 +175,24 @@ fn animation_json(cfg: &RunConfig, lab: &Lab) -> serde_json::Value {
     })
 }
 
-/// The reference's time: its median over frames 1.. (or its single frame's median).
-fn summarize_reference(frames: &[ReferenceFrame]) -> f64 {
-    let timed = if frames.len() > 1 { &frames[1..] } else { frames };
-    shadowlab_gpu::timing::median(&timed.iter().map(|r| r.total_ms).collect::<Vec<_>>())
+/// The reference and `cfg.specs` over `frames` views along the configured camera path (see
+/// [`shadowlab_gpu::lab::path`] for what is timed and averaged), driving the progress bar.
+fn run_path(lab: &Lab, cfg: &RunConfig, frames: usize, repeat: usize, pb: &ProgressBar) -> Result<PathRun> {
+    let spec = PathSpec {
+        cameras: cameras(&cfg.camera, &cfg.camera_path, frames),
+        light: *cfg.light(),
+        width: cfg.width,
+        height: cfg.height,
+        start_time: cfg.time,
+        animate: true,
+        specs: &cfg.specs,
+        repeat,
+    };
+    Ok(lab.run_path(&spec, &mut |p| match p {
+        Progress::Stage(s) => pb.set_message(s.to_string()),
+        Progress::Step => pb.inc(1),
+        Progress::Frame { .. } => {}
+    })?)
 }
 
 fn row_major(m: &glam::Mat4) -> [[f32; 4]; 4] {

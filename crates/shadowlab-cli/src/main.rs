@@ -4,7 +4,6 @@ mod bench;
 mod compare;
 mod config;
 mod export;
-mod frames;
 mod listing;
 mod output;
 mod report;
