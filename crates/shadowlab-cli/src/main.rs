@@ -5,6 +5,7 @@ mod compare;
 mod config;
 mod export;
 mod listing;
+mod metrics;
 mod output;
 mod report;
 
