@@ -163,11 +163,18 @@ pub struct ExtraImage {
     pub file: String,
 }
 
-/// `params` read back. `ParamValues` has no `Deserialize` of its own (core's params.rs, not
-/// ours to change): this reads today's form, a map of numbers. Once `ParamValues` derives
-/// `Deserialize` (its values becoming numbers, integers, booleans or names), this goes.
+/// `params` read back. `ParamValues` has no `Deserialize` of its own yet (core's params.rs,
+/// not ours to change): this reads the map its constructor takes, whatever the value type is
+/// (numbers today; numbers, integers, booleans or names once the typed values land). When
+/// `ParamValues` derives `Deserialize`, the `deserialize_with` and this function can go.
 fn params_from_json<'de, D: serde::Deserializer<'de>>(d: D) -> Result<ParamValues, D::Error> {
-    Ok(ParamValues(BTreeMap::<String, f64>::deserialize(d)?))
+    fn via<'de, D: serde::Deserializer<'de>, V: Deserialize<'de>>(
+        make: fn(BTreeMap<String, V>) -> ParamValues,
+        d: D,
+    ) -> Result<ParamValues, D::Error> {
+        Ok(make(BTreeMap::deserialize(d)?))
+    }
+    via(ParamValues, d)
 }
 
 impl Metrics {
