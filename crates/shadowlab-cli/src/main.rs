@@ -4,8 +4,8 @@ mod bench;
 mod compare;
 mod config;
 mod export;
-mod frames;
 mod listing;
+mod metrics;
 mod output;
 mod report;
 

@@ -11,6 +11,12 @@ use anyhow::{Context, Result};
 /// nothing of the user's.
 pub const MARKER: &str = ".shadowlab-output";
 
+/// What the marker file says: who wrote the directory, and the layout of its metrics.json
+/// ([`crate::metrics::SCHEMA_VERSION`]).
+pub fn marker_text() -> String {
+    format!("written by shadowlab {}\nschema_version {}\n", env!("CARGO_PKG_VERSION"), crate::metrics::SCHEMA_VERSION)
+}
+
 /// Whether `target` may be (re)written as an output directory: absent, an empty directory, or
 /// one shadowlab wrote. Otherwise one line naming the path and what to do.
 pub fn check_target(target: &Path) -> Result<()> {
@@ -46,8 +52,7 @@ impl StagedDir {
         let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&tmp);
         std::fs::create_dir_all(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
-        std::fs::write(tmp.join(MARKER), concat!("written by shadowlab ", env!("CARGO_PKG_VERSION"), "\n"))
-            .with_context(|| format!("writing {}", tmp.display()))?;
+        std::fs::write(tmp.join(MARKER), marker_text()).with_context(|| format!("writing {}", tmp.display()))?;
         Ok(StagedDir { tmp, target: target.to_path_buf(), done: false })
     }
 
@@ -162,6 +167,8 @@ mod tests {
         std::fs::write(staged.path("index.html"), "r").unwrap();
         staged.commit().unwrap();
         assert!(empty.join(MARKER).is_file() && empty.join("index.html").is_file());
+        let marker = std::fs::read_to_string(empty.join(MARKER)).unwrap();
+        assert!(marker.ends_with(&format!("\nschema_version {}\n", crate::metrics::SCHEMA_VERSION)), "{marker}");
         // shadowlab's own output: replaced
         let staged = StagedDir::new(&empty).unwrap();
         staged.commit().unwrap();

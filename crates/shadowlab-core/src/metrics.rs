@@ -1,6 +1,6 @@
 //! Quality metrics against the reference, over the evaluated pixels (GUIDE.md, "Metrics").
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct ErrorMetrics {
@@ -63,7 +63,7 @@ pub fn flicker_pct(prev: &[f32], cur: &[f32], prev_rt: &[f32], cur_rt: &[f32], p
 }
 
 /// How the view samples land in a shadow map: the quantities warping aims to even out.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SamplingStats {
     /// Texels hit by at least one view sample / all texels.
     pub used_texel_fraction: f64,

@@ -7,7 +7,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::camera::{Camera, CameraKey};
 use crate::light::Light;
@@ -111,7 +111,7 @@ impl Bounds {
 }
 
 /// Counts of what a loader dropped or patched, reported with the scene.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LoadReport {
     pub degenerate_triangles_skipped: usize,
     pub nan_triangles_skipped: usize,

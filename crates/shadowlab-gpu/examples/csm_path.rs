@@ -1,7 +1,7 @@
 //! Temporal stability of cascaded shadow maps along a scene's camera path: per technique, the
 //! mean wrong-pixel rate and the flicker (GUIDE.md: % of pixels whose thresholded visibility
 //! flips between consecutive frames while `rt`'s does not), each technique instance kept across
-//! the frames (`Lab::instantiate` + `Lab::step`).
+//! the frames ([`Lab::run_path`], the scene's moving objects held at t = 0).
 //!
 //! `cargo run -p shadowlab-gpu --example csm_path -- [scene] [frames] [size] [span] [spec...]`
 //! (`scene`: a built-in scene, e.g. `city`)
@@ -13,9 +13,8 @@
 
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera, CameraKey};
-use shadowlab_core::metrics::{compare, flicker_pct};
 use shadowlab_core::params::TechniqueSpec;
-use shadowlab_gpu::lab::Lab;
+use shadowlab_gpu::lab::{Lab, PathSpec, Progress};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::Gpu;
 
@@ -59,40 +58,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let step = if cams.len() > 1 { (cams[1].position - cams[0].position).length() } else { 0.0 };
 
-    let mut insts = Vec::new();
+    let mut resolved = Vec::new();
     for s in &specs {
-        let spec = TechniqueSpec::parse(s)?;
-        insts.push(lab.instantiate(&registry::resolve(&spec, Some(&light))?, &light)?);
+        resolved.push(registry::resolve(&TechniqueSpec::parse(s)?, Some(&light))?);
     }
-    // per technique: wrong % per frame, flicker per pair, previous visibility
-    let mut wrong = vec![Vec::new(); insts.len()];
-    let mut flicker = vec![Vec::new(); insts.len()];
-    let mut prev_vis: Vec<Vec<f32>> = vec![Vec::new(); insts.len()];
-    let (mut prev_rt, mut prev_mask): (Vec<f32>, Vec<u32>) = (Vec::new(), Vec::new());
+    // the scene held at t = 0 (moving objects still), each frame timed once
+    let path = PathSpec { cameras: cams, light, width: size, height: size, start_time: 0.0, animate: false, specs: &resolved, repeat: 1 };
+    // how much of the screen the reference itself changes per frame pair (context for the flicker)
     let mut rt_flips = Vec::new();
-    for (f, cam) in cams.iter().enumerate() {
-        let prev_cam = if f == 0 { cam } else { &cams[f - 1] };
-        let view = lab.view(cam, prev_cam, &light, size, size)?;
-        let rt = lab.reference(&view, 1)?;
-        for (k, inst) in insts.iter_mut().enumerate() {
-            let run = lab.step(&view, inst, false, 1)?;
-            wrong[k].push(compare(&run.visibility, &rt.visibility, &view.mask).wrong_pct);
-            if f > 0 {
-                flicker[k].push(flicker_pct(&prev_vis[k], &run.visibility, &prev_rt, &rt.visibility, &prev_mask, &view.mask));
+    let mut prev: Option<(Vec<f32>, Vec<u32>)> = None;
+    let run = lab.run_path(&path, &mut |p| {
+        if let Progress::Frame { view, rt, .. } = p {
+            if let Some((prev_rt, prev_mask)) = &prev {
+                let both = prev_mask.iter().zip(&view.mask).filter(|(a, b)| **a != 0 && **b != 0).count().max(1);
+                let flips = (0..view.mask.len())
+                    .filter(|&i| prev_mask[i] != 0 && view.mask[i] != 0 && (prev_rt[i] >= 0.5) != (rt.visibility[i] >= 0.5))
+                    .count();
+                rt_flips.push(100.0 * flips as f64 / both as f64);
             }
-            prev_vis[k] = run.visibility;
+            prev = Some((rt.visibility.clone(), view.mask.clone()));
         }
-        if f > 0 {
-            // how much of the screen the reference itself changes (context for the flicker)
-            let both = prev_mask.iter().zip(&view.mask).filter(|(a, b)| **a != 0 && **b != 0).count().max(1);
-            let flips = (0..view.mask.len())
-                .filter(|&i| prev_mask[i] != 0 && view.mask[i] != 0 && (prev_rt[i] >= 0.5) != (rt.visibility[i] >= 0.5))
-                .count();
-            rt_flips.push(100.0 * flips as f64 / both as f64);
-        }
-        prev_rt = rt.visibility;
-        prev_mask = view.mask.clone();
-    }
+    })?;
     let mean = |v: &[f64]| if v.is_empty() { 0.0 } else { v.iter().sum::<f64>() / v.len() as f64 };
     let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
     println!(
@@ -102,15 +88,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("rt itself flips {:.3} % of the pixels per frame pair (mean)\n", mean(&rt_flips));
     println!("| technique | wrong % (mean) | wrong % (max) | flicker % (mean) | flicker % (max) |");
     println!("|---|---:|---:|---:|---:|");
-    for (k, inst) in insts.iter().enumerate() {
-        println!(
-            "| `{}` | {:.3} | {:.3} | {:.4} | {:.4} |",
-            inst.label,
-            mean(&wrong[k]),
-            max(&wrong[k]),
-            mean(&flicker[k]),
-            max(&flicker[k])
-        );
+    for (spec, t) in resolved.iter().zip(&run.techniques) {
+        let wrong: Vec<f64> = t.frames.iter().map(|r| r.wrong_pct).collect();
+        let flicker: Vec<f64> = t.frames.iter().filter_map(|r| r.flicker_pct).collect();
+        println!("| `{}` | {:.3} | {:.3} | {:.4} | {:.4} |", spec.label, mean(&wrong), max(&wrong), mean(&flicker), max(&flicker));
     }
     Ok(())
 }

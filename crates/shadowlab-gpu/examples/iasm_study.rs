@@ -1,5 +1,5 @@
 //! The `iasm` studies of docs/bench/iasm.md (issue 6): along a scene's camera path, wrong pixels
-//! and temporal flicker against `rt` for several specs (techniques keep state across frames);
+//! and temporal flicker against `rt` for several specs (techniques keep state across frames, [`Lab::run_path`]);
 //! and the tile-corner study (thesis Figures 4.3/4.4): the camera turned in steps about the
 //! vertical axis, with the error in the camera's near field (samples within 0.4 tile of the
 //! camera across the light) for the thesis placement and the tile-centre fix.
@@ -12,13 +12,13 @@
 use glam::{Vec2, Vec3};
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera};
-use shadowlab_core::metrics::{compare, flicker_pct};
+use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Scene;
 use shadowlab_core::setup::{SceneSource, Setup};
 use shadowlab_core::techniques::iasm::{self as core, Anchor};
-use shadowlab_gpu::lab::{Lab, View};
-use shadowlab_gpu::registry;
+use shadowlab_gpu::lab::{Lab, PathSpec};
+use shadowlab_gpu::registry::{self, Resolved};
 use shadowlab_gpu::Gpu;
 
 type Res = Result<(), Box<dyn std::error::Error>>;
@@ -64,25 +64,28 @@ fn main() -> Res {
 
 fn path_study(lab: &Lab, scene: &Scene, cam: &Camera, size: u32, frames: usize, specs: &[String]) -> Res {
     let light = scene.lights[0];
-    let cams = path_cameras(cam, &scene.camera_path, frames);
-    let views: Vec<View> =
-        cams.iter().enumerate().map(|(i, c)| lab.view(c, &cams[i.saturating_sub(1)], &light, size, size)).collect::<Result<_, _>>()?;
-    let rts: Vec<Vec<f32>> = views.iter().map(|v| lab.reference(v, 1).map(|r| r.visibility)).collect::<Result<_, _>>()?;
+    let mut resolved: Vec<Resolved> = Vec::new();
+    for s in specs {
+        resolved.push(registry::resolve(&TechniqueSpec::parse(s)?, Some(&light))?);
+    }
+    // the scene held at t = 0 (moving objects still), each frame timed once
+    let path = PathSpec {
+        cameras: path_cameras(cam, &scene.camera_path, frames),
+        light,
+        width: size,
+        height: size,
+        start_time: 0.0,
+        animate: false,
+        specs: &resolved,
+        repeat: 1,
+    };
+    let run = lab.run_path(&path, &mut |_| {})?;
     println!("\n## path: {frames} frames along the scene's camera path");
     println!("| spec | wrong % (mean) | wrong % (max) | flicker % (mean) | flicker % (max) |");
     println!("|---|---|---|---|---|");
-    for spec in specs {
-        let mut inst = lab.instantiate(&registry::resolve(&TechniqueSpec::parse(spec)?, Some(&light))?, &light)?;
-        let (mut wrong, mut flick) = (Vec::new(), Vec::new());
-        let mut prev: Option<Vec<f32>> = None;
-        for (i, v) in views.iter().enumerate() {
-            let run = lab.step(v, &mut inst, false, 1)?;
-            wrong.push(compare(&run.visibility, &rts[i], &v.mask).wrong_pct);
-            if let Some(pv) = &prev {
-                flick.push(flicker_pct(pv, &run.visibility, &rts[i - 1], &rts[i], &views[i - 1].mask, &v.mask));
-            }
-            prev = Some(run.visibility);
-        }
+    for (spec, t) in specs.iter().zip(&run.techniques) {
+        let wrong: Vec<f64> = t.frames.iter().map(|r| r.wrong_pct).collect();
+        let flick: Vec<f64> = t.frames.iter().filter_map(|r| r.flicker_pct).collect();
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
         let max = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max);
         println!("| `{spec}` | {:.3} | {:.3} | {:.3} | {:.3} |", mean(&wrong), max(&wrong), mean(&flick), max(&flick));

@@ -29,25 +29,26 @@ fn bit_equal(a: &Run, b: &Run) -> bool {
 #[test]
 fn subdivision_out_of_capacity_is_deterministic_and_flagged() {
     let Some(gpu) = gpu() else { return };
-    // a capacity far below what these views need (tens of thousands of pieces): the cut happens
-    for (scene, light, name) in [
-        ("courtyard", 0, "notw"),
-        ("courtyard", 0, "rtw"),
-        ("room", 0, "notw"),
-        ("room", 1, "cube-notw"),
-        ("room", 1, "dpsm"),
-        ("room", 1, "dpsm-notw"),
-    ] {
-        let spec = format!("{name}:subdiv_capacity=64");
-        let (a, b) = twice(&gpu, scene, light, &spec);
+    // (scene, light, spec, whether it runs out of pieces): capacities below what these views
+    // need (the automatic one, 2^21, is exceeded too by 96x96 views of notw and cube-notw: the
+    // warp magnifies the few samples of a small view strongly; too slow for this suite), and
+    // views that fit
+    let cases = [
+        ("courtyard", 0, "notw:subdiv_capacity=64", true),
+        ("courtyard", 0, "rtw:subdiv_capacity=64", true),
+        ("room", 1, "dpsm:subdiv_capacity=64", true),
+        ("room", 1, "dpsm-notw:subdiv_capacity=64", true),
+        ("courtyard", 0, "notw:subdiv_capacity=100000", true),
+        ("room", 1, "cube-notw:subdiv_capacity=64", true),
+        ("courtyard", 0, "rtw", false),
+        ("room", 1, "dpsm", false),
+    ];
+    for (scene, light, spec, out_of_capacity) in cases {
+        let (a, b) = twice(&gpu, scene, light, spec);
         assert!(bit_equal(&a, &b), "{spec} on {scene} light {light}: two runs differ");
-        assert!(!a.report.degraded.is_empty(), "{spec} on {scene}: capacity reached but not flagged: {:?}", a.report.counters);
-        let c = &a.report.counters;
-        let dropped: f64 = c.iter().filter(|(k, _)| k.ends_with("subdiv_pieces_dropped")).map(|(_, v)| v).sum();
-        assert_eq!(dropped, 0.0, "{spec} on {scene}: pieces dropped");
-        // at the automatic capacity the same views fit: complete, unflagged, and as stable
-        let (a, b) = twice(&gpu, scene, light, name);
-        assert!(bit_equal(&a, &b), "{name} on {scene} light {light}: two runs differ");
-        assert!(a.report.degraded.is_empty(), "{name} on {scene}: {:?}", a.report.degraded);
+        assert_eq!(!a.report.degraded.is_empty(), out_of_capacity, "{spec} on {scene}: {:?} {:?}", a.report.degraded, a.report.counters);
+        let lost: f64 =
+            a.report.counters.iter().filter(|(k, _)| k.ends_with("dropped") || k.ends_with("queue_full_finishes")).map(|(_, v)| v).sum();
+        assert_eq!(lost, 0.0, "{spec} on {scene}: pieces lost");
     }
 }

@@ -138,7 +138,7 @@ fn gpu_pcf_equals_cpu_pcf_on_read_back_texels() {
         let (t, vis) = run_direct(&gpu, &lab, &v, args);
         let nsm = t.read_selected(&gpu);
         let p = *t.params();
-        let (res, n) = (p.texel[2], p.sel[0] as usize);
+        let (res, n) = (p.texel[2], p.n as usize);
         let k = (p.texel[3] * p.texel[3]) as u32;
         let vp = Mat4::from_cols_array_2d(&p.light_view_proj);
         let to_map = |q: Vec3| {
@@ -156,7 +156,7 @@ fn gpu_pcf_equals_cpu_pcf_on_read_back_texels() {
             let cos_t = nrm.dot(l).clamp(1e-4, 1.0);
             let tan_t = ((1.0 - cos_t * cos_t).sqrt() / cos_t).min(p.bias[3]);
             let half = (p.texel[3] - 1.0) * 0.5;
-            let reach = half + if p.sel[3] == 1 { (p.sel[1] as f32 - 1.0) * 0.5 } else { 0.0 };
+            let reach = half + if p.region_bias == 1 { (p.region as f32 - 1.0) * 0.5 } else { 0.0 };
             let q = pos + nrm * (p.bias[2] * p.texel[0]) + l * ((p.bias[0] + (p.bias[1] + reach) * tan_t) * p.texel[0]);
             let m = to_map(q);
             if m.x < 0.0 || m.y < 0.0 || m.x > 1.0 || m.y > 1.0 || m.z > 1.0 {

@@ -3,14 +3,19 @@
 
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
-use serde_json::Value;
+use shadowlab_gpu::lab::FrameRecord;
 
-/// The per-frame figures charted, as (key in a `frames` record, title).
-pub const CHARTS: &[(&str, &str)] = &[
-    ("wrong_pct", "wrong pixels (%)"),
-    ("flicker_pct", "flicker vs previous frame (%)"),
-    ("rays_traced", "rays traced"),
-    ("total_ms", "time (ms)"),
+use crate::metrics::Metrics;
+
+/// A chart: its title and the figure of a `frames` record, if the record has one.
+type Chart = (&'static str, fn(&FrameRecord) -> Option<f64>);
+
+/// The per-frame figures charted.
+pub const CHARTS: &[Chart] = &[
+    ("wrong pixels (%)", |r| Some(r.wrong_pct)),
+    ("flicker vs previous frame (%)", |r| r.flicker_pct),
+    ("rays traced", |r| r.rays_traced),
+    ("time (ms)", |r| Some(r.total_ms)),
 ];
 
 const PALETTE: &[RGBColor] = &[
@@ -25,25 +30,17 @@ const PALETTE: &[RGBColor] = &[
 ];
 
 /// One SVG per chart that has data, as (title, svg). Empty for single-frame runs.
-pub fn frame_charts(metrics: &Value) -> Result<Vec<(String, String)>> {
-    let techniques = metrics["techniques"].as_array().cloned().unwrap_or_default();
-    let frames = metrics["frames"].as_u64().unwrap_or(1);
+pub fn frame_charts(metrics: &Metrics) -> Result<Vec<(String, String)>> {
+    let frames = metrics.frames;
     if frames < 2 {
         return Ok(Vec::new());
     }
     let mut out = Vec::new();
-    for (key, title) in CHARTS {
-        let series: Vec<(String, Vec<(f64, f64)>)> = techniques
+    for (title, figure) in CHARTS {
+        let series: Vec<(String, Vec<(f64, f64)>)> = metrics
+            .techniques
             .iter()
-            .map(|t| {
-                let pts = t["frames"]
-                    .as_array()
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|r| Some((r["frame"].as_f64()?, r[*key].as_f64()?)))
-                    .collect::<Vec<_>>();
-                (t["label"].as_str().unwrap_or("").to_string(), pts)
-            })
+            .map(|t| (t.label.clone(), t.frames.iter().filter_map(|r| Some((r.frame as f64, figure(r)?))).collect::<Vec<_>>()))
             .filter(|(_, pts)| !pts.is_empty())
             .collect();
         if series.is_empty() {
@@ -86,11 +83,10 @@ fn chart(title: &str, frames: f64, series: &[(String, Vec<(f64, f64)>)]) -> Resu
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::metrics::sample;
     #[test]
     fn one_line_per_technique_and_nothing_for_one_frame() {
-        let rec = |f: u32, w: f64| serde_json::json!({"frame": f, "wrong_pct": w, "flicker_pct": if f == 0 { Value::Null } else { (w / 2.0).into() }, "total_ms": 3.0, "rays_traced": null});
-        let t = |l: &str| serde_json::json!({"label": l, "frames": [rec(0, 1.0), rec(1, 2.0), rec(2, 1.5)]});
-        let m = serde_json::json!({"frames": 3, "techniques": [t("sm"), t("vsm:blur=5")]});
+        let m = sample::metrics(3);
         let charts = frame_charts(&m).unwrap();
         let titles: Vec<&str> = charts.iter().map(|c| c.0.as_str()).collect();
         assert_eq!(titles, ["wrong pixels (%)", "flicker vs previous frame (%)", "time (ms)"], "no rays: no ray chart");
@@ -98,6 +94,6 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.contains("vsm:blur=5") && svg.contains("sm"));
         let lines = svg.lines().filter(|l| l.contains("<polyline") && l.contains("stroke-width=\"2\"")).count();
         assert_eq!(lines, 4, "two lines and two legend marks");
-        assert!(frame_charts(&serde_json::json!({"frames": 1, "techniques": [t("sm")]})).unwrap().is_empty());
+        assert!(frame_charts(&sample::metrics(1)).unwrap().is_empty());
     }
 }

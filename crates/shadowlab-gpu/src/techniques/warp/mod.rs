@@ -410,7 +410,7 @@ impl Warped {
         let queues = [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16));
         let counters = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some(&format!("{name}.counters")),
-            size: 96,
+            size: 1048 * 4,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });

@@ -267,16 +267,12 @@ impl Technique for Warped {
             c.insert("subdiv_pieces_unsplit".into(), a[20] as f64);
             if a[19] > 0 {
                 r.degraded.push(format!(
-                    "{}: subdivision level {} of {} did not fit the piece capacity ({} pieces); {} pieces were drawn unsplit (bent edges)",
-                    self.name(),
-                    a[19],
-                    self.params.subdiv_levels,
-                    self.params.extra_capacity,
-                    a[20]
+                    "subdivision level {} of {}: the pieces did not fit the piece capacity ({}); {} pieces were drawn unsplit (bent edges)",
+                    a[19], self.params.subdiv_levels, self.params.extra_capacity, a[20]
                 ));
             }
             if a[1] > 0 || a[2] > 0 {
-                r.degraded.push(format!("{}: {} pieces dropped, {} queue-full finishes", self.name(), a[1], a[2]));
+                r.degraded.push(format!("{} pieces dropped, {} queue-full finishes", a[1], a[2]));
             }
         }
         if self.variant != Variant::Dv {

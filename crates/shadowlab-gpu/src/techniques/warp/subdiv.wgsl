@@ -11,15 +11,17 @@
 //
 // Capacity, deterministically: which pieces an atomic append order lets through must not decide
 // the map. A queued piece carries its split mask (computed once, when it was queued), so the
-// pieces a level will produce are known before it runs: split_args adds them up and the level
-// splits only if all of them fit (as finished pieces, and in the next queue); otherwise it
-// finishes its inputs unsplit (coarser, complete) and the cut is counted. The set of pieces,
-// and so the depth map (a minimum), is then the same on every run.
+// pieces a level will produce are known before it runs, added up per bucket of triangle
+// indices (sums: the same in any order). split_args splits the pieces of the first buckets whose
+// children all fit (as finished pieces, and before the last level in the next queue) and the
+// level finishes the rest unsplit (coarser, complete; counted). The set of pieces, and so the
+// depth map (a minimum), is then the same on every run.
 //
 // counters: [appended, dropped (never: kept for the report), queue-full finishes (never), -,
 // draw args (4), queue 0: count, groups x, y, z, queue 1: count, groups x, y, z, children of
-// queue 0's pieces, of queue 1's, cut flag of the running level, first level cut (0: none),
-// pieces finished unsplit by the cut, -, -, -].
+// queue 0's pieces, of queue 1's, split limit of the running level (pieces of triangles below
+// it split), first level cut (0: none), pieces finished unsplit, -, -, -], then per queue
+// BUCKETS children and BUCKETS pieces by bucket of triangle index.
 
 struct Level {
     // x: level (1..), y: 1 on the last level, z: input queue (0 or 1), w: capacity per queue
@@ -27,7 +29,7 @@ struct Level {
 }
 
 @group(0) @binding(10) var<storage, read_write> pieces: array<vec4<u32>>;
-@group(0) @binding(11) var<storage, read_write> counters: array<atomic<u32>, 24>;
+@group(0) @binding(11) var<storage, read_write> counters: array<atomic<u32>, 1048>;
 @group(0) @binding(12) var<storage, read_write> q_in: array<vec4<u32>>;
 @group(0) @binding(13) var<storage, read_write> q_out: array<vec4<u32>>;
 @group(0) @binding(14) var<uniform> lv: Level;
@@ -179,6 +181,12 @@ fn children_of(mask: u32) -> u32 {
     }
 }
 
+const BUCKETS: u32 = 256u;
+
+fn bucket_of(tri: u32) -> u32 {
+    return tri / ((wp.triangles + BUCKETS - 1u) / BUCKETS);
+}
+
 fn enqueue(p: vec4<u32>, mask: u32, q: u32) {
     let i = atomicAdd(&counters[8u + 4u * q], 1u);
     if i >= lv.v.w {
@@ -188,7 +196,11 @@ fn enqueue(p: vec4<u32>, mask: u32, q: u32) {
         finish(p);
         return;
     }
-    atomicAdd(&counters[16u + q], children_of(mask));
+    let children = children_of(mask);
+    atomicAdd(&counters[16u + q], children);
+    let b = 24u + q * 2u * BUCKETS + bucket_of(p.x);
+    atomicAdd(&counters[b], children);
+    atomicAdd(&counters[b + BUCKETS], 1u);
     q_out[i] = vec4<u32>(p.x | (mask << MASK_SHIFT), p.y, p.z, p.w);
 }
 
@@ -272,12 +284,32 @@ fn split_args() {
     atomicStore(&counters[qi + 3u], 1u);
     atomicStore(&counters[qo], 0u);
     atomicStore(&counters[16u + 1u - lv.v.z], 0u);
-    // split only if every child fits: as a finished piece, and before the last level in the
-    // next queue (a level's inputs always fit as finished pieces: the level before checked)
-    let children = atomicLoad(&counters[16u + lv.v.z]);
-    let cut = atomicLoad(&counters[0]) + children > wp.extra_capacity || (lv.v.y == 0u && children > lv.v.w);
-    atomicStore(&counters[18], select(0u, 1u, cut));
-    if cut && atomicLoad(&counters[19]) == 0u {
+    let out = 24u + (1u - lv.v.z) * 2u * BUCKETS;
+    for (var b = 0u; b < 2u * BUCKETS; b++) {
+        atomicStore(&counters[out + b], 0u);
+    }
+    // the first buckets whose pieces split: each split piece's children must fit as finished
+    // pieces and (before the last level) in the next queue; the rest finish as one piece each
+    // (a level's inputs always fit so: the level before checked)
+    let inp = 24u + lv.v.z * 2u * BUCKETS;
+    var total = atomicLoad(&counters[0]);
+    for (var b = 0u; b < BUCKETS; b++) {
+        total += atomicLoad(&counters[inp + BUCKETS + b]);
+    }
+    var queued = 0u;
+    var k = 0u;
+    for (; k < BUCKETS; k++) {
+        let kids = atomicLoad(&counters[inp + k]);
+        let grow = kids - atomicLoad(&counters[inp + BUCKETS + k]);
+        if total + grow > wp.extra_capacity || (lv.v.y == 0u && queued + kids > lv.v.w) {
+            break;
+        }
+        total += grow;
+        queued += kids;
+    }
+    let size = (wp.triangles + BUCKETS - 1u) / BUCKETS;
+    atomicStore(&counters[18], select(k * size, 0xffffffffu, k == BUCKETS));
+    if k < BUCKETS && atomicLoad(&counters[19]) == 0u {
         atomicStore(&counters[19], lv.v.x);
     }
 }
@@ -306,8 +338,8 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
     let queued = q_in[id.x];
     let mask = queued.x >> MASK_SHIFT;
     let p = vec4<u32>(queued.x & TRI_BITS, queued.y, queued.z, queued.w);
-    if atomicLoad(&counters[18]) != 0u {
-        // the level's children do not fit: its inputs are drawn unsplit
+    if p.x >= atomicLoad(&counters[18]) {
+        // this piece's children do not fit (its bucket is past the level's split limit): drawn unsplit
         atomicAdd(&counters[20], 1u);
         finish(p);
         return;

@@ -1,5 +1,12 @@
 //! The lab: one scene on the GPU, views prepared once (G-buffer, mask, reference), techniques
-//! run against them. The CLI and the integration tests both drive this.
+//! run against them. The CLI and the integration tests both drive this; [`path`] runs the
+//! reference and techniques over a camera path ([`Lab::run_path`]), [`summary`] sums it up.
+
+pub mod path;
+pub mod summary;
+
+pub use path::{FrameRecord, PathError, PathRun, PathSpec, Progress, ReferenceFrame, TechniqueFrames};
+pub use summary::{reference_total_ms, summarize, Summary};
 
 use std::cell::Cell;
 use std::collections::BTreeMap;
