@@ -127,7 +127,7 @@ fn corner_study(lab: &Lab, cam: &Camera, light: &shadowlab_core::light::Light, s
         for s in specs {
             let run = lab.run(&v, &TechniqueSpec::parse(s)?, 0)?;
             let side = run.report.counters["square_side"] as f32;
-            let anchor = if run.params.get_u32("anchor") == 1 { Anchor::TileCentre } else { Anchor::Circle };
+            let anchor = if run.params.choice("anchor") == "tile" { Anchor::TileCentre } else { Anchor::Circle };
             let snap = run.params.get_bool("snap").then_some(side / 64.0);
             let p = core::place(direction, c.position, (c.target - c.position).normalize(), side, snap, anchor);
             if first {

@@ -182,14 +182,11 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 }
 
 #[test]
-fn cube_notw_lists_notws_parameters_with_five_defaults_of_its_own() {
+fn cube_notw_lists_notws_parameters_with_six_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
-    let (a, b) = (cube::NOTW_PARAMS, warp::NOTW_PARAMS);
-    // notw's shared list, then the bias footprint choice (notw's own list has it too)
-    assert_eq!(a.len(), b.len() + 1);
-    assert_eq!(a.last().map(|p| p.key), Some(warp::BIAS_MODE.key));
-    assert_eq!(a.last().map(|p| p.default), Some(cube::DEFAULT_NOTW_BIAS_MODE));
-    let a = &a[..b.len()];
+    // notw's whole list (the same keys in the same order, as the code reads them all)
+    let (a, b) = (cube::NOTW_PARAMS, warp::NOTW_OWN_PARAMS);
+    assert_eq!(a.len(), b.len());
     assert_eq!(a.iter().map(|p| p.key).collect::<Vec<_>>(), b.iter().map(|p| p.key).collect::<Vec<_>>());
     let own = [
         ("window", cube::DEFAULT_NOTW_WINDOW),
@@ -197,6 +194,7 @@ fn cube_notw_lists_notws_parameters_with_five_defaults_of_its_own() {
         ("mix", cube::DEFAULT_NOTW_MIX),
         ("subdiv", cube::DEFAULT_NOTW_SUBDIV),
         ("normal_offset", cube::DEFAULT_NOTW_NORMAL_OFFSET),
+        ("bias_mode", cube::DEFAULT_NOTW_BIAS_MODE),
     ];
     for (x, y) in a.iter().zip(b) {
         match own.iter().find(|(k, _)| *k == x.key) {

@@ -111,7 +111,7 @@ fn atlas_store_matches_buffer_store_and_rt() {
     let v = view(&lab, &scene, 0, 256);
     let buf = lab.run(&v, &TechniqueSpec::parse("iasm:store=buffer").unwrap(), 1).unwrap();
     let atl = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
-    assert_eq!(atl.params.get_u32("store"), 1, "atlas is the default store");
+    assert_eq!(atl.params.choice("store"), "atlas", "atlas is the default store");
     // the same tiles, frusta and depths; only where the depth lives differs
     let a = agreement(&atl.visibility, &buf.visibility, &v.mask);
     assert!(a >= 99.9, "atlas and buffer agree on {a:.3}%");

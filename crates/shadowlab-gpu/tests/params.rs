@@ -130,3 +130,26 @@ fn every_parameter_read_is_declared_with_its_kind() {
     }
     assert!(checked > 80, "only {checked} reads found: is the scan still right?");
 }
+
+/// Tests, examples and the CLI read results' parameters too: a key some technique declares must
+/// be declared of the accessor's kind by at least one (keys such as `k` mean different things
+/// to different techniques).
+#[test]
+fn parameter_reads_outside_the_techniques_fit_the_tables() {
+    let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut files = Vec::new();
+    for dir in ["shadowlab-gpu/tests", "shadowlab-gpu/examples", "shadowlab-cli/src"] {
+        files.extend(sources(&crates.join(dir)));
+    }
+    for f in files.iter().filter(|f| !f.ends_with("params.rs")) {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (acc, key) in reads(&text) {
+            let decls: Vec<(&str, Kind)> =
+                REGISTRY.iter().flat_map(|t| t.params.iter().filter(|p| p.key == key).map(move |p| (t.name, p.kind))).collect();
+            if decls.is_empty() {
+                continue; // not a parameter read (`get` of a map, a counter)
+            }
+            assert!(decls.iter().any(|(_, kind)| accessor_fits(acc, *kind)), "{}: {acc}(\"{key}\") but {decls:?}", f.display());
+        }
+    }
+}

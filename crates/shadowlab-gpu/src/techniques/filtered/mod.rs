@@ -32,6 +32,7 @@ pub use technique::Filtered;
 /// The representation library (encoders, bounds, `*_visibility_gather`): self-contained WGSL
 /// with no bindings, for other passes (leak tracing) to prepend.
 pub const MOMENTS_WGSL: &str = include_str!("moments.wgsl");
+const PARAMS_WGSL: &str = include_str!("params.wgsl");
 const RENDER_WGSL: &str = include_str!("render.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 
@@ -44,10 +45,10 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 }
 /// The composed moments raster (`FilteredParams` at group 0; leak tracing renders its sd maps with it).
 pub fn render_source() -> String {
-    compose(&format!("{MOMENTS_WGSL}{RENDER_WGSL}"), true)
+    compose(&format!("{MOMENTS_WGSL}{PARAMS_WGSL}{RENDER_WGSL}"), true)
 }
 fn eval_source() -> String {
-    compose_view(&format!("{MOMENTS_WGSL}{EVAL_WGSL}"), false)
+    compose_view(&format!("{MOMENTS_WGSL}{PARAMS_WGSL}{EVAL_WGSL}"), false)
 }
 
 /// The four representations; the index is `mode.x` in the WGSL.

@@ -5,17 +5,23 @@ use crate::shaders::compose;
 use crate::technique::{compose_view, view_layout};
 use crate::{binding, Gpu};
 
+const PARAMS_WGSL: &str = include_str!("params.wgsl");
 const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");
 const VOLUME_WGSL: &str = include_str!("volume.wgsl");
 const RESOLVE_WGSL: &str = include_str!("resolve.wgsl");
+
+/// `params.wgsl` (`SvParams`), then `body`.
+fn with_params(body: &str, with_scene: bool) -> String {
+    compose(&format!("{PARAMS_WGSL}{body}"), with_scene)
+}
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 const GATHER_WGSL: &str = include_str!("gather.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
-        ("sv/silhouette.wgsl", compose(SILHOUETTE_WGSL, true)),
-        ("sv/volume.wgsl", compose(VOLUME_WGSL, true)),
-        ("sv/resolve.wgsl", compose(RESOLVE_WGSL, false)),
+        ("sv/silhouette.wgsl", with_params(SILHOUETTE_WGSL, true)),
+        ("sv/volume.wgsl", with_params(VOLUME_WGSL, true)),
+        ("sv/resolve.wgsl", with_params(RESOLVE_WGSL, false)),
         ("sv/eval.wgsl", compose_view(EVAL_WGSL, false)),
         ("sv/gather.wgsl", compose(GATHER_WGSL, true)),
     ]
@@ -113,14 +119,14 @@ impl Pipelines {
         let sil_types =
             [uniform(), uniform(), storage(true), storage(true), storage(false), storage(false), storage(false), storage(false)];
         let sil_layout = binding::layout(d, "sv.silhouettes", c, &sil_types);
-        let sil_src = compose(SILHOUETTE_WGSL, true);
+        let sil_src = with_params(SILHOUETTE_WGSL, true);
         let facing = gpu.compute_pipeline("sv.facing", &sil_src, "facing_main", &[&sil_layout, scene_layout]);
         let edges = gpu.compute_pipeline("sv.edges", &sil_src, "edges_main", &[&sil_layout, scene_layout]);
 
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let vol_layout =
             binding::layout(d, "sv.volumes", vf, &[uniform(), uniform(), uniform(), storage(true), storage(true), storage(true)]);
-        let vol_module = gpu.shader("sv.volumes", &compose(VOLUME_WGSL, true));
+        let vol_module = gpu.shader("sv.volumes", &with_params(VOLUME_WGSL, true));
         let vol_pl = gpu.pipeline_layout("sv.volumes", &[&vol_layout, scene_layout]);
         let volume = |label, vs, front_face, count_only: bool| {
             raster(
@@ -151,7 +157,7 @@ impl Pipelines {
         ];
 
         let resolve_layout = binding::layout(d, "sv.resolve", vf, &[texture_depth(), uniform()]);
-        let res_module = gpu.shader("sv.resolve", &compose(RESOLVE_WGSL, false));
+        let res_module = gpu.shader("sv.resolve", &with_params(RESOLVE_WGSL, false));
         let res_pl = gpu.pipeline_layout("sv.resolve", &[&resolve_layout]);
         let full = |label, fs, depth_write, stencil, color| {
             raster(

@@ -3,19 +3,6 @@
 // light cap, rasterised at the same depth, fails the less-than test (it lies behind). `fs_lit`:
 // drawn with the stencil test "equal 0": writes 1 where no volume contains the sample.
 
-struct SvParams {
-    triangles: u32,
-    edges: u32,
-    // vertices per side record (3: one triangle to the point at infinity; 6: a quad)
-    side_vertices: u32,
-    // depth offset of the receivers (f32 ulps)
-    depth_offset: u32,
-    // extrusion distance (world units; 0 = to infinity, w = 0)
-    extrude: f32,
-    pad0: f32,
-    pad1: f32,
-    pad2: f32,
-}
 
 @group(0) @binding(0) var g_depth: texture_depth_2d;
 @group(0) @binding(1) var<uniform> sv: SvParams;
