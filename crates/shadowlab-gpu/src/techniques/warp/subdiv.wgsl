@@ -18,10 +18,10 @@
 // depth map (a minimum), is then the same on every run.
 //
 // counters: [appended, dropped (never: kept for the report), queue-full finishes (never), -,
-// draw args (4), queue 0: count, groups x, y, z, queue 1: count, groups x, y, z, children of
-// queue 0's pieces, of queue 1's, split limit of the running level (pieces of triangles below
-// it split), first level cut (0: none), pieces finished unsplit, -, -, -], then per queue
-// BUCKETS children and BUCKETS pieces by bucket of triangle index.
+// draw args (4), queue 0: count, groups x, y, z, queue 1: count, groups x, y, z, -, -, split
+// limit of the running level (pieces of triangles below it split), first level cut (0: none),
+// pieces finished unsplit, -, -, -], then per queue BUCKETS children and BUCKETS pieces by
+// bucket of triangle index.
 
 struct Level {
     // x: level (1..), y: 1 on the last level, z: input queue (0 or 1), w: capacity per queue
@@ -196,10 +196,8 @@ fn enqueue(p: vec4<u32>, mask: u32, q: u32) {
         finish(p);
         return;
     }
-    let children = children_of(mask);
-    atomicAdd(&counters[16u + q], children);
     let b = 24u + q * 2u * BUCKETS + bucket_of(p.x);
-    atomicAdd(&counters[b], children);
+    atomicAdd(&counters[b], children_of(mask));
     atomicAdd(&counters[b + BUCKETS], 1u);
     q_out[i] = vec4<u32>(p.x | (mask << MASK_SHIFT), p.y, p.z, p.w);
 }
@@ -283,7 +281,6 @@ fn split_args() {
     atomicStore(&counters[qi + 2u], 1u);
     atomicStore(&counters[qi + 3u], 1u);
     atomicStore(&counters[qo], 0u);
-    atomicStore(&counters[16u + 1u - lv.v.z], 0u);
     let out = 24u + (1u - lv.v.z) * 2u * BUCKETS;
     for (var b = 0u; b < 2u * BUCKETS; b++) {
         atomicStore(&counters[out + b], 0u);
