@@ -115,8 +115,9 @@ pub fn resolve(args: &RunArgs, default_specs: &[String]) -> Result<RunConfig> {
     if width == 0 || height == 0 {
         bail!("output size {width}x{height}: width and height must be at least 1");
     }
-    if !args.time.is_finite() {
-        bail!("--time {}: must be a finite number of frames", args.time);
+    let time = args.time.unwrap_or(setup.time);
+    if !time.is_finite() {
+        bail!("--time {time}: must be a finite number of frames");
     }
     let mut scene = load_scene(&source, &setup.transform()).with_context(|| "loading the scene")?;
     shadowlab_core::anim::apply(&mut scene, &setup.animations).map_err(|e| anyhow!("[[animations]]: {e}"))?;
@@ -152,7 +153,7 @@ pub fn resolve(args: &RunArgs, default_specs: &[String]) -> Result<RunConfig> {
         width,
         height,
         specs,
-        time: args.time,
+        time,
     };
     Ok(cfg)
 }

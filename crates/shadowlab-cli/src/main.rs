@@ -8,6 +8,7 @@ mod listing;
 mod metrics;
 mod output;
 mod report;
+mod view;
 
 use std::path::PathBuf;
 
@@ -46,9 +47,9 @@ pub struct RunArgs {
     #[arg(long, default_value_t = 1)]
     pub frames: usize,
     /// Animation time of frame 0, in frames (moving objects: frame k of `--frames` is at
-    /// time + k; a single view is at this time)
-    #[arg(long, default_value_t = 0.0)]
-    pub time: f32,
+    /// time + k; a single view is at this time). Default: the setup's `time`, else 0
+    #[arg(long)]
+    pub time: Option<f32>,
     /// No progress bar or summary
     #[arg(long, short)]
     pub quiet: bool,
@@ -79,6 +80,8 @@ enum Command {
         #[arg(long)]
         export: bool,
     },
+    /// Interactive viewer: fly, move the light, edit parameters live, see the error against `rt`
+    View(view::ViewArgs),
     /// Time every stage on the built-in scenes (and sponza/conference when present)
     Bench {
         /// Setup files to benchmark (default: the built-in scenes plus setups/sponza.toml and setups/conference.toml when their scenes exist)
@@ -126,6 +129,7 @@ fn main() {
         Command::Techniques => listing::techniques(),
         Command::Render { run, out } => compare::render(&run, &out),
         Command::Compare { run, out, export } => compare::compare(&run, &out, export),
+        Command::View(args) => view::view(&args),
         Command::Bench { setup, size, frames, out } => bench::bench(&setup, &size, frames, out.as_deref()),
     };
     if let Err(e) = result {

@@ -14,6 +14,9 @@ use crate::loaders::{SceneTransform, UpAxis};
 #[derive(Clone, Debug, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Setup {
+    /// Animation time of frame 0, in frames (moving objects); `--time` overrides it.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub time: f32,
     pub scene: SceneSection,
     #[serde(default)]
     pub camera: Option<CameraSection>,
@@ -64,6 +67,10 @@ pub struct SceneSection {
     pub scale: f32,
     #[serde(default)]
     pub offset: [f32; 3],
+}
+
+fn is_zero(t: &f32) -> bool {
+    *t == 0.0
 }
 
 fn one() -> f32 {
@@ -163,6 +170,9 @@ impl Setup {
         }
         for l in &self.lights {
             l.validate()?;
+        }
+        if !self.time.is_finite() {
+            return Err(format!("time = {}: must be a finite number of frames", self.time));
         }
         for (i, a) in self.animations.iter().enumerate() {
             a.validate().map_err(|e| format!("animations[{i}]: {e}"))?;

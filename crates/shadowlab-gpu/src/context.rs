@@ -41,21 +41,26 @@ impl Gpu {
         }))
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
-        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&Gpu::device_descriptor(&adapter)))
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+        Gpu::from_device(device, queue, info)
+    }
+
+    /// What shadowlab asks of an adapter's device: all of its limits, timestamps where offered,
+    /// and the optional features `sv` uses (the viewer opens its window's device with this too).
+    pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
         let ts = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let has_ts = adapter.features().contains(ts);
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        wgpu::DeviceDescriptor {
             label: Some("shadowlab"),
             // sv: unclipped depth (infinite extrusion) and a float depth-stencil target, where offered
             required_features: (if has_ts { ts } else { wgpu::Features::empty() })
                 | (adapter.features() & (wgpu::Features::DEPTH_CLIP_CONTROL | wgpu::Features::DEPTH32FLOAT_STENCIL8)),
-            required_limits: limits.clone(),
+            required_limits: adapter.limits(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| GpuError::Device(e.to_string()))?;
-        Gpu::from_device(device, queue, info)
+        }
     }
 
     /// Wraps a device the host application already opened (the library seam). shadowlab keeps

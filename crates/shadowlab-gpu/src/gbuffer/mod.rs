@@ -20,7 +20,9 @@ pub const NORMAL_FORMAT: F = F::Rgba32Float;
 pub const ALBEDO_FORMAT: F = F::Rgba8Unorm;
 pub const MOTION_FORMAT: F = F::Rg32Float;
 
-/// The G-buffer of one view. Position `w` is the linear view depth (0 where empty).
+/// The G-buffer of one view. Position `w` is the linear view depth (0 where empty). Cloning
+/// shares the targets (wgpu handles); the viewer's progressive reference swaps in its own mask.
+#[derive(Clone)]
 pub struct GBuffer {
     pub width: u32,
     pub height: u32,

@@ -1,6 +1,7 @@
 //! Shading pass: turns a visibility buffer into a picture (RGBA8, sRGB).
 
 use crate::gbuffer::GBuffer;
+use crate::record::Recorder;
 use crate::shaders::compose;
 use crate::technique::FrameInputs;
 use crate::{binding, Gpu};
@@ -35,8 +36,8 @@ impl ShadePass {
         gpu.storage("shade.color", g.pixels() as u64 * 4)
     }
 
-    /// Shades `visibility` into `out` (see [`ShadePass::output`]) and returns RGBA8 pixels (stage `shade`).
-    pub fn shade(&self, gpu: &Gpu, f: &FrameInputs, out: &wgpu::Buffer) -> Vec<u8> {
+    /// Records the shading of `f.visibility` into `out` (see [`ShadePass::output`]; stage `shade`).
+    pub fn record(&self, gpu: &Gpu, rec: &mut Recorder, f: &FrameInputs, out: &wgpu::Buffer) {
         let g = f.gbuffer;
         let views: Vec<_> = [&g.position, &g.normal, &g.albedo].iter().map(|t| t.create_view(&Default::default())).collect();
         let group = binding::group(
@@ -54,9 +55,16 @@ impl ShadePass {
                 out.as_entire_binding(),
             ],
         );
+        rec.stage("shade", |enc| gpu.dispatch_2d(enc, "shade", &self.pipeline, &[&group], g.width, g.height));
+    }
+
+    /// Shades `visibility` into `out` (see [`ShadePass::output`]) and returns RGBA8 pixels.
+    pub fn shade(&self, gpu: &Gpu, f: &FrameInputs, out: &wgpu::Buffer) -> Vec<u8> {
         let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shade") });
-        gpu.dispatch_2d(&mut enc, "shade", &self.pipeline, &[&group], g.width, g.height);
+        let mut rec = Recorder::new(gpu, &mut enc);
+        self.record(gpu, &mut rec, f, out);
+        rec.finish();
         gpu.submit(enc.finish());
-        gpu.read_buffer(out)[..g.pixels() * 4].to_vec()
+        gpu.read_buffer(out)[..f.gbuffer.pixels() * 4].to_vec()
     }
 }
