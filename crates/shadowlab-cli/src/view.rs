@@ -42,6 +42,9 @@ pub struct ViewArgs {
     /// Turn the camera about its target by this many degrees per frame (scripted runs)
     #[arg(long, default_value_t = 0.0)]
     pub orbit: f32,
+    /// Orbit only during the first N frames, then hold still (with --orbit)
+    #[arg(long)]
+    pub orbit_frames: Option<usize>,
     /// Set a parameter of technique A at a frame: FRAME:KEY=VALUE (repeatable; scripted runs)
     #[arg(long = "set-at")]
     pub set_at: Vec<String>,
@@ -92,6 +95,7 @@ pub fn view(args: &ViewArgs) -> Result<()> {
             exit_after: args.exit_after,
             screenshot: args.screenshot.clone(),
             orbit_deg: args.orbit,
+            orbit_frames: args.orbit_frames,
             set_at,
         },
         setup,

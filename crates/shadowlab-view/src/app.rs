@@ -62,6 +62,11 @@ pub(crate) struct App {
     out_dir: std::path::PathBuf,
     script: Script,
     frames: usize,
+    /// Every frame's time (ms), for the scripted run's summary.
+    all_frame_ms: Vec<f64>,
+    /// When the current still period began, and how long after it the reference was current.
+    still_since: Option<Instant>,
+    current_after: Option<(f64, usize)>,
     /// A scripted run has asked the window to close.
     closing: bool,
     dragging_divider: bool,
@@ -75,11 +80,12 @@ pub(crate) fn run(opts: Options) -> anyhow::Result<()> {
     // shadowlab's own device: every adapter limit, timestamps where offered
     setup.device_descriptor = Arc::new(|adapter| Gpu::device_descriptor(adapter));
     setup.instance_descriptor.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
-    let (w, h) = opts.size.unwrap_or((1280, 720));
+    // the window: the fixed render size plus the panels, else 1600x900
+    let (w, h) = opts.size.map_or((1600.0, 900.0), |(w, h)| (w as f32 + crate::app_panels::CONTROLS_W + crate::app_panels::HUD_W + 24.0, h as f32 + 16.0));
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("shadowlab view")
-            .with_inner_size([w as f32 + crate::app_panels::CONTROLS_W + crate::app_panels::HUD_W + 24.0, h as f32 + 16.0]),
+            .with_inner_size([w, h]),
         wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup), ..Default::default() },
         ..Default::default()
     };
@@ -143,6 +149,9 @@ impl App {
             out_dir: opts.out_dir,
             script: opts.script,
             frames: 0,
+            all_frame_ms: Vec::new(),
+            still_since: None,
+            current_after: None,
             closing: false,
             dragging_divider: false,
             debug: Default::default(),
@@ -252,7 +261,7 @@ impl App {
 
     /// Script steps due before this frame.
     fn scripted_steps(&mut self) {
-        if self.script.orbit_deg != 0.0 {
+        if self.script.orbit_deg != 0.0 && self.script.orbit_frames.is_none_or(|n| self.frames < n) {
             self.camera = orbit(&self.camera, self.script.orbit_deg);
         }
         let changes: Vec<(String, String)> = self.script.changes_at(self.frames).map(|(k, v)| (k.to_string(), v.to_string())).collect();
@@ -286,8 +295,15 @@ impl App {
                 self.fail(format!("--screenshot: {e}"));
             }
         }
-        let ms = self.info.as_ref().map_or(0.0, |i| i.frame_ms);
-        println!("view: {} frames, last frame {ms:.1} ms ({})", self.frames, self.gpu.timer_name());
+        let (w, h) = self.r.size();
+        let mut ms = self.all_frame_ms.clone();
+        ms.sort_by(f64::total_cmp);
+        let median = ms.get(ms.len() / 2).copied().unwrap_or(0.0);
+        let current = match self.current_after {
+            Some((t, n)) => format!("; reference current {t:.0} ms after the camera stopped ({n} frames)"),
+            None => String::new(),
+        };
+        println!("view: {} frames at {w}x{h}, median frame {median:.1} ms ({}){current}", self.frames, self.gpu.timer_name());
         ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
     }
 
@@ -335,6 +351,8 @@ impl App {
                 while self.frame_times.front().is_some_and(|f| f[0] < t - PLOT_S) {
                     self.frame_times.pop_front();
                 }
+                self.all_frame_ms.push(info.frame_ms);
+                self.track_stillness(still, &info, changed);
                 if info.recreated {
                     self.status = "light moved: every technique and the reference were created again for it (maps, lt's history and iasm's pages are per light)".into();
                 }
@@ -347,6 +365,18 @@ impl App {
         self.prev_time = self.time;
         self.show_picture(ui, frame, picture);
         self.scripted_end(ui);
+    }
+
+    /// Measures how long after the camera stopped the reference became current.
+    fn track_stillness(&mut self, still: bool, info: &FrameInfo, changed: bool) {
+        if changed {
+            self.still_since = None;
+            return;
+        }
+        let since = *self.still_since.get_or_insert_with(|| self.last_change);
+        if still && info.reference == crate::render::RefStatus::Current && self.current_after.is_none() {
+            self.current_after = Some((since.elapsed().as_secs_f64() * 1e3, self.frames + 1));
+        }
     }
 
     fn show_picture(&mut self, ui: &egui::Ui, frame: &eframe::Frame, rect: egui::Rect) {

@@ -173,7 +173,8 @@ pub fn numbers(app: &mut App, ui: &mut egui::Ui) {
     }
     let (w, h) = app.r.size();
     if let Some(info) = &app.info {
-        ui.label(format!("{w}x{h}: frame {:.1} ms ({:.1} fps)", info.frame_ms, 1000.0 / info.frame_ms.max(1e-3)));
+        let what = if info.reused { " (still: composition only)" } else { "" };
+        ui.label(format!("{w}x{h}: frame {:.1} ms ({:.1} fps){what}", info.frame_ms, 1000.0 / info.frame_ms.max(1e-3)));
         ui.small(format!("timer: {} (G-buffer, techniques, shading, composition)", gpu.timer_name()));
         let pts: Vec<[f64; 2]> = app.frame_times.iter().copied().collect();
         Plot::new("frame_times").height(90.0).allow_drag(false).allow_zoom(false).allow_scroll(false).include_y(0.0).show(ui, |p| {
@@ -186,7 +187,7 @@ pub fn numbers(app: &mut App, ui: &mut egui::Ui) {
         };
         ui.label(status);
         if !info.stamped_ms.is_empty() {
-            stages(ui, "stages (GPU timestamps, this frame)", &info.stamped_ms);
+            stages(ui, "stages, this frame", gpu.stages_timer_name(), &info.stamped_ms);
         }
     }
     let current = app.info.as_ref().is_some_and(|i| i.reference == RefStatus::Current);
@@ -216,8 +217,11 @@ fn side(ui: &mut egui::Ui, which: &str, s: &SideEval, stages_timer: &str) {
     for d in &s.report.degraded {
         ui.colored_label(egui::Color32::from_rgb(240, 160, 40), format!("degraded: {d}"));
     }
+    for (k, v) in s.report.counters.iter().filter(|(k, _)| k.contains("rays")) {
+        ui.label(format!("{k}: {v}"));
+    }
     if !s.stages_ms.is_empty() {
-        stages(ui, &format!("stages ({stages_timer})"), &s.stages_ms);
+        stages(ui, &format!("{which} stages"), stages_timer, &s.stages_ms);
     }
     egui::CollapsingHeader::new(format!("{which} counters")).show(ui, |ui| {
         for (k, v) in &s.report.counters {
@@ -226,8 +230,9 @@ fn side(ui: &mut egui::Ui, which: &str, s: &SideEval, stages_timer: &str) {
     });
 }
 
-fn stages(ui: &mut egui::Ui, title: &str, ms: &std::collections::BTreeMap<String, f64>) {
+fn stages(ui: &mut egui::Ui, title: &str, timer: &str, ms: &std::collections::BTreeMap<String, f64>) {
     egui::CollapsingHeader::new(title).default_open(true).show(ui, |ui| {
+        ui.small(format!("timer: {timer}"));
         for (k, v) in ms {
             ui.monospace(format!("{v:8.2} ms  {k}"));
         }

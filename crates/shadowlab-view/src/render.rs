@@ -23,9 +23,9 @@ const COMPOSE_WGSL: &str = include_str!("compose.wgsl");
 /// The composed picture's format (registered with egui as a texture; read back for screenshots).
 pub const VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// The reference is traced this many pixels per frame while the camera is still (about 0.13 s
+/// The reference is traced this many pixels per frame while the camera is still (about 0.2 s
 /// per band for `rt` on lavapipe), so that the window keeps answering while it refines.
-pub const REFERENCE_BAND_PIXELS: u32 = 131_072;
+pub const REFERENCE_BAND_PIXELS: u32 = 196_608;
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![("compose.wgsl", COMPOSE_WGSL.to_string())]
@@ -89,7 +89,8 @@ pub struct SideEval {
     /// Counters, memory, degraded flags and debug pictures (after the lab-only analysis).
     pub report: TechniqueReport,
     /// Per-stage ms of one profiled frame (each stage waited for alone), on adapters without
-    /// sane timestamps; the timestamped stages of the last frame otherwise.
+    /// sane timestamps (filled in a frame after the evaluation, see [`Evaluation::profiled`]);
+    /// empty on timestamp adapters, whose every frame has its stages ([`FrameInfo::stamped_ms`]).
     pub stages_ms: BTreeMap<String, f64>,
 }
 
@@ -102,6 +103,9 @@ pub struct Evaluation {
     pub b: Option<SideEval>,
     /// Time spent tracing the reference, summed over its bands (ms, wall clock).
     pub reference_ms: f64,
+    /// Whether `stages_ms` are in: a profiled frame runs one still frame after the evaluation
+    /// (adapters without sane timestamps), so that the error view is not kept waiting for it.
+    pub profiled: bool,
 }
 
 /// Where the reference stands for the current view.
@@ -119,6 +123,8 @@ pub enum RefStatus {
 pub struct FrameInfo {
     /// The recorded frame: one submit and one wait (wall clock, ms).
     pub frame_ms: f64,
+    /// Whether the frame re-used the last live frame (still, nothing changed: composition only).
+    pub reused: bool,
     /// Per-stage GPU time from timestamps (empty on adapters without sane ones).
     pub stamped_ms: BTreeMap<String, f64>,
     pub reference: RefStatus,
@@ -209,6 +215,9 @@ pub struct Renderer<'a> {
     progress: Option<Progress>,
     eval: Option<(String, Evaluation)>,
     evals: u64,
+    /// What the live buffers hold (view, techniques): a still frame that would record the same
+    /// again only composes, so the reference refines without the live frame's cost.
+    live: Option<String>,
 }
 
 impl<'a> Renderer<'a> {
@@ -247,6 +256,7 @@ impl<'a> Renderer<'a> {
             progress: None,
             eval: None,
             evals: 0,
+            live: None,
         })
     }
 
@@ -290,6 +300,7 @@ impl<'a> Renderer<'a> {
             (true, s) => self.b = s,
         }
         self.eval = None;
+        self.live = None;
         Ok(())
     }
 
@@ -313,6 +324,7 @@ impl<'a> Renderer<'a> {
         }
         self.progress = None;
         self.eval = None;
+        self.live = None;
         Ok(())
     }
 
@@ -348,7 +360,11 @@ impl<'a> Renderer<'a> {
             Some(s) => Recorder::with_stamps(gpu, &mut enc, s),
             None => Recorder::new(gpu, &mut enc),
         };
-        let recorded = self.record_live(&mut rec, pose, look.right == Right::Technique);
+        let with_b = look.right == Right::Technique;
+        let live_key = format!("{}|{with_b}", self.eval_key(&view_key));
+        let reuse = still && self.live.as_deref() == Some(live_key.as_str());
+        let recorded = if reuse { Ok(()) } else { self.record_live(&mut rec, pose, with_b) };
+        self.live = recorded.is_ok().then_some(live_key);
         if recorded.is_ok() {
             self.record_compose(&mut rec, look, eval_current);
         }
@@ -361,7 +377,7 @@ impl<'a> Renderer<'a> {
         recorded?;
         gpu.take_error()?;
         let reference = if still { self.refine(pose, &view_key)? } else { self.status(&view_key) };
-        Ok(FrameInfo { frame_ms, stamped_ms, reference, recreated })
+        Ok(FrameInfo { frame_ms, stamped_ms, reference, recreated, reused: reuse })
     }
 
     fn status(&self, view_key: &str) -> RefStatus {
@@ -471,12 +487,41 @@ impl<'a> Renderer<'a> {
         if self.eval.as_ref().is_none_or(|(k, _)| *k != key) {
             let e = self.evaluate(pose, ms)?;
             self.eval = Some((key, e));
+        } else if self.eval.as_ref().is_some_and(|(_, e)| !e.profiled) {
+            self.profile(pose)?;
         }
         Ok(RefStatus::Current)
     }
 
+    /// One profiled frame of each technique (each stage submitted and waited for alone): the
+    /// per-stage breakdown on adapters without sane timestamps.
+    fn profile(&mut self, pose: &Pose) -> Result<(), GpuError> {
+        let gpu = self.gpu;
+        let t = &self.t;
+        let mut out = Vec::new();
+        for s in std::iter::once(&mut self.a).chain(self.b.as_mut()) {
+            let inputs = t.inputs(&self.lab, pose, &t.g, &s.vis);
+            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("view.profiled") });
+            let mut rec = Recorder::profiled(gpu, &mut enc);
+            run_frame(s.inst.tech.as_mut(), gpu, &inputs, &mut rec)?;
+            let done = rec.finish();
+            gpu.submit(enc.finish());
+            gpu.wait();
+            out.push(done.profile_ms);
+        }
+        gpu.take_error()?;
+        let (_, e) = self.eval.as_mut().expect("profiled after an evaluation");
+        let mut it = out.into_iter();
+        e.a.stages_ms = it.next().unwrap_or_default();
+        if let Some(b) = &mut e.b {
+            b.stages_ms = it.next().unwrap_or_default();
+        }
+        e.profiled = true;
+        Ok(())
+    }
+
     /// The techniques against the complete reference: error images and metrics by the lab's own
-    /// functions, then the lab-only analysis, the report and a profiled frame.
+    /// functions, then the lab-only analysis and the report.
     fn evaluate(&mut self, pose: &Pose, reference_ms: f64) -> Result<Evaluation, GpuError> {
         let gpu = self.gpu;
         let n = self.t.g.pixels();
@@ -503,24 +548,13 @@ impl<'a> Renderer<'a> {
             gpu.submit(enc.finish());
             gpu.wait();
             let report = tech.report(gpu);
-            let stages_ms = if gpu.gpu_timestamps {
-                BTreeMap::new()
-            } else {
-                let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("view.profiled") });
-                let mut rec = Recorder::profiled(gpu, &mut enc);
-                run_frame(tech, gpu, &inputs, &mut rec)?;
-                let done = rec.finish();
-                gpu.submit(enc.finish());
-                gpu.wait();
-                done.profile_ms
-            };
             gpu.take_error()?;
-            sides.push(SideEval { label: s.spec.label.clone(), metrics: compare(&v, &v_rt, &mask), error, report, stages_ms });
+            sides.push(SideEval { label: s.spec.label.clone(), metrics: compare(&v, &v_rt, &mask), error, report, stages_ms: BTreeMap::new() });
         }
         let b = if with_b { sides.pop() } else { None };
         let a = sides.pop().expect("technique A is evaluated");
         self.evals += 1;
-        Ok(Evaluation { id: self.evals, a, b, reference_ms })
+        Ok(Evaluation { id: self.evals, a, b, reference_ms, profiled: gpu.gpu_timestamps })
     }
 
     /// The composed picture of the last frame, RGBA8.

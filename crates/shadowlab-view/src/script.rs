@@ -11,6 +11,9 @@ pub struct Script {
     pub screenshot: Option<PathBuf>,
     /// Turn the camera about its target by this many degrees every frame.
     pub orbit_deg: f32,
+    /// Orbit only during the first this many frames, then hold still (measures how soon the
+    /// reference is current after the camera stops); `None`: every frame.
+    pub orbit_frames: Option<usize>,
     /// Parameter changes of technique A: (frame, key, value).
     pub set_at: Vec<(usize, String, String)>,
 }
