@@ -62,8 +62,11 @@ pub(crate) struct App {
     out_dir: std::path::PathBuf,
     script: Script,
     frames: usize,
-    /// Every frame's time (ms), for the scripted run's summary.
+    /// Every frame's time (ms), and the window's frame period (ms, frame to frame, egui and
+    /// presentation included), for the scripted run's summary.
     all_frame_ms: Vec<f64>,
+    all_period_ms: Vec<f64>,
+    last_moving: bool,
     /// When the current still period began, and how long after it the reference was current.
     still_since: Option<Instant>,
     current_after: Option<(f64, usize)>,
@@ -86,7 +89,12 @@ pub(crate) fn run(opts: Options) -> anyhow::Result<()> {
         viewport: egui::ViewportBuilder::default()
             .with_title("shadowlab view")
             .with_inner_size([w, h]),
-        wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup), ..Default::default() },
+        wgpu_options: egui_wgpu::WgpuConfiguration {
+            wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup),
+            // the frame already waits for the GPU; presenting without vsync adds no second wait
+            surface: egui_wgpu::SurfaceConfig { present_mode: wgpu::PresentMode::AutoNoVsync, desired_maximum_frame_latency: Some(1) },
+            ..Default::default()
+        },
         ..Default::default()
     };
     let fatal = Arc::new(Mutex::new(None));
@@ -150,6 +158,8 @@ impl App {
             script: opts.script,
             frames: 0,
             all_frame_ms: Vec::new(),
+            all_period_ms: Vec::new(),
+            last_moving: false,
             still_since: None,
             current_after: None,
             closing: false,
@@ -296,14 +306,22 @@ impl App {
             }
         }
         let (w, h) = self.r.size();
-        let mut ms = self.all_frame_ms.clone();
-        ms.sort_by(f64::total_cmp);
-        let median = ms.get(ms.len() / 2).copied().unwrap_or(0.0);
+        let median = |v: &[f64]| {
+            let mut v = v.to_vec();
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(0.0)
+        };
+        let (frame_ms, period_ms) = (median(&self.all_frame_ms), median(&self.all_period_ms));
         let current = match self.current_after {
             Some((t, n)) => format!("; reference current {t:.0} ms after the camera stopped ({n} frames)"),
             None => String::new(),
         };
-        println!("view: {} frames at {w}x{h}, median frame {median:.1} ms ({}){current}", self.frames, self.gpu.timer_name());
+        println!(
+            "view: {} frames at {w}x{h}, median frame {frame_ms:.1} ms ({}), median window frame period while moving {period_ms:.1} ms ({:.1} fps, egui and presentation included){current}",
+            self.frames,
+            self.gpu.timer_name(),
+            1000.0 / period_ms.max(1e-3)
+        );
         ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
     }
 
@@ -320,7 +338,12 @@ impl App {
         let scale = (avail.width() / w as f32).min(avail.height() / h as f32);
         let picture = egui::Rect::from_center_size(avail.center(), egui::vec2(w as f32 * scale, h as f32 * scale));
         let now = Instant::now();
-        let dt = now.duration_since(self.last_frame).as_secs_f32().min(0.25);
+        let period = now.duration_since(self.last_frame);
+        if self.frames > 0 && self.last_moving {
+            // frame to frame while the camera moves (still frames add reference bands)
+            self.all_period_ms.push(period.as_secs_f64() * 1e3);
+        }
+        let dt = period.as_secs_f32().min(0.25);
         self.last_frame = now;
         let input = self.fly_input(ui, &resp, picture);
         if ui.input(|i| i.key_pressed(egui::Key::R)) && !ui.ctx().egui_wants_keyboard_input() {
@@ -344,6 +367,7 @@ impl App {
         }
         let settled = pose.prev_camera == pose.camera && pose.prev_time == pose.time;
         let still = settled && if self.script.is_scripted() { !changed } else { self.last_change.elapsed().as_secs_f64() > SETTLE_S };
+        self.last_moving = changed;
         match self.r.frame(&pose, &self.look, still) {
             Ok(info) => {
                 let t = self.started.elapsed().as_secs_f64();
