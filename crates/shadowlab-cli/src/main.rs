@@ -8,6 +8,7 @@ mod listing;
 mod metrics;
 mod output;
 mod report;
+mod sweep;
 
 use std::path::PathBuf;
 
@@ -79,6 +80,8 @@ enum Command {
         #[arg(long)]
         export: bool,
     },
+    /// Sweep specs with value lists over setups: Pareto front, recommendation, resumable, shards
+    Sweep(sweep::args::SweepCli),
     /// Time every stage on the built-in scenes (and sponza/conference when present)
     Bench {
         /// Setup files to benchmark (default: the built-in scenes plus setups/sponza.toml and setups/conference.toml when their scenes exist)
@@ -126,6 +129,7 @@ fn main() {
         Command::Techniques => listing::techniques(),
         Command::Render { run, out } => compare::render(&run, &out),
         Command::Compare { run, out, export } => compare::compare(&run, &out, export),
+        Command::Sweep(cli) => sweep::main(&cli),
         Command::Bench { setup, size, frames, out } => bench::bench(&setup, &size, frames, out.as_deref()),
     };
     if let Err(e) = result {
