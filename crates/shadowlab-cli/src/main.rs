@@ -80,7 +80,7 @@ enum Command {
         #[arg(long)]
         export: bool,
     },
-    /// Sweep specs with value lists over setups: Pareto front, recommendation, resumable, shards
+    #[command(about = sweep::args::SWEEP_ABOUT, long_about = sweep::args::SWEEP_LONG)]
     Sweep(sweep::args::SweepCli),
     /// Time every stage on the built-in scenes (and sponza/conference when present)
     Bench {

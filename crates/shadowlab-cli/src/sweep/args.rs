@@ -7,9 +7,9 @@ use clap::{Args, Subcommand};
 
 use super::choose::Budget;
 
-const SWEEP_ABOUT: &str = "Sweep technique parameters over setups: quality/cost Pareto front, a recommendation for a budget";
+pub const SWEEP_ABOUT: &str = "Sweep technique parameters over setups: quality/cost Pareto front, a recommendation for a budget";
 
-const SWEEP_LONG: &str = "\
+pub const SWEEP_LONG: &str = "\
 Runs every point (setup x spec) against the reference `rt`, computed once per view (setup x frame)
 and reused by every spec. Value lists expand to their product:
   shadowlab sweep --scene courtyard --scene city -t 'sm:res=512|1024|2048,pcf=1|3' -t lt --budget-ms 20
@@ -23,7 +23,7 @@ merge DIR... --out DIR` joins the shards. See docs/sweep.md.";
 
 /// `shadowlab sweep ...` or `shadowlab sweep merge ...`.
 #[derive(Args, Debug)]
-#[command(about = SWEEP_ABOUT, long_about = SWEEP_LONG, args_conflicts_with_subcommands = true)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct SweepCli {
     #[command(subcommand)]
     pub command: Option<SweepCommand>,

@@ -58,14 +58,18 @@ pub fn svg(title: &str, cost_name: &str, points: &[Point]) -> Result<String> {
         let mut c = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 15))
             .margin(10)
-            .x_label_area_size(36)
+            .x_label_area_size(44)
             .y_label_area_size(52)
             .build_cartesian_2d(x0..x1, 0f64..ymax)
             .map_err(|e| err(&e))?;
         let x_desc = if log { format!("{cost_name} (log scale)") } else { cost_name.to_string() };
+        let bytes_axis = cost_name.contains("bytes");
         let fmt_x = |v: &f64| {
             let c = if log { 10f64.powf(*v) } else { *v };
-            if c.abs() >= 1e6 {
+            if bytes_axis && c >= 1024.0 {
+                let (d, u) = if c >= 1048576.0 { (1048576.0, "MiB") } else { (1024.0, "KiB") };
+                format!("{:.1} {u}", c / d)
+            } else if c.abs() >= 1e6 {
                 format!("{c:.2e}")
             } else if c.abs() >= 100.0 || c == c.round() {
                 format!("{c:.0}")
@@ -89,7 +93,7 @@ pub fn svg(title: &str, cost_name: &str, points: &[Point]) -> Result<String> {
             c.draw_series(std::iter::once(Circle::new((xs[i], p.wrong_pct), r, style))).map_err(|e| err(&e))?;
             c.draw_series(std::iter::once(Circle::new((xs[i], p.wrong_pct), r, if on { FRONT } else { OTHER }.stroke_width(1))))
                 .map_err(|e| err(&e))?;
-            let text = Text::new(p.label.clone(), (r + 2, -r - 2), ("sans-serif", 11).into_font().color(&BLACK.mix(0.8)));
+            let text = Text::new(p.label.clone(), (r + 3, -4), ("sans-serif", 11).into_font().color(&BLACK.mix(0.8)));
             c.draw_series(std::iter::once(EmptyElement::at((xs[i], p.wrong_pct)) + text)).map_err(|e| err(&e))?;
         }
         root.present().map_err(|e| err(&e))?;
@@ -113,7 +117,8 @@ mod tests {
         assert!(s.starts_with("<svg") && s.contains("cheap") && s.contains("good") && s.contains("bad"), "labels drawn");
         assert!(s.contains("total ms") && s.contains("wrong pixels (%)"));
         assert_eq!(s.matches("<circle").count(), 6, "a filled disc and an outline per point");
-        assert_eq!(s.matches("<polyline").count(), 1, "one front line");
+        let front_lines = s.lines().filter(|l| l.contains("<polyline") && l.contains("stroke-width=\"2\"")).count();
+        assert_eq!(front_lines, 1, "one front line");
         assert!(!log_axis(&pts) && log_axis(&[p("a", 1.0, 1.0, 1), p("b", 100.0, 1.0, 1)]));
         let s = svg("x", "shadow data (bytes)", &[p("a", 1024.0, 1.0, 1024), p("b", 16e6, 0.5, 16_000_000)]).unwrap();
         assert!(s.contains("(log scale)"));
