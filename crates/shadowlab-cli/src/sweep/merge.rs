@@ -67,6 +67,7 @@ pub fn merge(a: &MergeArgs) -> Result<()> {
     let n = rows.len();
     let sweep = assemble(header, None, rows, budget, (0, n, 0), from);
     finish(&out, &sweep)?;
+    super::warnings(&sweep);
     if !a.quiet {
         summary(&sweep);
         println!("report: {}", out.root.join("index.html").display());

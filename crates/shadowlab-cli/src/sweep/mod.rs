@@ -114,6 +114,7 @@ fn sweep(a: &SweepArgs) -> Result<()> {
     let header = Header { frames: a.frames, repeat: a.repeat, light: a.light, time: a.time, setups: infos, plan: entries };
     let sweep = assemble(header, shard, rows, budget, (computed, cached, views), Vec::new());
     finish(&dir, &sweep)?;
+    warnings(&sweep);
     if !a.quiet {
         summary(&sweep);
         println!("report: {} ({:.1} s)", dir.root.join("index.html").display(), t0.elapsed().as_secs_f64());
@@ -176,6 +177,15 @@ pub fn finish(dir: &SweepDir, sweep: &Sweep) -> Result<()> {
     dir.write("sweep.csv", record::csv(&sweep.rows).as_bytes())?;
     dir.write("index.html", report::html(sweep)?.as_bytes())?;
     Ok(())
+}
+
+/// One warning line per degraded point (a capacity limit reached), as `compare` prints them.
+pub fn warnings(s: &Sweep) {
+    for r in &s.rows {
+        for d in &r.degraded {
+            eprintln!("warning: {} / {} is degraded: {d}", r.setup, r.label);
+        }
+    }
 }
 
 /// The terminal summary: counts, the timer, the recommendation.
