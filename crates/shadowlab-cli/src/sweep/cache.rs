@@ -137,9 +137,13 @@ mod tests {
         assert!(dir.read_point("abc").is_none());
         let mut r = row("planebox", "sm", 1.0, 2.0, 3);
         r.key = "abc".into();
+        // figures whose shortest decimal form serde_json reads back a bit off without float_roundtrip
+        r.wrong_pct = 1.4845709619086507;
+        r.mae = 1.3390861128498615;
+        r.total_ms = 0.1 + 0.2;
         let p = PointFile { schema_version: SCHEMA_VERSION, key: "abc".into(), key_text: "t".into(), row: r };
         dir.write_point(&p).unwrap();
-        assert_eq!(dir.read_point("abc"), Some(p.clone()));
+        assert_eq!(dir.read_point("abc"), Some(p.clone()), "read back bit-equal");
         assert_eq!(SweepDir::all_points(&d).unwrap().len(), 1);
         // a file under another key's name is not that key's result
         std::fs::copy(dir.point_path("abc"), dir.point_path("def")).unwrap();
