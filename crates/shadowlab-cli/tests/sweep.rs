@@ -106,7 +106,10 @@ fn a_sweep_writes_its_outputs_and_a_rerun_computes_only_the_missing_point() {
     let stdout = ok(&sweep(&out, &[]));
     assert!(stdout.is_empty(), "--quiet: {stdout}");
     let again = sweep_json(&out);
-    assert_eq!((again["points_computed"].as_u64(), again["points_cached"].as_u64(), again["views_computed"].as_u64()), (Some(0), Some(3), Some(0)));
+    assert_eq!(
+        (again["points_computed"].as_u64(), again["points_cached"].as_u64(), again["views_computed"].as_u64()),
+        (Some(0), Some(3), Some(0))
+    );
     assert_eq!(again["rows"], v["rows"], "cached rows are the stored ones, times included");
 
     // an interruption: one finished point and the final files lost
@@ -114,18 +117,46 @@ fn a_sweep_writes_its_outputs_and_a_rerun_computes_only_the_missing_point() {
     std::fs::remove_file(&lost).unwrap();
     std::fs::remove_file(out.join("sweep.json")).unwrap();
     let o = run(&[
-        "sweep", "--scene", "planebox", "--size", "64x64", "-t", "sm:res=256|512", "-t", "lt", "--repeat", "1", "--out", out.to_str().unwrap(),
+        "sweep",
+        "--scene",
+        "planebox",
+        "--size",
+        "64x64",
+        "-t",
+        "sm:res=256|512",
+        "-t",
+        "lt",
+        "--repeat",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
     ]);
     let stdout = ok(&o);
     assert!(stdout.contains("1 computed, 2 cached"), "{stdout}");
     let resumed = sweep_json(&out);
-    assert_eq!((resumed["points_computed"].as_u64(), resumed["points_cached"].as_u64(), resumed["views_computed"].as_u64()), (Some(1), Some(2), Some(1)));
+    assert_eq!(
+        (resumed["points_computed"].as_u64(), resumed["points_cached"].as_u64(), resumed["views_computed"].as_u64()),
+        (Some(1), Some(2), Some(1))
+    );
     assert!(lost.is_file(), "the lost point is stored again");
     assert_eq!(rows_without_times(&resumed), rows_without_times(&v), "the recomputed point equals the lost one");
     no_partials(&out);
 
     // another size is another sweep: nothing is reused
-    ok(&run(&["sweep", "--scene", "planebox", "--size", "48x48", "-t", "sm:res=256", "--repeat", "1", "-q", "--out", out.to_str().unwrap()]));
+    ok(&run(&[
+        "sweep",
+        "--scene",
+        "planebox",
+        "--size",
+        "48x48",
+        "-t",
+        "sm:res=256",
+        "--repeat",
+        "1",
+        "-q",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
     assert_eq!(sweep_json(&out)["points_computed"], 1);
     assert_eq!(point_files(&out).len(), 4);
     std::fs::remove_dir_all(&out).unwrap();

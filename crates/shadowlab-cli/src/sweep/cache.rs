@@ -101,7 +101,8 @@ impl SweepDir {
     pub fn all_points(dir: &Path) -> Result<std::collections::BTreeMap<String, PointFile>> {
         let points = dir.join("points");
         let mut out = std::collections::BTreeMap::new();
-        let entries = std::fs::read_dir(&points).with_context(|| format!("reading {} (is {} a sweep directory?)", points.display(), dir.display()))?;
+        let entries = std::fs::read_dir(&points)
+            .with_context(|| format!("reading {} (is {} a sweep directory?)", points.display(), dir.display()))?;
         for e in entries {
             let path = e?.path();
             if path.extension().is_none_or(|x| x != "json") {

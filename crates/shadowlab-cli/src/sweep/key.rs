@@ -88,7 +88,17 @@ mod tests {
     use super::*;
 
     fn base() -> KeyInput<'static> {
-        KeyInput { binary: "b1", setup: "builtin:planebox", width: 64, height: 64, frames: 1, repeat: 3, light: 0, time: 0.0, spec: "sm:res=512 label=sm" }
+        KeyInput {
+            binary: "b1",
+            setup: "builtin:planebox",
+            width: 64,
+            height: 64,
+            frames: 1,
+            repeat: 3,
+            light: 0,
+            time: 0.0,
+            spec: "sm:res=512 label=sm",
+        }
     }
 
     #[test]

@@ -66,7 +66,8 @@ fn sweep(a: &SweepArgs) -> Result<()> {
     let binary = key::binary_version()?;
     let inputs: Vec<SetupInput> =
         a.setups.iter().map(|p| SetupInput::File(p.clone())).chain(a.scenes.iter().map(|s| SetupInput::Scene(s.clone()))).collect();
-    let common = Common { specs: &specs, size: a.size.clone(), frames: a.frames, repeat: a.repeat, light: a.light, time: a.time, binary: &binary };
+    let common =
+        Common { specs: &specs, size: a.size.clone(), frames: a.frames, repeat: a.repeat, light: a.light, time: a.time, binary: &binary };
     let setups = plan::plan(&inputs, &common)?;
     let entries = plan::entries(&setups);
     let selected: BTreeSet<usize> = plan::selected(entries.len(), shard).into_iter().collect();
@@ -144,7 +145,14 @@ fn distinct(rows: &[Row], f: impl Fn(&Row) -> &str) -> String {
 }
 
 /// sweep.json from its rows: the aggregates over the setups and the recommendation.
-pub fn assemble(h: Header, shard: Option<Shard>, rows: Vec<Row>, budget: Budget, counts: (usize, usize, usize), merged_from: Vec<String>) -> Sweep {
+pub fn assemble(
+    h: Header,
+    shard: Option<Shard>,
+    rows: Vec<Row>,
+    budget: Budget,
+    counts: (usize, usize, usize),
+    merged_from: Vec<String>,
+) -> Sweep {
     let aggregates = aggregate(&rows);
     let recommendation = recommend(&aggregates, h.setups.len(), &budget);
     Sweep {

@@ -133,7 +133,9 @@ pub fn plan(inputs: &[SetupInput], common: &Common) -> Result<Vec<SetupPlan>> {
 pub fn entries(setups: &[SetupPlan]) -> Vec<PlanEntry> {
     setups
         .iter()
-        .flat_map(|s| s.info.labels.iter().zip(&s.keys).map(|(l, (k, _))| PlanEntry { key: k.clone(), setup: s.info.name.clone(), label: l.clone() }))
+        .flat_map(|s| {
+            s.info.labels.iter().zip(&s.keys).map(|(l, (k, _))| PlanEntry { key: k.clone(), setup: s.info.name.clone(), label: l.clone() })
+        })
         .collect()
 }
 
@@ -201,7 +203,9 @@ mod tests {
         let specs = vec!["sm:res=256".to_string(), "sm:res=512".to_string()];
         // room's light 0 is a spot light: csm (directional only) is refused, naming the setup
         let csm = vec!["csm".to_string()];
-        let e = plan(&[SetupInput::Scene("planebox".into()), SetupInput::Scene("room".into())], &common(&csm)).err().expect("csm on a spot light");
+        let e = plan(&[SetupInput::Scene("planebox".into()), SetupInput::Scene("room".into())], &common(&csm))
+            .err()
+            .expect("csm on a spot light");
         assert!(e.to_string().contains("setup 'room'"), "{e}");
         let p = plan(&[SetupInput::Scene("planebox".into()), SetupInput::Scene("city".into())], &common(&specs)).unwrap();
         let e = entries(&p);

@@ -11,12 +11,17 @@ use super::scatter::{self, Point};
 
 const TEMPLATE: &str = include_str!("sweep.html.j2");
 
-/// The costs a scatter can use: an id, a title and how a row / an aggregate (mean, worst) reads it.
+/// How a row reads a cost (None: the row has none).
+type RowCost = Box<dyn Fn(&Row) -> Option<f64>>;
+/// How an aggregate reads a cost: its mean (false) or worst case (true) over the setups.
+type AggregateCost = Box<dyn Fn(&Aggregate, bool) -> Option<f64>>;
+
+/// The costs a scatter can use: an id, a title and how a row / an aggregate reads it.
 struct Cost {
     id: String,
     title: String,
-    row: Box<dyn Fn(&Row) -> Option<f64>>,
-    agg: Box<dyn Fn(&Aggregate, bool) -> Option<f64>>,
+    row: RowCost,
+    agg: AggregateCost,
 }
 
 fn costs(s: &Sweep) -> Vec<Cost> {
@@ -48,7 +53,13 @@ fn costs(s: &Sweep) -> Vec<Cost> {
 }
 
 /// Points of a view for one cost; None unless every point has the cost.
-fn points<T>(items: &[T], label: impl Fn(&T) -> String, cost: impl Fn(&T) -> Option<f64>, wrong: impl Fn(&T) -> f64, bytes: impl Fn(&T) -> u64) -> Option<Vec<Point>> {
+fn points<T>(
+    items: &[T],
+    label: impl Fn(&T) -> String,
+    cost: impl Fn(&T) -> Option<f64>,
+    wrong: impl Fn(&T) -> f64,
+    bytes: impl Fn(&T) -> u64,
+) -> Option<Vec<Point>> {
     if items.is_empty() {
         return None;
     }
@@ -76,7 +87,10 @@ pub fn recommendation_lines(s: &Sweep) -> Vec<String> {
         }
         None => v.push(format!("nothing within {budget} ({} specs ran on every setup)", r.considered)),
     }
-    v.push(format!("{} of {} specs that ran on every setup are within the budget (worst case over the setups)", r.within_budget, r.considered));
+    v.push(format!(
+        "{} of {} specs that ran on every setup are within the budget (worst case over the setups)",
+        r.within_budget, r.considered
+    ));
     if s.software_adapter && r.budget.ms.is_some() {
         v.push(SOFTWARE_NOTE.into());
     }
@@ -121,7 +135,8 @@ pub fn html(s: &Sweep) -> Result<String> {
             };
             if let Some(p) = &pts {
                 let front = pareto_front(&p.iter().map(|q| (q.cost, q.wrong_pct)).collect::<Vec<_>>());
-                fronts.push(context! { view => vid, cost => c.id, labels => front.iter().map(|&i| p[i].label.clone()).collect::<Vec<_>>() });
+                fronts
+                    .push(context! { view => vid, cost => c.id, labels => front.iter().map(|&i| p[i].label.clone()).collect::<Vec<_>>() });
             }
             plots.push(context! { view => vid, cost => c.id, svg => svg });
         }
@@ -161,7 +176,12 @@ mod tests {
 
     fn sweep(budget: Budget) -> Sweep {
         let setup = |n: &str| SetupInfo { name: n.into(), source: n.into(), scene_source: n.into(), width: 8, height: 8, labels: vec![] };
-        let mut rows = vec![row("a", "sm", 3.0, 1.0, 1024), row("a", "lt", 1.0, 4.0, 4096), row("b", "sm", 5.0, 2.0, 1024), row("b", "lt", 0.5, 9.0, 4096)];
+        let mut rows = vec![
+            row("a", "sm", 3.0, 1.0, 1024),
+            row("a", "lt", 1.0, 4.0, 4096),
+            row("b", "sm", 5.0, 2.0, 1024),
+            row("b", "lt", 0.5, 9.0, 4096),
+        ];
         for r in &mut rows {
             r.counters.insert("fetches_per_pixel".into(), 4.0);
         }

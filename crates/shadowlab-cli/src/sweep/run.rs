@@ -25,7 +25,14 @@ pub fn steps(frames: usize, pending: usize) -> u64 {
     }
 }
 
-fn row(sp: &SetupPlan, spec: usize, run: &Run, frames: &[FrameRecord], breakdown: Option<&std::collections::BTreeMap<String, f64>>, gpu: &Gpu) -> Row {
+fn row(
+    sp: &SetupPlan,
+    spec: usize,
+    run: &Run,
+    frames: &[FrameRecord],
+    breakdown: Option<&std::collections::BTreeMap<String, f64>>,
+    gpu: &Gpu,
+) -> Row {
     let m = summarize(frames);
     Row {
         setup: sp.info.name.clone(),
