@@ -234,3 +234,48 @@ fn help_lists_sweep_and_merge() {
     let m = String::from_utf8_lossy(&run(&["sweep", "merge", "--help"]).stdout).to_string();
     assert!(m.contains("--out") && m.contains("DIRS"), "{m}");
 }
+
+#[test]
+fn a_sweep_killed_mid_way_keeps_its_finished_points_and_computes_only_the_rest() {
+    if skip_gpu() {
+        return;
+    }
+    let out = tmp("kill");
+    let o = out.to_str().unwrap().to_string();
+    let args = [
+        "sweep",
+        "--scene",
+        "foliage",
+        "--size",
+        "160x160",
+        "-t",
+        "sm:res=256|512|1024|2048,pcf=1|3",
+        "--repeat",
+        "1",
+        "-q",
+        "--out",
+        o.as_str(),
+    ];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_shadowlab")).env("XDG_RUNTIME_DIR", std::env::temp_dir()).args(args).spawn().unwrap();
+    // killed (SIGKILL: no clean-up) as soon as its first point is stored
+    let t0 = std::time::Instant::now();
+    while !out.join("points").is_dir() || point_files(&out).is_empty() {
+        assert!(t0.elapsed().as_secs() < 120, "no point finished in 2 minutes");
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = child.kill();
+    child.wait().unwrap();
+    let finished = point_files(&out).iter().filter(|p| p.extension().is_some_and(|x| x == "json")).count();
+    assert!(finished >= 1);
+    let stdout = ok(&run(&args));
+    assert!(stdout.is_empty());
+    let v = sweep_json(&out);
+    assert_eq!(v["points_cached"].as_u64().unwrap() as usize, finished, "every point stored before the kill is reused");
+    assert_eq!(v["points_computed"].as_u64().unwrap() as usize, 8 - finished, "only the missing points are computed");
+    assert_eq!(v["rows"].as_array().unwrap().len(), 8);
+    no_partials(&out);
+    std::fs::remove_dir_all(&out).unwrap();
+}
