@@ -40,7 +40,9 @@ fn costs(s: &Sweep) -> Vec<Cost> {
         },
     ];
     let names: std::collections::BTreeSet<String> = s.rows.iter().flat_map(|r| r.counters.keys().cloned()).collect();
-    for n in names {
+    // offered where some view can plot it: every row of a setup has it
+    let plottable = |n: &String| s.setups.iter().any(|st| s.rows.iter().filter(|r| r.setup == st.name).all(|r| r.counters.contains_key(n)));
+    for n in names.into_iter().filter(|n| is_cost_counter(n) && plottable(n)) {
         let (a, b) = (n.clone(), n.clone());
         v.push(Cost {
             id: format!("counter-{}", crate::output::slug(&n)),
@@ -50,6 +52,15 @@ fn costs(s: &Sweep) -> Vec<Cost> {
         });
     }
     v
+}
+
+/// Counters that measure work or memory (fetches, rays, pieces, bytes, reads, texels, map
+/// renders), offered as hardware-independent costs; the others (split distances, box sizes,
+/// depth ranges) describe a result, not its cost.
+pub const COST_COUNTERS: &[&str] = &["fetch", "ray", "pieces", "bytes", "reads", "texels", "renders"];
+
+fn is_cost_counter(name: &str) -> bool {
+    COST_COUNTERS.iter().any(|c| name.contains(c)) && !name.starts_with("ray_traced_cascade")
 }
 
 /// Points of a view for one cost; None unless every point has the cost.
@@ -200,8 +211,14 @@ mod tests {
         for id in ["plot-mean-ms", "plot-worst-bytes", "plot-setup-0-ms", "plot-setup-1-counter-fetches_per_pixel"] {
             assert!(h.contains(&format!("id=\"{id}\"")), "{id}");
         }
-        // rays_traced: on one row only, so no plot of it in any view
-        assert!(h.contains("id=\"none-setup-0-counter-rays_traced\""));
+        // rays_traced: on one row only, so no view can plot it and it is not offered
+        assert!(!h.contains("counter-rays_traced"));
+        // not a cost: a split distance is not offered even where every row has it
+        let mut with_split = s.clone();
+        for r in &mut with_split.rows {
+            r.counters.insert("split_0".into(), 3.0);
+        }
+        assert!(!html(&with_split).unwrap().contains("counter-split_0"));
         assert_eq!(h.matches("<svg").count(), 4 * 3, "4 views x (ms, bytes, fetches)");
         assert!(h.contains("recommended for worst-case total &lt;= 5 ms: sm"), "lt takes 9 ms on b");
         assert!(h.contains("time on lavapipe is not your GPU"));
