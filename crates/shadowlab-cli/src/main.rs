@@ -9,6 +9,7 @@ mod metrics;
 mod output;
 mod report;
 mod view;
+mod sweep;
 
 use std::path::PathBuf;
 
@@ -82,6 +83,8 @@ enum Command {
     },
     /// Interactive viewer: fly, move the light, edit parameters live, see the error against `rt`
     View(view::ViewArgs),
+    #[command(about = sweep::args::SWEEP_ABOUT, long_about = sweep::args::SWEEP_LONG)]
+    Sweep(sweep::args::SweepCli),
     /// Time every stage on the built-in scenes (and sponza/conference when present)
     Bench {
         /// Setup files to benchmark (default: the built-in scenes plus setups/sponza.toml and setups/conference.toml when their scenes exist)
@@ -101,8 +104,9 @@ enum Command {
 
 /// Mesa's window-system code prints `error: XDG_RUNTIME_DIR is invalid or not set in the
 /// environment.` on every run where the variable is missing, which users read as shadowlab's
-/// error. shadowlab opens no window: a private runtime directory (0700, under the temporary
-/// directory) stands in for it, so that every `error:` line is shadowlab's own.
+/// error. Only `view` opens a window (through X11, which needs no runtime directory): a private
+/// runtime directory (0700, under the temporary directory) stands in for it, so that every
+/// `error:` line is shadowlab's own.
 fn ensure_runtime_dir() {
     #[cfg(unix)]
     {
@@ -130,6 +134,7 @@ fn main() {
         Command::Render { run, out } => compare::render(&run, &out),
         Command::Compare { run, out, export } => compare::compare(&run, &out, export),
         Command::View(args) => view::view(&args),
+        Command::Sweep(cli) => sweep::main(&cli),
         Command::Bench { setup, size, frames, out } => bench::bench(&setup, &size, frames, out.as_deref()),
     };
     if let Err(e) = result {
