@@ -30,6 +30,9 @@ pub struct ViewArgs {
     /// Animation time, in frames (default: the setup's `time`, else 0)
     #[arg(long)]
     pub time: Option<f32>,
+    /// What the picture shows first: shaded, visibility or error (against rt)
+    #[arg(long, default_value = "shaded", value_parser = ["shaded", "visibility", "error"])]
+    pub show: String,
     /// Directory for saved setups (F2) and screenshots (F12)
     #[arg(long, default_value = ".")]
     pub out: PathBuf,
@@ -91,6 +94,11 @@ pub fn view(args: &ViewArgs) -> Result<()> {
         size: args.size.as_ref().map(|_| (cfg.width, cfg.height)),
         time: cfg.time,
         out_dir: args.out.clone(),
+        show: match args.show.as_str() {
+            "visibility" => shadowlab_view::render::Show::Visibility,
+            "error" => shadowlab_view::render::Show::Error,
+            _ => shadowlab_view::render::Show::Shaded,
+        },
         script: shadowlab_view::script::Script {
             exit_after: args.exit_after,
             screenshot: args.screenshot.clone(),

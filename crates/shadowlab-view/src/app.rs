@@ -16,7 +16,7 @@ use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::Gpu;
 
 use crate::fly::{fly, orbit, FlyInput};
-use crate::render::{FrameInfo, Look, Pose, Renderer, Right, Show};
+use crate::render::{FrameInfo, Look, Pose, Renderer, Right};
 use crate::script::Script;
 use crate::{session, widgets, Options};
 
@@ -143,7 +143,7 @@ impl App {
             time_rate: 30.0,
             path_u: 0.0,
             play_path: false,
-            look: Look { show: Show::Shaded, right: if opts.b.is_some() { Right::Technique } else { Right::None }, divider: 0.5 },
+            look: Look { show: opts.show, right: if opts.b.is_some() { Right::Technique } else { Right::None }, divider: 0.5 },
             speed: extent * 0.15,
             fixed_size: opts.size,
             last_pose: None,

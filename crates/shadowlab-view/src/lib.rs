@@ -43,6 +43,8 @@ pub struct Options {
     /// Fixed render size; `None` follows the window.
     pub size: Option<(u32, u32)>,
     pub time: f32,
+    /// What the picture shows first.
+    pub show: render::Show,
     /// Where saved setups and screenshots go.
     pub out_dir: PathBuf,
     pub script: script::Script,

@@ -89,9 +89,9 @@ pub struct SweepArgs {
     /// Index of the light to evaluate in every setup
     #[arg(long, default_value_t = 0)]
     pub light: usize,
-    /// Animation time of frame 0, in frames
-    #[arg(long, default_value_t = 0.0)]
-    pub time: f32,
+    /// Animation time of frame 0, in frames (default: each setup's `time`, else 0)
+    #[arg(long)]
+    pub time: Option<f32>,
     /// Output directory (resumed when it holds a sweep; refused when it holds anything else)
     #[arg(long, default_value = "sweep")]
     pub out: PathBuf,

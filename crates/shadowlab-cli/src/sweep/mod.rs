@@ -55,8 +55,8 @@ fn sweep(a: &SweepArgs) -> Result<()> {
     if a.repeat == 0 {
         bail!("--repeat must be at least 1");
     }
-    if !a.time.is_finite() {
-        bail!("--time {}: must be a finite number of frames", a.time);
+    if let Some(t) = a.time.filter(|t| !t.is_finite()) {
+        bail!("--time {t}: must be a finite number of frames");
     }
     let shard = a.shard.as_deref().map(plan::parse_shard).transpose()?;
     let budget = a.budget.budget()?;
@@ -128,7 +128,8 @@ pub struct Header {
     pub frames: usize,
     pub repeat: usize,
     pub light: usize,
-    pub time: f32,
+    /// `--time`, or null: each setup's own `time`
+    pub time: Option<f32>,
     pub setups: Vec<SetupInfo>,
     pub plan: Vec<PlanEntry>,
 }

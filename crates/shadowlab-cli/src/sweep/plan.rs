@@ -28,7 +28,7 @@ pub struct Common<'a> {
     pub frames: usize,
     pub repeat: usize,
     pub light: usize,
-    pub time: f32,
+    pub time: Option<f32>,
     pub binary: &'a str,
 }
 
@@ -107,7 +107,7 @@ pub fn plan(inputs: &[SetupInput], common: &Common) -> Result<Vec<SetupPlan>> {
                     frames: common.frames,
                     repeat: common.repeat,
                     light: common.light,
-                    time: common.time,
+                    time: cfg.time,
                     spec: &spec,
                 };
                 (k.key(), k.text())
@@ -195,7 +195,7 @@ mod tests {
     }
 
     fn common<'a>(specs: &'a [String]) -> Common<'a> {
-        Common { specs, size: Some("32x32".into()), frames: 1, repeat: 1, light: 0, time: 0.0, binary: "b" }
+        Common { specs, size: Some("32x32".into()), frames: 1, repeat: 1, light: 0, time: None, binary: "b" }
     }
 
     #[test]

@@ -115,7 +115,8 @@ pub struct Sweep {
     pub frames: usize,
     pub repeat: usize,
     pub light: usize,
-    pub time: f32,
+    /// `--time`, or null: each setup's own `time`
+    pub time: Option<f32>,
     pub setups: Vec<SetupInfo>,
     /// This output's share of the plan; null for a whole sweep (or a merge).
     pub shard: Option<Shard>,
