@@ -85,6 +85,8 @@ enum Command {
     View(view::ViewArgs),
     #[command(about = sweep::args::SWEEP_ABOUT, long_about = sweep::args::SWEEP_LONG)]
     Sweep(sweep::args::SweepCli),
+    #[command(about = sweep::tune::TUNE_ABOUT, long_about = sweep::tune::TUNE_LONG)]
+    Tune(sweep::tune::TuneArgs),
     /// Time every stage on the built-in scenes (and sponza/conference when present)
     Bench {
         /// Setup files to benchmark (default: the built-in scenes plus setups/sponza.toml and setups/conference.toml when their scenes exist)
@@ -135,6 +137,7 @@ fn main() {
         Command::Compare { run, out, export } => compare::compare(&run, &out, export),
         Command::View(args) => view::view(&args),
         Command::Sweep(cli) => sweep::main(&cli),
+        Command::Tune(args) => sweep::tune::tune(&args),
         Command::Bench { setup, size, frames, out } => bench::bench(&setup, &size, frames, out.as_deref()),
     };
     if let Err(e) = result {

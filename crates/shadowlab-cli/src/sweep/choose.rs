@@ -149,14 +149,10 @@ pub struct Recommendation {
 /// How many runners-up a recommendation lists.
 pub const RUNNERS_UP: usize = 3;
 
-/// The recommendation for `budget` among the aggregates that ran on all `setups`; None
-/// without a budget.
-pub fn recommend(aggregates: &[Aggregate], setups: usize, budget: &Budget) -> Option<Recommendation> {
-    if !budget.is_set() {
-        return None;
-    }
-    let complete: Vec<&Aggregate> = aggregates.iter().filter(|a| a.setups == setups).collect();
-    let mut within: Vec<&Aggregate> = complete.iter().copied().filter(|a| budget.admits(a)).collect();
+/// The aggregates that ran on all `setups` and fit `budget` (every one when it sets no limit),
+/// best first: lowest mean wrong %, then lower worst wrong %, then cheaper, then by label.
+pub fn rank<'a>(aggregates: &'a [Aggregate], setups: usize, budget: &Budget) -> Vec<&'a Aggregate> {
+    let mut within: Vec<&Aggregate> = aggregates.iter().filter(|a| a.setups == setups && budget.admits(a)).collect();
     within.sort_by(|a, b| {
         a.mean_wrong_pct
             .total_cmp(&b.mean_wrong_pct)
@@ -165,6 +161,17 @@ pub fn recommend(aggregates: &[Aggregate], setups: usize, budget: &Budget) -> Op
             .then(a.max_shadow_data_bytes.cmp(&b.max_shadow_data_bytes))
             .then(a.label.cmp(&b.label))
     });
+    within
+}
+
+/// The recommendation for `budget` among the aggregates that ran on all `setups`; None
+/// without a budget.
+pub fn recommend(aggregates: &[Aggregate], setups: usize, budget: &Budget) -> Option<Recommendation> {
+    if !budget.is_set() {
+        return None;
+    }
+    let considered = aggregates.iter().filter(|a| a.setups == setups).count();
+    let within = rank(aggregates, setups, budget);
     let best_wrong = within.first().map(|a| a.mean_wrong_pct).unwrap_or(0.0);
     let choice = |a: &Aggregate| Choice {
         label: a.label.clone(),
@@ -176,7 +183,7 @@ pub fn recommend(aggregates: &[Aggregate], setups: usize, budget: &Budget) -> Op
     };
     Some(Recommendation {
         budget: *budget,
-        considered: complete.len(),
+        considered,
         within_budget: within.len(),
         best: within.first().map(|a| choice(a)),
         runners_up: within.iter().skip(1).take(RUNNERS_UP).map(|a| choice(a)).collect(),

@@ -17,6 +17,7 @@ mod record;
 mod report;
 mod run;
 mod scatter;
+pub mod tune;
 
 use std::collections::BTreeSet;
 
@@ -34,7 +35,7 @@ use record::{PlanEntry, PointFile, Row, SetupInfo, Shard, Sweep, SCHEMA_VERSION}
 pub fn main(cli: &SweepCli) -> Result<()> {
     match &cli.command {
         Some(SweepCommand::Merge(m)) => merge::merge(m),
-        None => sweep(&cli.run),
+        None => sweep(&cli.run).map(|_| ()),
     }
 }
 
@@ -47,7 +48,8 @@ fn progress(quiet: bool, len: u64) -> ProgressBar {
     pb
 }
 
-fn sweep(a: &SweepArgs) -> Result<()> {
+/// Runs a sweep and writes its directory; returns what sweep.json holds.
+pub fn sweep(a: &SweepArgs) -> Result<Sweep> {
     let t0 = std::time::Instant::now();
     if a.frames == 0 {
         bail!("--frames must be at least 1");
@@ -120,7 +122,7 @@ fn sweep(a: &SweepArgs) -> Result<()> {
         summary(&sweep);
         println!("report: {} ({:.1} s)", dir.root.join("index.html").display(), t0.elapsed().as_secs_f64());
     }
-    Ok(())
+    Ok(sweep)
 }
 
 /// What a sweep.json says about the plan, shared by a run and a merge.

@@ -197,7 +197,7 @@ mod tests {
             r.counters.insert("fetches_per_pixel".into(), 4.0);
         }
         rows[1].counters.insert("rays_traced".into(), 10.0);
-        let h = Header { frames: 1, repeat: 1, light: 0, time: 0.0, setups: vec![setup("a"), setup("b")], plan: vec![] };
+        let h = Header { frames: 1, repeat: 1, light: 0, time: None, setups: vec![setup("a"), setup("b")], plan: vec![] };
         assemble(h, None, rows, budget, (4, 0, 2), vec![])
     }
 
