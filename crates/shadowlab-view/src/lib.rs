@@ -10,10 +10,9 @@
 //! - [`fly`]: camera and light motion, pure.
 //! - [`session`]: the saved setup and screenshots.
 //! - [`script`]: scripted runs (`--exit-after`, `--orbit`, `--set-at`).
-//! - `app`: the window.
+//! - `app`: the window (its state, its panels).
 
 mod app;
-mod app_panels;
 pub mod fly;
 pub mod render;
 pub mod script;

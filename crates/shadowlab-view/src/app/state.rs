@@ -1,6 +1,6 @@
-//! The window: eframe (winit + egui-wgpu) on shadowlab's device. Each egui frame moves the
-//! camera from the input, renders one frame with [`Renderer::frame`] and shows its picture;
-//! the panels are in [`crate::app_panels`].
+//! The viewer's state: camera, light, time, techniques and what is shown; each egui frame
+//! moves the camera from the input, renders one frame with [`Renderer::frame`] and shows its
+//! picture ([`App::central`]).
 
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
@@ -8,7 +8,6 @@ use std::time::Instant;
 
 use anyhow::anyhow;
 use eframe::egui;
-use eframe::egui_wgpu;
 use shadowlab_core::camera::{path_cameras, Camera, CameraKey};
 use shadowlab_core::light::Light;
 use shadowlab_core::setup::Setup;
@@ -26,6 +25,18 @@ const SETTLE_S: f64 = 0.15;
 const PLOT_S: f64 = 10.0;
 /// Mouse look, radians per point dragged.
 const LOOK_PER_POINT: f32 = 0.005;
+
+pub const CONTROLS_W: f32 = 300.0;
+pub const HUD_W: f32 = 300.0;
+
+/// The debug pictures of the current evaluation, as egui textures.
+#[derive(Default)]
+pub struct DebugPictures {
+    /// Which evaluation they belong to ([`crate::render::Evaluation::id`]).
+    pub key: Option<u64>,
+    pub textures: Vec<(String, egui::TextureHandle)>,
+    pub pick: usize,
+}
 
 pub(crate) struct App {
     pub r: Renderer<'static>,
@@ -71,52 +82,15 @@ pub(crate) struct App {
     still_since: Option<Instant>,
     current_after: Option<(f64, usize)>,
     /// A scripted run has asked the window to close.
-    closing: bool,
+    pub closing: bool,
     dragging_divider: bool,
-    pub debug: crate::app_panels::DebugPictures,
+    pub debug: DebugPictures,
     /// A scripted run's failure, returned by [`run`] once the window is closed.
     fatal: Arc<Mutex<Option<String>>>,
 }
 
-pub(crate) fn run(opts: Options) -> anyhow::Result<()> {
-    let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
-    // shadowlab's own device: every adapter limit, timestamps where offered
-    setup.device_descriptor = Arc::new(|adapter| Gpu::device_descriptor(adapter));
-    setup.instance_descriptor.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
-    // the window: the fixed render size plus the panels, else 1600x900
-    let (w, h) = opts.size.map_or((1600.0, 900.0), |(w, h)| (w as f32 + crate::app_panels::CONTROLS_W + crate::app_panels::HUD_W + 24.0, h as f32 + 16.0));
-    let native = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_title("shadowlab view")
-            .with_inner_size([w, h]),
-        wgpu_options: egui_wgpu::WgpuConfiguration {
-            wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup),
-            // the frame already waits for the GPU; presenting without vsync adds no second wait
-            surface: egui_wgpu::SurfaceConfig { present_mode: wgpu::PresentMode::AutoNoVsync, desired_maximum_frame_latency: Some(1) },
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    let fatal = Arc::new(Mutex::new(None));
-    let fatal_app = fatal.clone();
-    eframe::run_native(
-        "shadowlab view",
-        native,
-        Box::new(move |cc| {
-            let app = App::new(cc, opts, fatal_app).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.to_string().into() })?;
-            Ok(Box::new(app))
-        }),
-    )
-    .map_err(|e| anyhow!("the viewer could not run: {e} (a window needs a display: run it in a desktop session, or under Xvfb: xvfb-run -a shadowlab view ...)"))?;
-    let failed = fatal.lock().expect("not poisoned").take();
-    match failed {
-        Some(e) => Err(anyhow!(e)),
-        None => Ok(()),
-    }
-}
-
 impl App {
-    fn new(cc: &eframe::CreationContext, opts: Options, fatal: Arc<Mutex<Option<String>>>) -> anyhow::Result<App> {
+    pub fn new(cc: &eframe::CreationContext, opts: Options, fatal: Arc<Mutex<Option<String>>>) -> anyhow::Result<App> {
         let rs = cc.wgpu_render_state.as_ref().ok_or_else(|| anyhow!("eframe started without wgpu"))?;
         let gpu: &'static Gpu = Box::leak(Box::new(Gpu::from_device(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info())?));
         let scene = Box::leak(Box::new(opts.scene));
@@ -326,7 +300,7 @@ impl App {
     }
 
     /// Moves, renders and shows one frame in the central panel.
-    fn central(&mut self, ui: &mut egui::Ui, frame: &eframe::Frame) {
+    pub fn central(&mut self, ui: &mut egui::Ui, frame: &eframe::Frame) {
         let avail = ui.available_rect_before_wrap();
         let resp = ui.allocate_rect(avail, egui::Sense::click_and_drag());
         let ppp = ui.ctx().pixels_per_point();
@@ -428,24 +402,3 @@ impl App {
     }
 }
 
-impl eframe::App for App {
-    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
-        if self.closing {
-            return;
-        }
-        if ui.input(|i| i.key_pressed(egui::Key::F2)) {
-            self.save_setup();
-        }
-        if ui.input(|i| i.key_pressed(egui::Key::F12)) {
-            self.save_screenshot();
-        }
-        egui::Panel::left("controls").resizable(true).default_size(crate::app_panels::CONTROLS_W).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| crate::app_panels::controls(self, ui));
-        });
-        egui::Panel::right("numbers").resizable(true).default_size(crate::app_panels::HUD_W).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| crate::app_panels::numbers(self, ui));
-        });
-        egui::CentralPanel::default().show(ui, |ui| self.central(ui, frame));
-        ui.ctx().request_repaint();
-    }
-}

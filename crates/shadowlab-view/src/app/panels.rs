@@ -7,22 +7,10 @@ use egui_plot::{Line, Plot, PlotPoints};
 use shadowlab_core::light::Light;
 use shadowlab_gpu::registry::REGISTRY;
 
-use crate::app::App;
+use super::state::App;
 use crate::fly::{sun_angles, sun_direction};
 use crate::render::{RefStatus, Right, SideEval, Show};
 use crate::widgets;
-
-pub const CONTROLS_W: f32 = 300.0;
-pub const HUD_W: f32 = 300.0;
-
-/// The debug pictures of the current evaluation, as egui textures.
-#[derive(Default)]
-pub struct DebugPictures {
-    /// Which evaluation they belong to ([`crate::render::Evaluation::id`]).
-    key: Option<u64>,
-    textures: Vec<(String, egui::TextureHandle)>,
-    pick: usize,
-}
 
 pub fn controls(app: &mut App, ui: &mut egui::Ui) {
     ui.heading("shadowlab view");
