@@ -67,6 +67,12 @@ pub fn flip_rgba8(reference: &[u8], test: &[u8], width: u32, height: u32) -> Fli
     flip_computed(reference, test, width, height)
 }
 
+/// [`flip_rgba8`] of each of `tests` against the one `reference`, in parallel (rayon), in order.
+pub fn flip_each(reference: &[u8], tests: &[&[u8]], width: u32, height: u32) -> Vec<FlipMap> {
+    use rayon::prelude::*;
+    tests.par_iter().map(|t| flip_rgba8(reference, t, width, height)).collect()
+}
+
 /// [`flip_rgba8`] always through the reference implementation (no shortcut for equal images).
 pub fn flip_computed(reference: &[u8], test: &[u8], width: u32, height: u32) -> FlipMap {
     let n = width as usize * height as usize;
@@ -99,6 +105,11 @@ mod tests {
         let img: Vec<u8> = (0..w * h * 4).map(|i| (i * 37 % 251) as u8).collect();
         assert!(flip_computed(&img, &img, w, h).values.iter().all(|&v| v == 0.0), "the reference gives 0 itself");
         assert_eq!(flip_rgba8(&img, &img, w, h).mean(), 0.0);
+        let other: Vec<u8> = img.iter().map(|v| v / 2).collect();
+        let each = flip_each(&img, &[&img, &other], w, h);
+        assert_eq!(each[0].mean(), 0.0);
+        assert_eq!(each[1], flip_rgba8(&img, &other, w, h));
+        assert!(each[1].mean() > 0.05);
     }
 
     /// Uniform images have no edges or points (FLIP's feature term is 0), and the spatial
