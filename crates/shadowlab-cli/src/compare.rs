@@ -68,14 +68,20 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         for (file, split) in [(format!("{s}-error.png"), false), (format!("{s}-error-split.png"), true)] {
             export::png(&dir.path(&file), w, h, &error_image(&rt.shaded, &run.visibility, &rt.visibility, &view.mask, split))?;
         }
+        export::png(&dir.path(&format!("{s}-flip.png")), w, h, &t.last_flip.magma_rgba())?;
         let mut extra = Vec::new();
         for (k, img) in run.report.images.iter().enumerate() {
             let file = format!("{s}-extra{k}.png");
             export::png(&dir.path(&file), img.width, img.height, &img.rgba)?;
             extra.push(ExtraImage { name: img.name.clone(), file });
         }
-        let images =
-            Images { shaded: format!("{s}.png"), error: format!("{s}-error.png"), error_split: format!("{s}-error-split.png"), extra };
+        let images = Images {
+            shaded: format!("{s}.png"),
+            error: format!("{s}-error.png"),
+            error_split: format!("{s}-error-split.png"),
+            flip: format!("{s}-flip.png"),
+            extra,
+        };
         techniques.push(technique(t, gpu.gpu_timestamps, images, export_raw.then(|| format!("visibility/{s}.npy"))));
     }
     let metrics = Metrics {
@@ -152,6 +158,7 @@ fn technique(t: &TechniqueFrames, gpu_timestamps: bool, images: Images, visibili
         false_lit_pct: m.false_lit_pct,
         false_shadow_pct: m.false_shadow_pct,
         mae: m.mae,
+        flip_mean: m.flip_mean,
         evaluated_pixels: m.evaluated_pixels,
         flicker_pct: m.flicker_pct,
         shadow_data_bytes: run.report.shadow_data_bytes,

@@ -116,6 +116,40 @@ fn compare_writes_report_metrics_and_exports() {
 }
 
 #[test]
+fn flip_is_zero_where_the_shading_agrees_with_rt_and_positive_where_not() {
+    if skip_gpu() {
+        return;
+    }
+    let out = tmp("flip");
+    // rt against itself; sv agrees with rt on planebox; sm with a 64x64 map does not
+    let o = run(&["compare", "-q", "--scene", "planebox", "--size", "96x64", "-t", "rt", "-t", "sv", "-t", "sm:res=64", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    let t = m["techniques"].as_array().unwrap();
+    let flip = |i: usize| t[i]["flip_mean"].as_f64().unwrap_or_else(|| panic!("{} has no flip_mean", t[i]["label"]));
+    assert_eq!(flip(0), 0.0, "rt against rt");
+    assert!(flip(1) < 1e-3, "sv: {}", flip(1));
+    if t[1]["mae"].as_f64().unwrap() == 0.0 {
+        assert_eq!(flip(1), 0.0, "sv's visibility equals rt's: the same image");
+    }
+    assert!(t[2]["wrong_pct"].as_f64().unwrap() > 0.0, "sm:res=64 has wrong pixels");
+    assert!(flip(2) > 1e-4 && flip(2) < 0.5, "sm:res=64: {}", flip(2));
+    for (i, slug) in ["rt", "sv", "sm_res_64"].iter().enumerate() {
+        let file = t[i]["images"]["flip"].as_str().unwrap();
+        assert_eq!(file, format!("{slug}-flip.png"));
+        let img = image::open(out.join(file)).unwrap().into_rgb8();
+        assert_eq!(img.dimensions(), (96, 64));
+        let black = img.pixels().all(|p| p.0 == [0, 0, 4]);
+        assert_eq!(black, flip(i) == 0.0, "{file}: magma's black exactly where there is no error");
+    }
+    let csv = std::fs::read_to_string(out.join("metrics.csv")).unwrap();
+    assert!(csv.starts_with("label,technique,wrong_pct,false_lit_pct,false_shadow_pct,mae,flip_mean,"), "{csv}");
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("<th>wrong %</th><th>FLIP&dagger;</th>") && html.contains("src=\"sm_res_64-flip.png\""));
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
 fn a_scene_file_loads_without_a_setup() {
     if skip_gpu() {
         return;
@@ -185,6 +219,11 @@ fn frames_follow_the_camera_path_with_per_frame_metrics() {
         assert!((t["wrong_pct"].as_f64().unwrap() - mean).abs() < 1e-9, "top-level wrong % is the mean over frames");
         let fl = fr[1..].iter().map(|f| f["flicker_pct"].as_f64().unwrap()).sum::<f64>() / 3.0;
         assert!((t["flicker_pct"].as_f64().unwrap() - fl).abs() < 1e-9);
+        let flip = fr.iter().map(|f| f["flip_mean"].as_f64().unwrap()).sum::<f64>() / 4.0;
+        assert!((t["flip_mean"].as_f64().unwrap() - flip).abs() < 1e-12, "top-level FLIP is the mean over frames");
+        for f in fr.iter().filter(|f| f["wrong_pct"].as_f64().unwrap() > 0.0) {
+            assert!(f["flip_mean"].as_f64().unwrap() > 0.0, "wrong pixels are seen by FLIP too: {f}");
+        }
         assert!(fr.iter().any(|f| f["wrong_pct"] != fr[0]["wrong_pct"]), "frames differ");
     }
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();

@@ -61,6 +61,12 @@ fn written_metrics_match_the_schema_and_the_schema_is_strict() {
     let mut mistyped = m.clone();
     mistyped["reference"]["frames"][1]["edge_pixels"] = "12".into();
     assert!(!validator.is_valid(&mistyped), "a string for a count must fail");
+    let mut no_flip = m.clone();
+    no_flip["techniques"][0].as_object_mut().unwrap().remove("flip_mean");
+    assert!(!validator.is_valid(&no_flip), "flip_mean is required");
+    let mut bad_flip = m.clone();
+    bad_flip["techniques"][0]["frames"][0]["flip_mean"] = 1.5.into();
+    assert!(!validator.is_valid(&bad_flip), "FLIP is in [0, 1]");
     let mut unknown = m.clone();
     unknown["bvh"]["leaves"] = 3.into();
     assert!(!validator.is_valid(&unknown), "an unknown field must fail");
@@ -86,5 +92,9 @@ fn written_metrics_read_back_into_the_typed_record_unchanged() {
     assert_eq!(typed.techniques.len(), 3);
     assert_eq!(typed.techniques[1].label, "soft");
     assert!(typed.techniques.iter().all(|t| t.frames.len() == 2 && t.visibility_npy.is_some()));
+    for t in &typed.techniques {
+        assert!((0.0..=1.0).contains(&t.flip_mean) && t.images.flip == format!("{}-flip.png", t.label.replace([':', '=', ','], "_")));
+        assert!(t.frames.iter().all(|f| (0.0..=1.0).contains(&f.flip_mean)));
+    }
     assert_eq!(typed.to_json().unwrap(), text, "writing the record read back gives the same text");
 }

@@ -76,7 +76,7 @@ fn a_sweep_writes_its_outputs_and_a_rerun_computes_only_the_missing_point() {
     let out = tmp("resume");
     ok(&sweep(&out, &["--budget-bytes", "1048576"]));
     let v = sweep_json(&out);
-    assert_eq!(v["schema_version"], 1);
+    assert_eq!(v["schema_version"], 2);
     assert_eq!((v["points_computed"].as_u64(), v["points_cached"].as_u64()), (Some(3), Some(0)));
     assert_eq!(v["views_computed"], 1, "one G-buffer + reference for the three points");
     let rows = v["rows"].as_array().unwrap();
@@ -88,6 +88,14 @@ fn a_sweep_writes_its_outputs_and_a_rerun_computes_only_the_missing_point() {
         assert_eq!(r["setup"], "planebox");
         assert!(r["evaluated_pixels"].as_u64().unwrap() > 1000 && r["total_ms"].as_f64().unwrap() > 0.0);
         assert!(r["wrong_pct"].as_f64().unwrap() < 5.0, "planebox has an exact shadow: {r}");
+        let flip = r["flip_mean"].as_f64().expect("every row has flip_mean");
+        assert!((0.0..0.2).contains(&flip), "{r}");
+        if r["wrong_pct"].as_f64().unwrap() > 0.0 {
+            assert!(flip > 0.0, "wrong pixels are seen by FLIP: {r}");
+        }
+        if r["mae"].as_f64().unwrap() == 0.0 {
+            assert_eq!(flip, 0.0, "the same visibility, the same image: {r}");
+        }
     }
     assert!(v["timer"].as_str().unwrap().len() > 5 && v["stages_timer"].is_string() && v["adapter"].is_string());
     // --budget-bytes 1 MiB: lt's maps do not fit; the better sm does
@@ -97,8 +105,10 @@ fn a_sweep_writes_its_outputs_and_a_rerun_computes_only_the_missing_point() {
     let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
     assert_eq!(csv.lines().count(), 4);
     assert!(csv.lines().nth(2).unwrap().starts_with("planebox,sm:res=512,sm,"));
+    assert!(csv.starts_with("setup,label,technique,wrong_pct,false_lit_pct,false_shadow_pct,mae,flip_mean,"), "{csv}");
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(html.contains("<svg") && html.contains("Pareto front") && html.contains("recommended for shadow data"));
+    assert!(html.contains("id=\"quality\"") && html.contains("id=\"plot-setup-0-flip-ms\""), "FLIP is offered as the quality");
     assert_eq!(point_files(&out).len(), 3);
     no_partials(&out);
 

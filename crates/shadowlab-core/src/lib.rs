@@ -6,6 +6,7 @@ pub mod anim;
 pub mod builtin;
 pub mod bvh;
 pub mod camera;
+pub mod flip;
 pub mod light;
 pub mod lightspace;
 pub mod loaders;

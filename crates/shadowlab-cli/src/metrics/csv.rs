@@ -13,6 +13,7 @@ pub const COLUMNS: &[Column] = &[
     ("false_lit_pct", |t| cell(t.false_lit_pct)),
     ("false_shadow_pct", |t| cell(t.false_shadow_pct)),
     ("mae", |t| cell(t.mae)),
+    ("flip_mean", |t| cell(t.flip_mean)),
     ("flicker_pct", |t| cell(t.flicker_pct)),
     ("evaluated_pixels", |t| cell(t.evaluated_pixels)),
     ("shadow_data_bytes", |t| cell(t.shadow_data_bytes)),
@@ -49,9 +50,9 @@ mod tests {
         let lines: Vec<&str> = s.lines().collect();
         assert_eq!(
             lines[0],
-            "label,technique,wrong_pct,false_lit_pct,false_shadow_pct,mae,flicker_pct,evaluated_pixels,shadow_data_bytes,total_ms,fetches_per_pixel,rays_traced"
+            "label,technique,wrong_pct,false_lit_pct,false_shadow_pct,mae,flip_mean,flicker_pct,evaluated_pixels,shadow_data_bytes,total_ms,fetches_per_pixel,rays_traced"
         );
-        assert_eq!(lines[1], "\"sm:pcf=3\",sm,1.25,0.5,0.75,0.01,,10,1048576,3.0,9.0,");
+        assert_eq!(lines[1], "\"sm:pcf=3\",sm,1.25,0.5,0.75,0.01,0.0625,,10,1048576,3.0,9.0,");
         assert!(lines[2].starts_with("\"say \"\"hi\"\"\",sm,"), "{}", lines[2]);
         assert_eq!(lines.len(), 3);
     }

@@ -22,7 +22,8 @@ pub use text::{summary, warnings};
 /// Version of metrics.json's layout (also in the output marker, [`crate::output::MARKER`]):
 /// raised when a field is renamed, removed or changes meaning; added fields raise it too, since
 /// the schema is strict.
-pub const SCHEMA_VERSION: u32 = 1;
+/// 2: `flip_mean` per technique and frame, `images.flip`.
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// Milliseconds per named stage (`<technique>.<stage>`).
 pub type StagesMs = BTreeMap<String, f64>;
@@ -130,6 +131,8 @@ pub struct Technique {
     pub false_lit_pct: f64,
     pub false_shadow_pct: f64,
     pub mae: f64,
+    /// Mean FLIP (LDR) of the shaded image against `rt`'s, over all pixels; mean over frames.
+    pub flip_mean: f64,
     pub evaluated_pixels: u64,
     pub flicker_pct: Option<f64>,
     pub shadow_data_bytes: u64,
@@ -155,6 +158,8 @@ pub struct Images {
     pub shaded: String,
     pub error: String,
     pub error_split: String,
+    /// The last frame's FLIP error map against `rt` (magma colour map).
+    pub flip: String,
     pub extra: Vec<ExtraImage>,
 }
 

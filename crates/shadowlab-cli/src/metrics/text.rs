@@ -14,12 +14,18 @@ pub fn warnings(m: &Metrics) {
 pub fn summary(m: &Metrics) {
     let light = m.light().map(|l| l.kind()).unwrap_or("?");
     println!("{} ({} triangles), {}x{}, light {} ({}), {}", m.scene, m.triangles, m.width, m.height, m.light_index, light, m.adapter);
-    println!("{:<28} {:>8} {:>9} {:>9} {:>8} {:>10} {:>12}", "technique", "wrong%", "f-lit%", "f-shad%", "mae", "ms", "bytes");
-    println!("{:<28} {:>8} {:>9} {:>9} {:>8} {:>10.2} {:>12}", "rt (reference)", "-", "-", "-", "-", m.reference.total_ms, m.bvh.bytes);
+    println!(
+        "{:<28} {:>8} {:>9} {:>9} {:>8} {:>7} {:>10} {:>12}",
+        "technique", "wrong%", "f-lit%", "f-shad%", "mae", "FLIP", "ms", "bytes"
+    );
+    println!(
+        "{:<28} {:>8} {:>9} {:>9} {:>8} {:>7} {:>10.2} {:>12}",
+        "rt (reference)", "-", "-", "-", "-", "-", m.reference.total_ms, m.bvh.bytes
+    );
     for t in &m.techniques {
         println!(
-            "{:<28} {:>8.3} {:>9.3} {:>9.3} {:>8.4} {:>10.2} {:>12}",
-            t.label, t.wrong_pct, t.false_lit_pct, t.false_shadow_pct, t.mae, t.total_ms, t.shadow_data_bytes
+            "{:<28} {:>8.3} {:>9.3} {:>9.3} {:>8.4} {:>7.4} {:>10.2} {:>12}",
+            t.label, t.wrong_pct, t.false_lit_pct, t.false_shadow_pct, t.mae, t.flip_mean, t.total_ms, t.shadow_data_bytes
         );
     }
     println!("times: median of {} frames, {}", m.repeat, m.timer);

@@ -48,6 +48,8 @@ mod tests {
         assert!(h.contains("sm:pcf=3") && h.contains("1.250") && h.contains("1.00 MiB") && h.contains("b.png"));
         assert!(h.contains("res=512<") || h.contains("res=512,") || h.contains("res=512 "), "parameters print as whole numbers");
         assert!(h.contains("<td>9</td>"), "fetches print as whole numbers");
+        assert!(h.contains("<td>1.250</td><td>0.0625</td>"), "FLIP sits beside wrong %");
+        assert!(h.contains("src=\"d.png\" alt=\"FLIP\""), "the FLIP map is shown with the other images");
         assert!(!h.contains("http://") && !h.contains("https://"), "report must work offline");
         assert!(!h.contains("moving"), "a still scene says nothing about moving objects");
         let mut moving = m.clone();

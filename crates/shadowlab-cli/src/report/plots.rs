@@ -13,6 +13,7 @@ type Chart = (&'static str, fn(&FrameRecord) -> Option<f64>);
 /// The per-frame figures charted.
 pub const CHARTS: &[Chart] = &[
     ("wrong pixels (%)", |r| Some(r.wrong_pct)),
+    ("FLIP (mean)", |r| Some(r.flip_mean)),
     ("flicker vs previous frame (%)", |r| r.flicker_pct),
     ("rays traced", |r| r.rays_traced),
     ("time (ms)", |r| Some(r.total_ms)),
@@ -89,7 +90,7 @@ mod tests {
         let m = sample::metrics(3);
         let charts = frame_charts(&m).unwrap();
         let titles: Vec<&str> = charts.iter().map(|c| c.0.as_str()).collect();
-        assert_eq!(titles, ["wrong pixels (%)", "flicker vs previous frame (%)", "time (ms)"], "no rays: no ray chart");
+        assert_eq!(titles, ["wrong pixels (%)", "FLIP (mean)", "flicker vs previous frame (%)", "time (ms)"], "no rays: no ray chart");
         let svg = &charts[0].1;
         assert!(svg.starts_with("<svg") && svg.contains("vsm:blur=5") && svg.contains("sm"));
         let lines = svg.lines().filter(|l| l.contains("<polyline") && l.contains("stroke-width=\"2\"")).count();

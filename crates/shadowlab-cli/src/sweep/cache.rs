@@ -109,10 +109,12 @@ impl SweepDir {
                 continue;
             }
             let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-            let p: PointFile = serde_json::from_str(&text).with_context(|| format!("{} is not a sweep point", path.display()))?;
-            if p.schema_version != SCHEMA_VERSION {
-                bail!("{}: schema_version {} (this shadowlab reads {SCHEMA_VERSION})", path.display(), p.schema_version);
+            // the version first: an older layout (e.g. without flip_mean) is named as such
+            let v: serde_json::Value = serde_json::from_str(&text).with_context(|| format!("{} is not a sweep point", path.display()))?;
+            if let Some(other) = v.get("schema_version").and_then(|x| x.as_u64()).filter(|&x| x != SCHEMA_VERSION as u64) {
+                bail!("{}: schema_version {other} (this shadowlab reads {SCHEMA_VERSION}; rerun that shard)", path.display());
             }
+            let p: PointFile = serde_json::from_value(v).with_context(|| format!("{} is not a sweep point", path.display()))?;
             out.insert(p.key.clone(), p);
         }
         Ok(out)
@@ -157,6 +159,21 @@ mod tests {
         let again = SweepDir::open(&d).unwrap();
         assert!(!stale.exists());
         assert_eq!(again.read_point("abc"), Some(p));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_point_written_before_flip_is_computed_again_and_not_merged() {
+        let d = root("preflip");
+        let dir = SweepDir::open(&d).unwrap();
+        let mut r = row("planebox", "sm", 1.0, 2.0, 3);
+        r.key = "old".into();
+        let mut v = serde_json::to_value(PointFile { schema_version: 1, key: "old".into(), key_text: "t".into(), row: r }).unwrap();
+        v["row"].as_object_mut().unwrap().remove("flip_mean");
+        std::fs::write(dir.point_path("old"), serde_json::to_string(&v).unwrap()).unwrap();
+        assert!(dir.read_point("old").is_none(), "no flip_mean: computed again");
+        let e = SweepDir::all_points(&d).unwrap_err().to_string();
+        assert!(e.contains("schema_version 1 (this shadowlab reads 2"), "{e}");
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -17,6 +17,9 @@ pub struct Aggregate {
     pub setups: usize,
     pub mean_wrong_pct: f64,
     pub worst_wrong_pct: f64,
+    /// Mean and worst (largest) over the setups of the rows' `flip_mean`.
+    pub mean_flip_mean: f64,
+    pub worst_flip_mean: f64,
     pub mean_total_ms: f64,
     pub worst_total_ms: f64,
     /// The largest shadow data over the setups.
@@ -50,6 +53,8 @@ pub fn aggregate(rows: &[Row]) -> Vec<Aggregate> {
                 setups: g.len(),
                 mean_wrong_pct: mean(&|r| r.wrong_pct),
                 worst_wrong_pct: worst(&|r| r.wrong_pct),
+                mean_flip_mean: mean(&|r| r.flip_mean),
+                worst_flip_mean: worst(&|r| r.flip_mean),
                 mean_total_ms: mean(&|r| r.total_ms),
                 worst_total_ms: worst(&|r| r.total_ms),
                 max_shadow_data_bytes: g.iter().map(|r| r.shadow_data_bytes).max().unwrap_or(0),
@@ -206,6 +211,7 @@ mod tests {
         assert_eq!(a.len(), 2);
         assert_eq!((a[0].label.as_str(), a[0].setups), ("sm", 2));
         assert_eq!((a[0].mean_wrong_pct, a[0].worst_wrong_pct), (3.0, 4.0));
+        assert!((a[0].mean_flip_mean - 0.15).abs() < 1e-12 && (a[0].worst_flip_mean - 0.2).abs() < 1e-12, "FLIP: mean and worst");
         assert_eq!((a[0].mean_total_ms, a[0].worst_total_ms, a[0].max_shadow_data_bytes), (15.0, 20.0, 300));
         assert_eq!(a[0].mean_counters, BTreeMap::from([("fetches_per_pixel".to_string(), 2.0)]), "only counters every row has");
         assert_eq!(a[0].worst_counters["fetches_per_pixel"], 3.0);

@@ -10,8 +10,10 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
 
-/// Raised when the key text's layout changes (old cache entries then never match).
-const KEY_VERSION: u32 = 1;
+/// Raised when the key text's layout or what a point holds changes (old cache entries then
+/// never match and are computed again). 2: points carry `flip_mean`; a point file written
+/// before it (schema 1) is never looked up, let alone misread.
+const KEY_VERSION: u32 = 2;
 
 fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()

@@ -10,7 +10,8 @@ use shadowlab_core::params::ParamValues;
 use super::choose::{Aggregate, Budget, Recommendation};
 
 /// Version of sweep.json's and the point files' layout; raised with any change to it.
-pub const SCHEMA_VERSION: u32 = 1;
+/// 2: `flip_mean` in rows, `mean_flip_mean`/`worst_flip_mean` in aggregates.
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// One (spec, setup) result.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -28,6 +29,8 @@ pub struct Row {
     pub false_lit_pct: f64,
     pub false_shadow_pct: f64,
     pub mae: f64,
+    /// Mean FLIP (LDR) of the shaded image against `rt`'s, over all pixels; mean over frames.
+    pub flip_mean: f64,
     /// Mean over consecutive frames; null with one frame.
     pub flicker_pct: Option<f64>,
     pub evaluated_pixels: u64,
@@ -177,6 +180,7 @@ pub fn csv(rows: &[Row]) -> String {
         "false_lit_pct",
         "false_shadow_pct",
         "mae",
+        "flip_mean",
         "flicker_pct",
         "evaluated_pixels",
         "total_ms",
@@ -202,6 +206,7 @@ pub fn csv(rows: &[Row]) -> String {
             num(r.false_lit_pct),
             num(r.false_shadow_pct),
             num(r.mae),
+            num(r.flip_mean),
             r.flicker_pct.map(num).unwrap_or_default(),
             r.evaluated_pixels.to_string(),
             num(r.total_ms),
@@ -236,6 +241,7 @@ pub mod tests {
             false_lit_pct: wrong / 2.0,
             false_shadow_pct: wrong / 2.0,
             mae: wrong / 100.0,
+            flip_mean: wrong / 20.0,
             flicker_pct: None,
             evaluated_pixels: 100,
             total_ms: ms,
@@ -265,9 +271,9 @@ pub mod tests {
         let s = csv(&[a, b]);
         let lines: Vec<&str> = s.lines().collect();
         assert_eq!(lines.len(), 3);
-        assert!(lines[0].starts_with("setup,label,technique,wrong_pct,"));
+        assert!(lines[0].starts_with("setup,label,technique,wrong_pct,false_lit_pct,false_shadow_pct,mae,flip_mean,flicker_pct,"));
         assert!(lines[0].ends_with(",counter.fetches_per_pixel,counter.rays_traced,stage_ms.sm.render"), "{}", lines[0]);
-        assert!(lines[1].starts_with("room,\"sm:res=512,pcf=3\",sm,1.5,"), "{}", lines[1]);
+        assert!(lines[1].starts_with("room,\"sm:res=512,pcf=3\",sm,1.5,0.75,0.75,0.015,0.075,,"), "{}", lines[1]);
         assert!(lines[1].ends_with(",9,,0.5"), "{}", lines[1]);
         assert!(lines[2].contains(",\"x, y\",") && lines[2].ends_with(",,10,"), "{}", lines[2]);
     }

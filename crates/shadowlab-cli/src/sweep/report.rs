@@ -1,6 +1,7 @@
-//! The sweep's report page (`index.html`, offline): a scatter of wrong % against a cost per
-//! setup and over the setups (mean and worst case), the cost chosen on the page (time, shadow
-//! data bytes, or a counter every point has), the recommendation and the tables.
+//! The sweep's report page (`index.html`, offline): a scatter of quality against a cost per
+//! setup and over the setups (mean and worst case), the quality (wrong %, the primary figure,
+//! or mean FLIP) and the cost (time, shadow data bytes, or a counter every point has) chosen
+//! on the page, the recommendation and the tables.
 
 use anyhow::Result;
 use minijinja::context;
@@ -54,6 +55,31 @@ fn costs(s: &Sweep) -> Vec<Cost> {
     v
 }
 
+/// A quality figure a scatter can plot (lower is better): an id, a title, and how a row / an
+/// aggregate (mean or worst case over the setups) reads it.
+struct Quality {
+    id: &'static str,
+    title: &'static str,
+    row: fn(&Row) -> f64,
+    agg: fn(&Aggregate, bool) -> f64,
+}
+
+/// Wrong % first (the primary figure, the page's default and the recommendation's), then FLIP.
+const QUALITIES: &[Quality] = &[
+    Quality {
+        id: "wrong",
+        title: "wrong pixels (%)",
+        row: |r| r.wrong_pct,
+        agg: |a, worst| if worst { a.worst_wrong_pct } else { a.mean_wrong_pct },
+    },
+    Quality {
+        id: "flip",
+        title: "mean FLIP",
+        row: |r| r.flip_mean,
+        agg: |a, worst| if worst { a.worst_flip_mean } else { a.mean_flip_mean },
+    },
+];
+
 /// Counters that measure work or memory (fetches, rays, pieces, bytes, reads, texels, map
 /// renders), offered as hardware-independent costs; the others (split distances, box sizes,
 /// depth ranges) describe a result, not its cost.
@@ -68,13 +94,13 @@ fn points<T>(
     items: &[T],
     label: impl Fn(&T) -> String,
     cost: impl Fn(&T) -> Option<f64>,
-    wrong: impl Fn(&T) -> f64,
+    quality: impl Fn(&T) -> f64,
     bytes: impl Fn(&T) -> u64,
 ) -> Option<Vec<Point>> {
     if items.is_empty() {
         return None;
     }
-    items.iter().map(|t| Some(Point { label: label(t), cost: cost(t)?, wrong_pct: wrong(t), bytes: bytes(t) })).collect()
+    items.iter().map(|t| Some(Point { label: label(t), cost: cost(t)?, quality: quality(t), bytes: bytes(t) })).collect()
 }
 
 /// The terminal's and the page's words on the recommendation (none without a budget).
@@ -126,30 +152,28 @@ pub fn html(s: &Sweep) -> Result<String> {
     let mut plots = Vec::new();
     let mut fronts = Vec::new();
     for (vid, vtitle, setup, worst) in &views {
-        for c in &costs {
-            let pts = match setup {
-                Some(i) => {
-                    let rows: Vec<&Row> = s.rows.iter().filter(|r| r.setup == s.setups[*i].name).collect();
-                    points(&rows, |r| r.label.clone(), |r| (c.row)(r), |r| r.wrong_pct, |r| r.shadow_data_bytes)
+        for q in QUALITIES {
+            for c in &costs {
+                let pts = match setup {
+                    Some(i) => {
+                        let rows: Vec<&Row> = s.rows.iter().filter(|r| r.setup == s.setups[*i].name).collect();
+                        points(&rows, |r| r.label.clone(), |r| (c.row)(r), |r| (q.row)(r), |r| r.shadow_data_bytes)
+                    }
+                    None => {
+                        points(&complete, |a| a.label.clone(), |a| (c.agg)(a, *worst), |a| (q.agg)(a, *worst), |a| a.max_shadow_data_bytes)
+                    }
+                };
+                let svg = match &pts {
+                    Some(p) => Some(scatter::svg(&format!("{vtitle}: {} against {}", q.title, c.title), &c.title, q.title, p)?),
+                    None => None,
+                };
+                if let Some(p) = &pts {
+                    let front = pareto_front(&p.iter().map(|p| (p.cost, p.quality)).collect::<Vec<_>>());
+                    let labels: Vec<String> = front.iter().map(|&i| p[i].label.clone()).collect();
+                    fronts.push(context! { view => vid, quality => q.id, cost => c.id, labels => labels });
                 }
-                None => points(
-                    &complete,
-                    |a| a.label.clone(),
-                    |a| (c.agg)(a, *worst),
-                    |a| if *worst { a.worst_wrong_pct } else { a.mean_wrong_pct },
-                    |a| a.max_shadow_data_bytes,
-                ),
-            };
-            let svg = match &pts {
-                Some(p) => Some(scatter::svg(&format!("{vtitle}: wrong % against {}", c.title), &c.title, p)?),
-                None => None,
-            };
-            if let Some(p) = &pts {
-                let front = pareto_front(&p.iter().map(|q| (q.cost, q.wrong_pct)).collect::<Vec<_>>());
-                fronts
-                    .push(context! { view => vid, cost => c.id, labels => front.iter().map(|&i| p[i].label.clone()).collect::<Vec<_>>() });
+                plots.push(context! { view => vid, quality => q.id, cost => c.id, svg => svg });
             }
-            plots.push(context! { view => vid, cost => c.id, svg => svg });
         }
     }
     let mut env = minijinja::Environment::new();
@@ -166,10 +190,12 @@ pub fn html(s: &Sweep) -> Result<String> {
     });
     let view_list: Vec<_> = views.iter().map(|(id, title, _, _)| context! { id => id, title => title }).collect();
     let cost_list: Vec<_> = costs.iter().map(|c| context! { id => c.id, title => c.title }).collect();
+    let quality_list: Vec<_> = QUALITIES.iter().map(|q| context! { id => q.id, title => q.title }).collect();
     Ok(env.get_template("sweep.html")?.render(context! {
         s => minijinja::Value::from_serialize(s),
         views => view_list,
         costs => cost_list,
+        qualities => quality_list,
         plots => plots,
         fronts => fronts,
         recommendation => recommendation_lines(s),
@@ -208,9 +234,16 @@ mod tests {
         // the only address is the SVG namespace, which is a name, not a download
         let loaded = h.replace("xmlns=\"http://www.w3.org/2000/svg\"", "");
         assert!(!loaded.contains("http://") && !loaded.contains("https://"), "offline");
-        for id in ["plot-mean-ms", "plot-worst-bytes", "plot-setup-0-ms", "plot-setup-1-counter-fetches_per_pixel"] {
+        for id in ["plot-mean-wrong-ms", "plot-worst-wrong-bytes", "plot-setup-0-wrong-ms", "plot-setup-1-wrong-counter-fetches_per_pixel"]
+        {
             assert!(h.contains(&format!("id=\"{id}\"")), "{id}");
         }
+        // the quality selector: FLIP as well as wrong %, for every view and cost
+        for id in ["plot-mean-flip-ms", "plot-worst-flip-bytes", "plot-setup-1-flip-counter-fetches_per_pixel"] {
+            assert!(h.contains(&format!("id=\"{id}\"")), "{id}");
+        }
+        assert!(h.contains("<option value=\"wrong\">wrong pixels (%)</option><option value=\"flip\">mean FLIP</option>"), "wrong % first");
+        assert!(h.contains("mean FLIP against total ms"));
         // rays_traced: on one row only, so no view can plot it and it is not offered
         assert!(!h.contains("counter-rays_traced"));
         // not a cost: a split distance is not offered even where every row has it
@@ -219,7 +252,7 @@ mod tests {
             r.counters.insert("split_0".into(), 3.0);
         }
         assert!(!html(&with_split).unwrap().contains("counter-split_0"));
-        assert_eq!(h.matches("<svg").count(), 4 * 3, "4 views x (ms, bytes, fetches)");
+        assert_eq!(h.matches("<svg").count(), 4 * 2 * 3, "4 views x (wrong, FLIP) x (ms, bytes, fetches)");
         assert!(h.contains("recommended for worst-case total &lt;= 5 ms: sm"), "lt takes 9 ms on b");
         assert!(h.contains("time on lavapipe is not your GPU"));
         let lines = recommendation_lines(&s);

@@ -6,6 +6,7 @@
 
 use anyhow::{anyhow, Context, Result};
 use indicatif::ProgressBar;
+use shadowlab_core::flip::flip_rgba8;
 use shadowlab_core::metrics::{compare as metrics_of, edge_pixels};
 use shadowlab_gpu::lab::path::{cameras, PathSpec, Progress};
 use shadowlab_gpu::lab::{summarize, FrameRecord, Lab, Run};
@@ -44,6 +45,7 @@ fn row(
         false_lit_pct: m.false_lit_pct,
         false_shadow_pct: m.false_shadow_pct,
         mae: m.mae,
+        flip_mean: m.flip_mean,
         flicker_pct: m.flicker_pct,
         evaluated_pixels: m.evaluated_pixels,
         total_ms: m.total_ms,
@@ -96,12 +98,14 @@ pub fn run_setup(
             // the profiled breakdown frame, as `compare` does
             let run = lab.run_resolved(&view, spec, repeat).map_err(|e| anyhow!("setup '{name}', technique '{}': {e}", spec.label))?;
             let m = metrics_of(&run.visibility, &rt.visibility, &view.mask);
+            let flip = flip_rgba8(&rt.shaded, &run.shaded, cfg.width, cfg.height);
             let rec = FrameRecord {
                 frame: 0,
                 wrong_pct: m.wrong_pct,
                 false_lit_pct: m.false_lit_pct,
                 false_shadow_pct: m.false_shadow_pct,
                 mae: m.mae,
+                flip_mean: flip.mean(),
                 evaluated_pixels: m.evaluated_pixels,
                 rays_traced: run.report.counters.get("rays_traced").copied(),
                 edge_pixels: edges,

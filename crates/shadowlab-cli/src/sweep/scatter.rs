@@ -1,4 +1,4 @@
-//! The sweep report's scatter plots: wrong % against a cost, marker area by memory (shadow data
+//! The sweep report's scatter plots: a quality figure (wrong % or mean FLIP) against a cost, marker area by memory (shadow data
 //! bytes), the Pareto front drawn and marked, every point labelled. SVG from plotters (no fonts,
 //! no network). Costs spanning more than a factor 20 are drawn on a log10 axis.
 
@@ -12,7 +12,8 @@ use super::choose::pareto_front;
 pub struct Point {
     pub label: String,
     pub cost: f64,
-    pub wrong_pct: f64,
+    /// The quality figure (lower is better): wrong % or mean FLIP.
+    pub quality: f64,
     pub bytes: u64,
 }
 
@@ -34,9 +35,9 @@ pub fn log_axis(points: &[Point]) -> bool {
     lo > 0.0 && hi / lo > 20.0
 }
 
-/// The SVG of one scatter; `cost_name` labels the x axis.
-pub fn svg(title: &str, cost_name: &str, points: &[Point]) -> Result<String> {
-    let points: Vec<&Point> = points.iter().filter(|p| p.cost.is_finite() && p.wrong_pct.is_finite()).collect();
+/// The SVG of one scatter; `cost_name` labels the x axis, `quality_name` the y axis.
+pub fn svg(title: &str, cost_name: &str, quality_name: &str, points: &[Point]) -> Result<String> {
+    let points: Vec<&Point> = points.iter().filter(|p| p.cost.is_finite() && p.quality.is_finite()).collect();
     let log = log_axis(&points.iter().map(|p| (*p).clone()).collect::<Vec<_>>());
     let x = |c: f64| if log { c.log10() } else { c };
     let xs: Vec<f64> = points.iter().map(|p| x(p.cost)).collect();
@@ -46,10 +47,10 @@ pub fn svg(title: &str, cost_name: &str, points: &[Point]) -> Result<String> {
     }
     let pad = if x1 > x0 { (x1 - x0) * 0.08 } else { x0.abs().max(1.0) * 0.1 };
     let (x0, x1) = if log { (x0 - pad, x1 + pad) } else { ((x0 - pad).max(0.0_f64.min(x0)), x1 + pad) };
-    let ymax = points.iter().map(|p| p.wrong_pct).fold(0.0f64, f64::max);
+    let ymax = points.iter().map(|p| p.quality).fold(0.0f64, f64::max);
     let ymax = if ymax > 0.0 { ymax * 1.15 } else { 1.0 };
     let max_bytes = points.iter().map(|p| p.bytes).max().unwrap_or(0);
-    let front = pareto_front(&points.iter().map(|p| (p.cost, p.wrong_pct)).collect::<Vec<_>>());
+    let front = pareto_front(&points.iter().map(|p| (p.cost, p.quality)).collect::<Vec<_>>());
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, (760, 460)).into_drawing_area();
@@ -79,22 +80,22 @@ pub fn svg(title: &str, cost_name: &str, points: &[Point]) -> Result<String> {
         };
         c.configure_mesh()
             .x_desc(x_desc)
-            .y_desc("wrong pixels (%)")
+            .y_desc(quality_name)
             .x_label_formatter(&fmt_x)
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(|e| err(&e))?;
-        let fpts: Vec<(f64, f64)> = front.iter().map(|&i| (xs[i], points[i].wrong_pct)).collect();
+        let fpts: Vec<(f64, f64)> = front.iter().map(|&i| (xs[i], points[i].quality)).collect();
         c.draw_series(LineSeries::new(fpts, FRONT.stroke_width(2))).map_err(|e| err(&e))?;
         for (i, p) in points.iter().enumerate() {
             let on = front.contains(&i);
             let r = radius(p.bytes, max_bytes);
             let style = if on { FRONT.mix(0.55).filled() } else { OTHER.mix(0.35).filled() };
-            c.draw_series(std::iter::once(Circle::new((xs[i], p.wrong_pct), r, style))).map_err(|e| err(&e))?;
-            c.draw_series(std::iter::once(Circle::new((xs[i], p.wrong_pct), r, if on { FRONT } else { OTHER }.stroke_width(1))))
+            c.draw_series(std::iter::once(Circle::new((xs[i], p.quality), r, style))).map_err(|e| err(&e))?;
+            c.draw_series(std::iter::once(Circle::new((xs[i], p.quality), r, if on { FRONT } else { OTHER }.stroke_width(1))))
                 .map_err(|e| err(&e))?;
             let text = Text::new(p.label.clone(), (r + 3, -4), ("sans-serif", 11).into_font().color(&BLACK.mix(0.8)));
-            c.draw_series(std::iter::once(EmptyElement::at((xs[i], p.wrong_pct)) + text)).map_err(|e| err(&e))?;
+            c.draw_series(std::iter::once(EmptyElement::at((xs[i], p.quality)) + text)).map_err(|e| err(&e))?;
         }
         root.present().map_err(|e| err(&e))?;
     }
@@ -106,22 +107,22 @@ mod tests {
     use super::*;
 
     fn p(label: &str, cost: f64, wrong: f64, bytes: u64) -> Point {
-        Point { label: label.into(), cost, wrong_pct: wrong, bytes }
+        Point { label: label.into(), cost, quality: wrong, bytes }
     }
 
     #[test]
     fn markers_grow_with_memory_and_the_front_is_drawn() {
         assert_eq!((radius(0, 100), radius(100, 100), radius(25, 100), radius(5, 0)), (3, 14, 9, 3));
         let pts = [p("cheap", 1.0, 5.0, 10), p("good", 4.0, 1.0, 1000), p("bad", 3.0, 6.0, 100)];
-        let s = svg("planebox", "total ms", &pts).unwrap();
+        let s = svg("planebox", "total ms", "wrong pixels (%)", &pts).unwrap();
         assert!(s.starts_with("<svg") && s.contains("cheap") && s.contains("good") && s.contains("bad"), "labels drawn");
         assert!(s.contains("total ms") && s.contains("wrong pixels (%)"));
         assert_eq!(s.matches("<circle").count(), 6, "a filled disc and an outline per point");
         let front_lines = s.lines().filter(|l| l.contains("<polyline") && l.contains("stroke-width=\"2\"")).count();
         assert_eq!(front_lines, 1, "one front line");
         assert!(!log_axis(&pts) && log_axis(&[p("a", 1.0, 1.0, 1), p("b", 100.0, 1.0, 1)]));
-        let s = svg("x", "shadow data (bytes)", &[p("a", 1024.0, 1.0, 1024), p("b", 16e6, 0.5, 16_000_000)]).unwrap();
+        let s = svg("x", "shadow data (bytes)", "mean FLIP", &[p("a", 1024.0, 1.0, 1024), p("b", 16e6, 0.5, 16_000_000)]).unwrap();
         assert!(s.contains("(log scale)"));
-        assert!(svg("empty", "ms", &[]).unwrap().starts_with("<svg"));
+        assert!(svg("empty", "ms", "wrong pixels (%)", &[]).unwrap().starts_with("<svg"));
     }
 }

@@ -6,7 +6,8 @@
 //! Several frames: each technique is created once and sees the frames in order, once each
 //! (techniques with history, such as temporal masks or delayed analysis, see a real sequence);
 //! times are medians over frames 1.. (frame 0 is the warm-up), quality figures are means over
-//! all frames, flicker is the mean over consecutive pairs. Moving objects move with the frames:
+//! all frames (FLIP too: each frame's shaded images against `rt`'s), flicker is the mean over
+//! consecutive pairs. Moving objects move with the frames:
 //! frame k is at animation time `start_time` + k (frames) when [`PathSpec::animate`] is set.
 //! On adapters without sane timestamps, one more frame per technique, profiled (a wait per
 //! stage), runs after the measured frames for the per-stage breakdown.
@@ -15,6 +16,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 use shadowlab_core::camera::{path_cameras, Camera, CameraKey};
+use shadowlab_core::flip::{flip_each, FlipMap};
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::{compare as metrics_of, edge_pixels, flicker_pct, ErrorMetrics};
 
@@ -101,6 +103,9 @@ pub struct FrameRecord {
     pub false_lit_pct: f64,
     pub false_shadow_pct: f64,
     pub mae: f64,
+    /// Mean FLIP (LDR, [`shadowlab_core::flip`]) of the technique's shaded image against
+    /// `rt`'s, over all pixels of the image.
+    pub flip_mean: f64,
     pub evaluated_pixels: u64,
     /// Rays the technique traced this frame (ray-assisted techniques).
     pub rays_traced: Option<f64>,
@@ -128,6 +133,8 @@ pub struct ReferenceFrame {
 pub struct TechniqueFrames {
     /// The last frame's run (its pictures and report go to the outputs).
     pub last: Run,
+    /// The last frame's FLIP error map against `rt` (its mean is the last record's `flip_mean`).
+    pub last_flip: FlipMap,
     pub frames: Vec<FrameRecord>,
     /// Per-stage ms of one profiled frame (a wait per stage) after the last frame, on adapters
     /// without sane timestamps; empty on the others (their timed frames carry stage times).
@@ -200,6 +207,7 @@ impl Lab<'_> {
                     false_lit_pct: m.false_lit_pct,
                     false_shadow_pct: m.false_shadow_pct,
                     mae: m.mae,
+                    flip_mean: 0.0, // below, once the frame's images are all there
                     evaluated_pixels: m.evaluated_pixels,
                     rays_traced: run.report.counters.get("rays_traced").copied(),
                     edge_pixels: edges,
@@ -210,12 +218,19 @@ impl Lab<'_> {
                 runs.push(run);
                 progress(Progress::Step);
             }
+            // FLIP on the CPU, the frame's techniques in parallel (the GPU is idle meanwhile)
+            progress(Progress::Stage(&format!("frame {}/{frames}: FLIP", f + 1)));
+            let shaded: Vec<&[u8]> = runs.iter().map(|r| r.shaded.as_slice()).collect();
+            let flips = flip_each(&rt.shaded, &shaded, p.width, p.height);
+            for (rec, map) in records.iter_mut().zip(&flips) {
+                rec.last_mut().expect("this frame's record").flip_mean = map.mean();
+            }
             progress(Progress::Frame { index: f, view: &view, rt: &rt, runs: &runs });
             let this_v: Vec<Vec<f32>> = runs.iter().map(|r| r.visibility.clone()).collect();
             prev = Some((rt.visibility.clone(), view.mask.clone(), this_v));
-            last = Some((view, rt, runs));
+            last = Some((view, rt, runs, flips));
         }
-        let (view, rt, runs) = last.expect("at least one frame");
+        let (view, rt, runs, flips) = last.expect("at least one frame");
         // the breakdown: one more frame each, profiled, after the measured ones (it advances
         // techniques with history by a frame, so it comes last)
         let timestamps = self.gpu.gpu_timestamps;
@@ -223,10 +238,10 @@ impl Lab<'_> {
         progress(Progress::Stage("profiled breakdown"));
         let rt_breakdown_ms = profile(&mut rt_inst)?;
         let mut techniques = Vec::new();
-        for ((last, frames), inst) in runs.into_iter().zip(records).zip(insts.iter_mut()) {
+        for (((last, last_flip), frames), inst) in runs.into_iter().zip(flips).zip(records).zip(insts.iter_mut()) {
             let label = inst.label.clone();
             let breakdown_ms = within(profile(inst), || format!("technique '{label}', profiled frame"))?;
-            techniques.push(TechniqueFrames { last, frames, breakdown_ms });
+            techniques.push(TechniqueFrames { last, last_flip, frames, breakdown_ms });
         }
         Ok(PathRun { cameras: p.cameras.clone(), view, rt, reference, rt_breakdown_ms, techniques })
     }

@@ -16,6 +16,8 @@ pub struct Summary {
     pub false_lit_pct: f64,
     pub false_shadow_pct: f64,
     pub mae: f64,
+    /// Mean FLIP, the mean over the frames of each frame's image mean.
+    pub flip_mean: f64,
     /// Mean over the frames, rounded.
     pub evaluated_pixels: u64,
     pub rays_traced: Option<f64>,
@@ -59,6 +61,7 @@ pub fn summarize(frames: &[FrameRecord]) -> Summary {
         false_lit_pct: q(|r| r.false_lit_pct),
         false_shadow_pct: q(|r| r.false_shadow_pct),
         mae: q(|r| r.mae),
+        flip_mean: q(|r| r.flip_mean),
         evaluated_pixels: q(|r| r.evaluated_pixels as f64).round() as u64,
         rays_traced: if frames.iter().all(|r| r.rays_traced.is_some()) { mean(frames.iter().filter_map(|r| r.rays_traced)) } else { None },
         flicker_pct: mean(frames.iter().filter_map(|r| r.flicker_pct)),
@@ -82,6 +85,7 @@ mod tests {
             false_lit_pct: wrong,
             false_shadow_pct: 0.0,
             mae: wrong / 100.0,
+            flip_mean: wrong / 10.0,
             evaluated_pixels: 100,
             rays_traced: None,
             edge_pixels: 3,
@@ -95,6 +99,7 @@ mod tests {
         let s =
             summarize(&[rec(0, 1.0, 100.0, None), rec(1, 2.0, 5.0, Some(1.0)), rec(2, 3.0, 7.0, Some(3.0)), rec(3, 6.0, 6.0, Some(2.0))]);
         assert_eq!(s.wrong_pct, 3.0);
+        assert!((s.flip_mean - 0.3).abs() < 1e-12, "FLIP is a mean over all frames");
         assert_eq!(s.flicker_pct, Some(2.0));
         assert_eq!(s.total_ms, 6.0, "frame 0 (100 ms warm-up) is not timed");
         assert_eq!(s.stages_ms["a"], 6.0);
