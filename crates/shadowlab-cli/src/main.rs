@@ -8,8 +8,8 @@ mod listing;
 mod metrics;
 mod output;
 mod report;
-mod view;
 mod sweep;
+mod view;
 
 use std::path::PathBuf;
 

@@ -122,7 +122,22 @@ fn flip_is_zero_where_the_shading_agrees_with_rt_and_positive_where_not() {
     }
     let out = tmp("flip");
     // rt against itself; sv agrees with rt on planebox; sm with a 64x64 map does not
-    let o = run(&["compare", "-q", "--scene", "planebox", "--size", "96x64", "-t", "rt", "-t", "sv", "-t", "sm:res=64", "--out", out.to_str().unwrap()]);
+    let o = run(&[
+        "compare",
+        "-q",
+        "--scene",
+        "planebox",
+        "--size",
+        "96x64",
+        "-t",
+        "rt",
+        "-t",
+        "sv",
+        "-t",
+        "sm:res=64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
     let t = m["techniques"].as_array().unwrap();

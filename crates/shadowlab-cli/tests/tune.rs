@@ -26,7 +26,21 @@ fn tune_chooses_on_train_and_judges_on_validate() {
         return;
     }
     let out = tmp("run");
-    let args = ["tune", "-t", "sm:res=64|1024", "--train", "courtyard", "--validate", "city", "--validate", "planebox", "--size", "48x48", "--quiet", "--out"];
+    let args = [
+        "tune",
+        "-t",
+        "sm:res=64|1024",
+        "--train",
+        "courtyard",
+        "--validate",
+        "city",
+        "--validate",
+        "planebox",
+        "--size",
+        "48x48",
+        "--quiet",
+        "--out",
+    ];
     let run = bin().args(args).arg(&out).output().unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let t = json(out.join("tune.json"));

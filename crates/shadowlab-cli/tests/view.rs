@@ -78,7 +78,12 @@ fn a_saved_view_reproduces_its_numbers_in_compare() {
     assert_eq!(t["label"], "edited");
     assert_eq!((m["width"].as_u64(), m["height"].as_u64()), (Some(w as u64), Some(h as u64)));
     assert_eq!(t["evaluated_pixels"].as_u64(), Some(e.a.metrics.evaluated_pixels));
-    for (k, v) in [("wrong_pct", e.a.metrics.wrong_pct), ("false_lit_pct", e.a.metrics.false_lit_pct), ("false_shadow_pct", e.a.metrics.false_shadow_pct), ("mae", e.a.metrics.mae)] {
+    for (k, v) in [
+        ("wrong_pct", e.a.metrics.wrong_pct),
+        ("false_lit_pct", e.a.metrics.false_lit_pct),
+        ("false_shadow_pct", e.a.metrics.false_shadow_pct),
+        ("mae", e.a.metrics.mae),
+    ] {
         assert_eq!(t[k].as_f64(), Some(v), "{k}: compare {} vs the viewer's {v}", t[k]);
     }
     assert!(e.a.metrics.wrong_pct > 0.0, "a 192 map leaves wrong pixels to compare");

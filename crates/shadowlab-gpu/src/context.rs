@@ -41,8 +41,8 @@ impl Gpu {
         }))
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
-        let (device, queue) = pollster::block_on(adapter.request_device(&Gpu::device_descriptor(&adapter)))
-        .map_err(|e| GpuError::Device(e.to_string()))?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&Gpu::device_descriptor(&adapter))).map_err(|e| GpuError::Device(e.to_string()))?;
         Gpu::from_device(device, queue, info)
     }
 

@@ -12,9 +12,17 @@ use shadowlab_gpu::GpuError;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Widget {
     /// A range slider; logarithmic when the range spans more than two decades (from 0 or above).
-    Slider { min: f64, max: f64, log: bool },
+    Slider {
+        min: f64,
+        max: f64,
+        log: bool,
+    },
     /// An integer stepper; `doubling` steps by powers of two (map sizes).
-    Stepper { min: i64, max: i64, doubling: bool },
+    Stepper {
+        min: i64,
+        max: i64,
+        doubling: bool,
+    },
     Checkbox,
     Dropdown(&'static [&'static str]),
 }

@@ -158,8 +158,8 @@ pub fn tune(a: &TuneArgs) -> Result<()> {
     }
     prepare_dir(&a.out)?;
     // the defaults run beside the grid on both lists
-    let train = super::sweep(&sweep_args(a, &a.train, vec![a.technique.clone(), name.clone()], a.out.join("train")))
-        .context("the train sweep")?;
+    let train =
+        super::sweep(&sweep_args(a, &a.train, vec![a.technique.clone(), name.clone()], a.out.join("train"))).context("the train sweep")?;
     let aggs = aggregate(&train.rows);
     let grid_aggs: Vec<Aggregate> = aggs.iter().filter(|g| g.label != name).cloned().collect();
     let ranking: Vec<Side> =

@@ -22,9 +22,7 @@ pub(crate) fn run(opts: Options) -> anyhow::Result<()> {
     // the window: the fixed render size plus the panels, else 1600x900
     let (w, h) = opts.size.map_or((1600.0, 900.0), |(w, h)| (w as f32 + CONTROLS_W + HUD_W + 24.0, h as f32 + 16.0));
     let native = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_title("shadowlab view")
-            .with_inner_size([w, h]),
+        viewport: egui::ViewportBuilder::default().with_title("shadowlab view").with_inner_size([w, h]),
         wgpu_options: egui_wgpu::WgpuConfiguration {
             wgpu_setup: egui_wgpu::WgpuSetup::CreateNew(setup),
             // the frame already waits for the GPU; presenting without vsync adds no second wait

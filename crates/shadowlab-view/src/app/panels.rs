@@ -9,7 +9,7 @@ use shadowlab_gpu::registry::REGISTRY;
 
 use super::state::App;
 use crate::fly::{sun_angles, sun_direction};
-use crate::render::{RefStatus, Right, SideEval, Show};
+use crate::render::{RefStatus, Right, Show, SideEval};
 use crate::widgets;
 
 pub fn controls(app: &mut App, ui: &mut egui::Ui) {

@@ -157,7 +157,8 @@ impl App {
     pub fn save_setup(&mut self) {
         let (w, h) = self.r.size();
         let s = session::snapshot(&self.setup, &self.camera, &self.light, self.time, w, h, &self.specs());
-        let res = session::to_toml(&s).and_then(|t| session::write_fresh(&self.out_dir, "view", "toml", t.as_bytes()).map_err(|e| e.to_string()));
+        let res =
+            session::to_toml(&s).and_then(|t| session::write_fresh(&self.out_dir, "view", "toml", t.as_bytes()).map_err(|e| e.to_string()));
         self.report(res.map(|p| format!("setup saved: {} (shadowlab compare --setup {})", p.display(), p.display())));
     }
 
@@ -304,7 +305,8 @@ impl App {
         let avail = ui.available_rect_before_wrap();
         let resp = ui.allocate_rect(avail, egui::Sense::click_and_drag());
         let ppp = ui.ctx().pixels_per_point();
-        let size = self.fixed_size.unwrap_or(((avail.width() * ppp).round().max(16.0) as u32, (avail.height() * ppp).round().max(16.0) as u32));
+        let size =
+            self.fixed_size.unwrap_or(((avail.width() * ppp).round().max(16.0) as u32, (avail.height() * ppp).round().max(16.0) as u32));
         if let Err(e) = self.r.resize(size.0, size.1) {
             self.error = Some(e.to_string());
         }
@@ -334,7 +336,8 @@ impl App {
             self.scripted_steps();
         }
         self.camera = fly(&self.camera, &input, dt, self.speed);
-        let pose = Pose { camera: self.camera, prev_camera: self.prev_camera, light: self.light, time: self.time, prev_time: self.prev_time };
+        let pose =
+            Pose { camera: self.camera, prev_camera: self.prev_camera, light: self.light, time: self.time, prev_time: self.prev_time };
         let changed = self.last_pose.is_none_or(|p| p.camera != pose.camera || p.light != pose.light || p.time != pose.time);
         if changed {
             self.last_change = now;
@@ -401,4 +404,3 @@ impl App {
         ui.painter().image(id, rect, uv, egui::Color32::WHITE);
     }
 }
-

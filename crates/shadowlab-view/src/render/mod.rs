@@ -118,7 +118,10 @@ pub enum RefStatus {
     /// The camera, light or time moved since the last reference.
     Stale,
     /// Bands of rows traced so far, of all.
-    Refining { done: u32, of: u32 },
+    Refining {
+        done: u32,
+        of: u32,
+    },
     Current,
 }
 

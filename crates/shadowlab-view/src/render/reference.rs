@@ -122,12 +122,17 @@ impl Renderer<'_> {
             gpu.wait();
             let report = tech.report(gpu);
             gpu.take_error()?;
-            sides.push(SideEval { label: s.spec.label.clone(), metrics: compare(&v, &v_rt, &mask), error, report, stages_ms: BTreeMap::new() });
+            sides.push(SideEval {
+                label: s.spec.label.clone(),
+                metrics: compare(&v, &v_rt, &mask),
+                error,
+                report,
+                stages_ms: BTreeMap::new(),
+            });
         }
         let b = if with_b { sides.pop() } else { None };
         let a = sides.pop().expect("technique A is evaluated");
         self.evals += 1;
         Ok(Evaluation { id: self.evals, a, b, reference_ms, profiled: gpu.gpu_timestamps })
     }
-
 }
