@@ -3,6 +3,7 @@
 
 mod city;
 mod courtyard;
+mod eaves;
 mod foliage;
 mod planebox;
 mod room;
@@ -48,6 +49,11 @@ pub const BUILTIN_SCENES: &[BuiltinScene] = &[
         name: "city",
         summary: "9 x 9 blocks of towers, 450 m across, street lamps, street-level camera, sun 25 degrees high (IASM/CSM wide area)",
         build: city::build,
+    },
+    BuiltinScene {
+        name: "eaves",
+        summary: "dense stress case: a porch under a 65 k-triangle tile roof on rafters, a lattice screen; point light (0) and spot (2) close under the eaves, low sun (1)",
+        build: eaves::build,
     },
 ];
 
