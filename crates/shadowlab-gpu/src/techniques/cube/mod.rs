@@ -137,6 +137,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     w::NOTW_SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, THREE_SETUPS),
     w::SUBDIV_LEVELS,
     w::SUBDIV_CAPACITY,
+    w::MIN_PIECE,
     w::CLOSE_CRACKS,
     w::NOTW_EXACT,
     w::PCF,

@@ -163,42 +163,63 @@ fn offsets_cols(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Smoothing across neighbouring functions: the average over [r - window/2, r + window/2]
-// weighted by their sample totals (seed 000 Figure 4).
-fn smoothed(axis: u32, r: u32, k: u32) -> f32 {
-    let w = res_u();
-    let n = w * w;
-    let half = u32(wp.window) / 2u;
-    let a = max(i32(r) - i32(half), 0);
-    let b = min(r + half, w - 1u);
-    var num = 0.0;
-    var den = 0.0;
-    for (var j = u32(a); j <= b; j++) {
-        let tj = fwork[3u * n + j];
-        num += tj * fwork[n + at(axis, j, k)];
-        den += tj;
-    }
-    return select(0.0, num / den, den > 0.0);
+// weighted by their sample totals (seed 000 Figure 4). One invocation smooths SMOOTH_BLOCK
+// consecutive functions r at one position k: it sums its first window directly, then slides
+// it (adds the function that enters, removes the one that leaves), so a texel costs about
+// window / SMOOTH_BLOCK + 2 reads instead of window + 1 (cube-notw's window 128 made this
+// the largest stage of its frame). The totals are whole sample counts, exact in f32 below
+// 2^24 samples, so only the weighted sum drifts, by rounding over at most SMOOTH_BLOCK slides.
+// Set by the pipeline (warp::SMOOTH_BLOCK, which also sizes the dispatch).
+override SMOOTH_BLOCK: u32;
+
+fn weighted(axis: u32, j: u32, k: u32) -> vec2<f32> {
+    let n = res_u() * res_u();
+    let tj = fwork[3u * n + j];
+    return vec2<f32>(tj * fwork[n + at(axis, j, k)], tj);
 }
 
-@compute @workgroup_size(8, 8)
-fn smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+fn smooth_block(axis: u32, k: u32, block: u32) {
     let w = res_u();
-    if id.x >= w || id.y >= w {
+    let half = i32(u32(wp.window) / 2u);
+    let r0 = block * SMOOTH_BLOCK;
+    if k >= w || r0 >= w {
         return;
     }
-    let o = smoothed(0u, id.y, id.x);
-    fwork[2u * w * w + id.y * w + id.x] = o;
-    textureStore(warp_x_out, id.xy, vec4<f32>(o, 0.0, 0.0, 0.0));
+    var acc = vec2<f32>(0.0);
+    for (var j = max(i32(r0) - half, 0); j <= min(i32(r0) + half, i32(w) - 1); j++) {
+        acc += weighted(axis, u32(j), k);
+    }
+    for (var r = r0; r < min(r0 + SMOOTH_BLOCK, w); r++) {
+        if r > r0 {
+            let enter = i32(r) + half;
+            let leave = i32(r) - half - 1;
+            if enter < i32(w) {
+                acc += weighted(axis, u32(enter), k);
+            }
+            if leave >= 0 {
+                acc -= weighted(axis, u32(leave), k);
+            }
+        }
+        let o = select(0.0, acc.x / acc.y, acc.y > 0.0);
+        if axis == 0u {
+            fwork[2u * w * w + r * w + k] = o;
+            textureStore(warp_x_out, vec2<u32>(k, r), vec4<f32>(o, 0.0, 0.0, 0.0));
+        } else {
+            // r = column, k = edge: stored as an image, (column, edge)
+            textureStore(warp_y_out, vec2<u32>(r, k), vec4<f32>(o, 0.0, 0.0, 0.0));
+        }
+    }
+}
+
+// Dispatched over (position k, block of SMOOTH_BLOCK functions).
+@compute @workgroup_size(8, 8)
+fn smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    smooth_block(0u, id.x, id.y);
 }
 
 @compute @workgroup_size(8, 8)
 fn smooth_cols(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = res_u();
-    if id.x >= w || id.y >= w {
-        return;
-    }
-    // id.y = column, id.x = edge: stored as an image, (column, edge)
-    textureStore(warp_y_out, vec2<u32>(id.y, id.x), vec4<f32>(smoothed(1u, id.y, id.x), 0.0, 0.0, 0.0));
+    smooth_block(1u, id.x, id.y);
 }
 
 // o_x^(i)(x) from the smoothed row offsets in fwork.

@@ -141,6 +141,12 @@ pub const DV_CROP: f32 = 1.0;
 /// `WarpParams::dv_mode`: cropped, and subdivision cracks closed by a 3x3 depth minimum.
 pub const DV_CROP_CLOSED: f32 = 2.0;
 
+/// NoTW smoothing across functions (analyze.wgsl `smooth_block`): functions per invocation,
+/// summed directly once and then slid. 32: a texel costs window / 32 + 2 reads (window + 1
+/// before; cube-notw's window 128 made smoothing its largest stage), and the sliding sum
+/// rounds over at most 32 steps.
+pub(super) const SMOOTH_BLOCK: u32 = 32;
+
 /// WGSL `WarpParams` (params.wgsl): one named field per value (the layout test checks each).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -177,6 +183,11 @@ pub struct WarpParams {
     pub bias_mode: f32,
     pub footprint_cap: f32,
     pub depth_clamp: f32,
+    /// Smallest warped extent (texels) of an edge that subdivision splits; 0 = no bound.
+    pub min_piece: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+    pub pad2: f32,
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -383,6 +394,10 @@ impl Warped {
             bias_mode: k.bias_mode as f32,
             footprint_cap: k.footprint_cap,
             depth_clamp: k.depth_clamp as f32,
+            min_piece: k.min_piece,
+            pad0: 0.0,
+            pad1: 0.0,
+            pad2: 0.0,
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;
@@ -434,7 +449,11 @@ impl Warped {
             Variant::Rtw => &["dv_reduce", "count", "rtw_collapse", "rtw_blur", "rtw_offsets"],
             Variant::Dv => &["dv_reduce"],
         };
-        let analyze = entries.iter().map(|&e| (e, gpu.compute_pipeline(&format!("{name}.{e}"), &src, e, &[&analyze_layout]))).collect();
+        let constants = [("SMOOTH_BLOCK", SMOOTH_BLOCK as f64)];
+        let analyze = entries
+            .iter()
+            .map(|&e| (e, gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&analyze_layout], &constants)))
+            .collect();
         let look = [(6, binding::uniform()), (7, ro), (8, tex), (9, tex)];
         let lookup_layout =
             layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX_FRAGMENT, &[look[0], look[1], look[2], look[3], (10, ro)]);

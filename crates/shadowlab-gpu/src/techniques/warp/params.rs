@@ -121,6 +121,23 @@ pub const SUBDIV_CAPACITY: ParamDef = ParamDef::integer(
     "shadowlab (deterministic capacity, issue 18)",
 );
 
+/// Smallest piece worth splitting, in warped texels: an edge whose warped image (its ends and
+/// the three points the bend is measured at) spans less than this along both map axes is not
+/// split, however much the warp bends it, because the rasteriser cannot resolve a bend inside
+/// it. This bounds the pieces by the texels they cover (about 2 / min_piece^2 per texel per
+/// layer) instead of by the warp's magnification. 0 = no bound (the seeds' subdivision).
+/// Low: pieces explode under dense geometry near a point light (issue 18: 7.8 M pieces, 68 s a
+/// frame on sibenik's vault); high: bent edges of pieces up to this size.
+pub const DEFAULT_MIN_PIECE: f64 = 0.0;
+pub const MIN_PIECE: ParamDef = ParamDef::number(
+    "min_piece",
+    DEFAULT_MIN_PIECE,
+    0.0,
+    64.0,
+    "do not split an edge whose warped image spans less than this many warped texels (the rasteriser cannot resolve its bend); bounds the pieces by the texels; 0 = no bound; high: bent edges",
+    "shadowlab (bounded subdivision, issue 18)",
+);
+
 /// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.
 pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
 pub const CLOSE_CRACKS: ParamDef = ParamDef::flag("close_cracks", DEFAULT_CLOSE_CRACKS != 0.0, "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap", "shadowlab measurement (docs/bench/warp.md)");
@@ -188,7 +205,7 @@ pub const DEPTH_CLAMP: ParamDef = ParamDef::integer(
 );
 
 /// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
-const NOTW_SHARED: [ParamDef; 16] = [
+const NOTW_SHARED: [ParamDef; 17] = [
     RES,
     WINDOW,
     NOTW_BLUR,
@@ -197,6 +214,7 @@ const NOTW_SHARED: [ParamDef; 16] = [
     NOTW_SUBDIV,
     SUBDIV_LEVELS,
     SUBDIV_CAPACITY,
+    MIN_PIECE,
     CLOSE_CRACKS,
     NOTW_EXACT,
     PCF,
@@ -221,7 +239,7 @@ const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A]
 }
 
 /// notw's own list: `NOTW_PARAMS` plus the warp strength and the bias footprint parameters.
-pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<16, 4, 20>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP]);
+pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<17, 4, 21>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP]);
 
 /// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
 /// run with; the gradient footprint (2) was measured for `notw` only.
@@ -237,6 +255,7 @@ pub const RTW_PARAMS: &[ParamDef] = &[
     SUBDIV,
     SUBDIV_LEVELS,
     SUBDIV_CAPACITY,
+    MIN_PIECE,
     CLOSE_CRACKS,
     EXACT_DEPTH,
     PCF,
@@ -270,6 +289,8 @@ pub(super) struct Knobs {
     pub subdiv_levels: u32,
     /// Pieces beyond the triangles; 0 = automatic.
     pub subdiv_capacity: u32,
+    /// Smallest warped extent (texels) of an edge that is split; 0 = no bound.
+    pub min_piece: f32,
     pub exact_depth: bool,
     pub close_cracks: bool,
     pub dv_margin: f32,
@@ -294,6 +315,7 @@ impl Knobs {
             subdiv,
             subdiv_levels: if subdivides { p.get_u32("subdiv_levels") } else { 1 },
             subdiv_capacity: if subdivides { p.get_u32("subdiv_capacity") } else { 0 },
+            min_piece: if subdivides { p.get("min_piece") as f32 } else { 0.0 },
             exact_depth: subdivides && p.get_bool("exact_depth"),
             close_cracks: warped && dv && p.get_bool("close_cracks"),
             dv_margin: if dv { p.get("dv_margin") as f32 } else { 0.0 },

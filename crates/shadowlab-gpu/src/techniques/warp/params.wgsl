@@ -57,6 +57,12 @@ struct WarpParams {
     footprint_cap: f32,
     // 1 = exact depth clamped to the whole triangle's corner depths (0: the piece's corners)
     depth_clamp: f32,
+    // subdivision: an edge whose warped image spans less than this (warped texels) is not
+    // split; 0 = no bound
+    min_piece: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.

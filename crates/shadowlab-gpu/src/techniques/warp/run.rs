@@ -3,7 +3,7 @@
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::techniques::warp::Warp2D;
 
-use super::{Variant, Warped, DV_CROP_CLOSED};
+use super::{Variant, Warped, DV_CROP_CLOSED, SMOOTH_BLOCK};
 use crate::prefix_sum::ScanParams;
 use crate::record::Recorder;
 use crate::technique::{FrameInputs, NamedImage, Technique, TechniqueReport};
@@ -138,13 +138,13 @@ impl Technique for Warped {
                     let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::rows(res, res) };
                     self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
                     gpu.dispatch_2d(enc, "notw.offsets_rows", self.pipeline("offsets_rows"), &[&group], res, res);
-                    gpu.dispatch_2d(enc, "notw.smooth_rows", self.pipeline("smooth_rows"), &[&group], res, res);
+                    gpu.dispatch_2d(enc, "notw.smooth_rows", self.pipeline("smooth_rows"), &[&group], res, res.div_ceil(SMOOTH_BLOCK));
                     gpu.dispatch_2d(enc, "notw.rebuild", self.pipeline("rebuild"), &[&group], w, h);
                     gpu.dispatch_2d(enc, "notw.blur_cols", self.pipeline("blur_cols"), &[&group], res, res);
                     let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::columns(res, res) };
                     self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
                     gpu.dispatch_2d(enc, "notw.offsets_cols", self.pipeline("offsets_cols"), &[&group], res, res);
-                    gpu.dispatch_2d(enc, "notw.smooth_cols", self.pipeline("smooth_cols"), &[&group], res, res);
+                    gpu.dispatch_2d(enc, "notw.smooth_cols", self.pipeline("smooth_cols"), &[&group], res, res.div_ceil(SMOOTH_BLOCK));
                 }
                 _ => {
                     let one_d = |enc: &mut wgpu::CommandEncoder, e: &str| {

@@ -48,13 +48,28 @@ fn corner_pos(tri: u32, c: u32) -> vec3<f32> {
     return v0 + (vertices[3u * tri + 1u].pos - v0) * b.x + (vertices[3u * tri + 2u].pos - v0) * b.y;
 }
 
+// Whether the warped points of an edge (its ends and the points its bend is measured at) span
+// less than `min_piece` warped texels along both map axes: the rasteriser cannot resolve a bend
+// inside it, so splitting it further only multiplies pieces (a function of the edge alone).
+fn below_min_piece(lo: vec2<f32>, hi: vec2<f32>) -> bool {
+    return max(hi.x - lo.x, hi.y - lo.y) * wp.res < wp.min_piece;
+}
+
 // How far the warped edge strays from the straight line the rasteriser draws between its
-// warped ends (warped texels), sampled at 1/4, 1/2 and 3/4.
+// warped ends (warped texels), sampled at 1/4, 1/2 and 3/4; 0 below `min_piece`.
 fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32 {
     var e = 0.0;
+    var lo = min(wa, wb);
+    var hi = max(wa, wb);
     for (var s = 1u; s <= 3u; s++) {
         let t = f32(s) / 4.0;
-        e = max(e, distance(warp(mix(ma, mb, t)), mix(wa, wb, t)));
+        let w = warp(mix(ma, mb, t));
+        lo = min(lo, w);
+        hi = max(hi, w);
+        e = max(e, distance(w, mix(wa, wb, t)));
+    }
+    if below_min_piece(lo, hi) {
+        return 0.0;
     }
     return e * wp.res;
 }
@@ -94,17 +109,25 @@ fn paraboloid_edge_error(pa: vec3<f32>, pb: vec3<f32>, wa: vec2<f32>, wb: vec2<f
     let dir = wb - wa;
     let len = length(dir);
     var e = 0.0;
+    var lo = min(wa, wb);
+    var hi = max(wa, wb);
     for (var s = 1u; s <= 3u; s++) {
         let c = base_clip(wp, mix(pa, pb, f32(s) / 4.0));
         if c.w <= 1e-7 {
             return 1e30;
         }
-        let m = warp(to_dv(clip_to_map(c).xy, r)) - wa;
+        let w = warp(to_dv(clip_to_map(c).xy, r));
+        lo = min(lo, w);
+        hi = max(hi, w);
+        let m = w - wa;
         var d = length(m);
         if len > 1e-12 {
             d = abs(m.x * dir.y - m.y * dir.x) / len;
         }
         e = max(e, d);
+    }
+    if below_min_piece(lo, hi) {
+        return 0.0;
     }
     return e * wp.res;
 }
