@@ -5,7 +5,8 @@
 // its depth, else the last), and reduce per cascade the min/max of its light-view x, y, z and
 // the sample count. Min/max use order keys (order_key.wgsl, prepended): the min kept as the
 // complement of its key so that every word starts at 0 and reduces with atomicMax;
-// deterministic. Per workgroup first in shared memory, then one global atomic per word.
+// deterministic. Per thread first, then per workgroup in shared memory, then one global
+// atomic per word.
 //
 // `out` layout (u32 words): [0] ~key(min depth), [1] key(max depth) (copied from `depth_mm`),
 // [2] cascades in use, [3] 0, [4 + i] bits of split i (i <= count), then per cascade c at
@@ -85,6 +86,21 @@ fn split(i: u32, n: u32, r: vec2<f32>) -> f32 {
     return u.lambda * lg + (1.0 - u.lambda) * uni;
 }
 
+// one thread's run of samples of cascade c into the workgroup's words
+fn flush(c: u32, lo: vec3<u32>, hi: vec3<u32>, cnt: u32) {
+    if cnt == 0u {
+        return;
+    }
+    let w = c * 8u;
+    atomicMax(&acc[w], lo.x);
+    atomicMax(&acc[w + 1u], lo.y);
+    atomicMax(&acc[w + 2u], lo.z);
+    atomicMax(&acc[w + 3u], hi.x);
+    atomicMax(&acc[w + 4u], hi.y);
+    atomicMax(&acc[w + 5u], hi.z);
+    atomicAdd(&acc[w + 6u], cnt);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let n = u32(u.count);
@@ -101,6 +117,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
             atomicStore(&out[4u + i], bitcast<u32>(splits[i]));
         }
     }
+    // per thread first, over runs of samples in the same cascade (neighbours mostly are; no
+    // dynamically indexed per-thread arrays), then per workgroup in shared memory
+    var cur = 0u;
+    var lo = vec3<u32>(0u);
+    var hi = vec3<u32>(0u);
+    var cnt = 0u;
     let size = textureDimensions(src);
     for (var dy = 0u; dy < PER_THREAD; dy++) {
         for (var dx = 0u; dx < PER_THREAD; dx++) {
@@ -112,18 +134,22 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
                 while c + 1u < n && s.w > splits[c + 1u] {
                     c++;
                 }
+                if c != cur {
+                    flush(cur, lo, hi, cnt);
+                    cur = c;
+                    lo = vec3<u32>(0u);
+                    hi = vec3<u32>(0u);
+                    cnt = 0u;
+                }
                 let q = (u.light_view * vec4<f32>(s.xyz, 1.0)).xyz;
-                let w = c * 8u;
-                atomicMax(&acc[w], ~order_key(q.x));
-                atomicMax(&acc[w + 1u], ~order_key(q.y));
-                atomicMax(&acc[w + 2u], ~order_key(q.z));
-                atomicMax(&acc[w + 3u], order_key(q.x));
-                atomicMax(&acc[w + 4u], order_key(q.y));
-                atomicMax(&acc[w + 5u], order_key(q.z));
-                atomicAdd(&acc[w + 6u], 1u);
+                let k = vec3<u32>(order_key(q.x), order_key(q.y), order_key(q.z));
+                lo = max(lo, ~k);
+                hi = max(hi, k);
+                cnt += 1u;
             }
         }
     }
+    flush(cur, lo, hi, cnt);
     workgroupBarrier();
     let v = atomicLoad(&acc[li]);
     if v != 0u {
