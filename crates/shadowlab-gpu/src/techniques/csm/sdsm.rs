@@ -58,7 +58,7 @@ pub const SDSM_PARAMS: &[ParamDef] = &[
     RES_PARAM,
     ParamDef::number("lambda", fit::DEFAULT_LAMBDA as f64, 0.0, 1.0, "split blend between the samples' min and max depth: 1 logarithmic, 0 uniform; low: coarse near cascade", "Lauritzen et al. 2011 section 3.1 (log partitioning of the tight range)"),
     BLEND,
-    ParamDef::flag("snap", true, "snap each fitted box: half sides rounded up to 2^(1/16) steps (a fixed set of texel sizes, at most 9 % more area) and the origin to whole texels of that size, so the map does not shimmer while the samples' extent stays within a step", "Valient 2008 (stable CSM) applied to fitted bounds; steps: shadowlab_core::techniques::sdsm::SIZE_STEPS_PER_OCTAVE"),
+    ParamDef::flag("snap", true, "snap each fitted box: half sides rounded up to 2^(1/16) steps (a fixed set of texel sizes, at most 9 % more area), kept from the last frame until the samples need 2 steps less, and the origin moved by whole texels of that size: the map does not shimmer while the size holds", "Valient 2008 (stable CSM) applied to fitted bounds; steps: shadowlab_core::techniques::sdsm::SIZE_STEPS_PER_OCTAVE"),
     ParamDef::flag("delayed", false, "use the previous frame's reduction (splits and bounds, read back without a stall; frame 0 uses the frustum-slice fit) instead of this frame's (one sync); a sample the camera moved out of last frame's boxes falls to the next cascade, or counts as lit", "Lauritzen et al. 2011 (GPU-only fit) / shadowlab's recorded-frame seam (docs/bench/recorded_frame.md)"),
     BIAS_PARAM,
     NORMAL_OFFSET_PARAM,
@@ -269,8 +269,14 @@ pub(super) fn prepare(t: &mut Cascaded, gpu: &Gpu, f: &FrameInputs, rec: &mut Re
     };
     let scene = &f.scene.bounds;
     let slices = cascades::fit_cascades(&frustum, t.dir, scene, &splits, t.res, t.snap, Fit::Box);
-    let fitted: Vec<Option<FittedBox>> =
-        slices.iter().zip(&bounds).map(|(sl, b)| b.map(|b| fit::fit_to_samples(sl, &b, scene, t.res, t.snap, s.margin))).collect();
+    // the previous frame's sizes, for the snapped sizes' hysteresis
+    let prev: Vec<Option<glam::Vec2>> = (0..count).map(|i| s.fitted.get(i).copied().flatten().map(|fb| fb.extent)).collect();
+    let fitted: Vec<Option<FittedBox>> = slices
+        .iter()
+        .zip(&bounds)
+        .zip(prev)
+        .map(|((sl, b), p)| b.map(|b| fit::fit_to_samples(sl, &b, scene, t.res, t.snap, s.margin, p)))
+        .collect();
     let boxes: Vec<(Mat4, f32)> =
         slices.iter().zip(&fitted).map(|(sl, fb)| fb.map_or((sl.view_proj, sl.texel), |fb| (fb.view_proj, fb.max_texel()))).collect();
     (s.bounds, s.fitted, s.source) = (bounds, fitted, source);
