@@ -24,6 +24,7 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &filtered::EVSM_INFO,
     &filtered::MSM_INFO,
     &csm::INFO,
+    &csm::SDSM_INFO,
     &iasm::INFO,
     &cube::INFO,
     &cube::NOTW_INFO,

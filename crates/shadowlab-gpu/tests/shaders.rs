@@ -389,3 +389,16 @@ fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {
     }
     assert_eq!(most.len(), FOLDERS.len(), "a folder of FOLDERS no longer needs more than the default: {most:?}");
 }
+
+#[test]
+fn sdsm_layout_matches_wgsl() {
+    use shadowlab_gpu::techniques::csm::SdsmReduce;
+    let all = shadowlab_gpu::registry::shaders();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    check_all(
+        &get("csm/sdsm_bounds.wgsl"),
+        "SdsmReduce",
+        size_of::<SdsmReduce>(),
+        fields!(SdsmReduce; light_view, near, far, count, lambda, steps, pad0, pad1, pad2),
+    );
+}

@@ -10,6 +10,7 @@
 //! - `lt`: leak tracing's LTT test, temporal mask bits and cascades
 //! - `mdsm`: multiple-depth selection and PCF(k,n)
 //! - `min_sm`: rotating calipers and the minimal shadow frustum (MSF)
+//! - `sdsm`: sample-distribution splits and boxes fitted to the samples (`sdsm`, GPU half in `csm/`)
 //! - `sv`: silhouette edges of closed meshes for shadow volumes
 //! - `warp`: RTW and NoTW warping functions
 
@@ -21,5 +22,6 @@ pub mod iasm;
 pub mod lt;
 pub mod mdsm;
 pub mod min_sm;
+pub mod sdsm;
 pub mod sv;
 pub mod warp;

@@ -8,12 +8,14 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::{binding, Gpu};
 
+/// `order_key` / `from_order_key` (WGSL), shared by the reductions that use them.
+pub const ORDER_KEY_WGSL: &str = include_str!("order_key.wgsl");
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
 /// Pixels per thread side (`PER_THREAD` in reduce.wgsl).
 const PER_THREAD: u32 = 4;
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("reduce/reduce.wgsl", REDUCE_WGSL.to_string())]
+    vec![("reduce/reduce.wgsl", format!("{ORDER_KEY_WGSL}{REDUCE_WGSL}"))]
 }
 
 /// WGSL `ReduceParams`.
@@ -41,7 +43,7 @@ impl MinMax {
             wgpu::ShaderStages::COMPUTE,
             &[binding::uniform(), binding::texture_float(), binding::storage(true), binding::storage(false)],
         );
-        let pipeline = gpu.compute_pipeline(label, REDUCE_WGSL, "main", &[&layout]);
+        let pipeline = gpu.compute_pipeline(label, &format!("{ORDER_KEY_WGSL}{REDUCE_WGSL}"), "main", &[&layout]);
         let params = gpu.uniform(label, &ReduceParams { channel: channel.min(3), _pad: [0; 3] });
         let result = gpu.storage(label, 8);
         MinMax { pipeline, layout, params, result }

@@ -2,7 +2,7 @@
 // (e.g. the G-buffer's linear view depth over the evaluated pixels). Each thread folds a
 // PER_THREAD x PER_THREAD block of pixels (a workgroup covers 32 x 32), then a workgroup tree
 // reduction in shared memory, then two atomics per workgroup on keys that
-// order like the floats (`order_key`). The min is kept as the complement of its key so that
+// order like the floats (`order_key`, order_key.wgsl, prepended). The min is kept as the complement of its key so that
 // both words start at 0 (`clear_buffer`) and both reduce with atomicMax.
 
 struct ReduceParams {
@@ -21,15 +21,6 @@ struct ReduceParams {
 
 var<workgroup> lo: array<u32, 64>;
 var<workgroup> hi: array<u32, 64>;
-
-// Monotonic map f32 -> u32: negative floats flipped entirely, positive ones get the sign bit.
-fn order_key(x: f32) -> u32 {
-    let b = bitcast<u32>(x);
-    if (b & 0x80000000u) != 0u {
-        return ~b;
-    }
-    return b | 0x80000000u;
-}
 
 const PER_THREAD: u32 = 4u;
 

@@ -9,9 +9,12 @@
 //! the GPU and reads it back (one device sync, timed as `csm.readback`), then fits the boxes to
 //! the view's camera on the CPU (`shadowlab_core::techniques::csm`); `render` draws
 //! the scene once per cascade; `evaluate` picks the cascade per pixel by view depth.
+//!
+//! `sdsm` (sdsm.rs) is the same type with its boxes fitted to the view samples instead.
 
 mod params;
 mod report;
+mod sdsm;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
@@ -20,6 +23,7 @@ use shadowlab_core::params::ParamValues;
 use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 
 pub use params::*;
+pub use sdsm::{SdsmReduce, OUT_BYTES as SDSM_BOUNDS_BYTES, SDSM_INFO, SDSM_PARAMS};
 
 use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, MinMax};
@@ -83,6 +87,8 @@ pub struct CsmParams {
 const PROBE_BYTES: u64 = 8;
 
 pub struct Cascaded {
+    /// `csm` or `sdsm`: the stage names' prefix.
+    name: &'static str,
     count: usize,
     res: u32,
     lambda: f32,
@@ -111,6 +117,8 @@ pub struct Cascaded {
     sampler: wgpu::Sampler,
     reduce: MinMax,
     probe: wgpu::Buffer,
+    /// `sdsm`: the boxes fitted to the samples' bounds.
+    sample_fit: Option<sdsm::SampleFit>,
 }
 
 fn texture_depth_array() -> wgpu::BindingType {
@@ -122,13 +130,10 @@ fn texture_depth_array() -> wgpu::BindingType {
 }
 
 impl Cascaded {
+    /// `csm`.
     pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<Cascaded, GpuError> {
-        let Light::Directional { direction } = *light else {
-            return Err(GpuError::Invalid(format!("csm supports directional lights only (got a {} light)", light.kind())));
-        };
-        let count = p.get_u32("cascades") as usize;
-        let res = p.get_u32("res");
-        gpu.check_size(res, res, "cascade map")?;
+        let mut t = Cascaded::build(gpu, scene, p, light, "csm")?;
+        let count = t.count;
         let manual: Vec<f32> = ["split1", "split2", "split3"].iter().map(|k| p.get(k) as f32).filter(|x| *x > 0.0).collect();
         if !manual.is_empty() && manual.len() + 1 != count {
             return Err(GpuError::Invalid(format!(
@@ -138,6 +143,28 @@ impl Cascaded {
                 manual.len()
             )));
         }
+        t.manual = manual;
+        t.fit = if p.choice("fit") == "sphere" { Fit::Sphere } else { Fit::Box };
+        t.tighten = p.get_bool("tighten");
+        t.delayed = (t.tighten && p.get_bool("delayed")).then(|| DelayedRead::new(gpu, "csm.delayed", PROBE_BYTES));
+        Ok(t)
+    }
+
+    /// `sdsm`: the cascades of `csm` fitted to the view samples (sdsm.rs).
+    pub fn new_sdsm(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<Cascaded, GpuError> {
+        let mut t = Cascaded::build(gpu, scene, p, light, "sdsm")?;
+        t.sample_fit = Some(sdsm::SampleFit::new(gpu, p, t.dir, t.count));
+        Ok(t)
+    }
+
+    /// What `csm` and `sdsm` share, from the parameters both declare.
+    fn build(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, name: &'static str) -> Result<Cascaded, GpuError> {
+        let Light::Directional { direction } = *light else {
+            return Err(GpuError::Invalid(format!("{name} supports directional lights only (got a {} light)", light.kind())));
+        };
+        let count = p.get_u32("cascades") as usize;
+        let res = p.get_u32("res");
+        gpu.check_size(res, res, "cascade map")?;
         let d = &gpu.device;
         let maps = raster::depth_target(gpu, "csm.maps", res, res, count as u32, wgpu::TextureUsages::empty());
         let params = CsmParams {
@@ -166,14 +193,15 @@ impl Cascaded {
         let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {
+            name,
             count,
             res,
             lambda: p.get("lambda") as f32,
-            manual,
+            manual: Vec::new(),
             snap: p.get_bool("snap"),
-            fit: if p.choice("fit") == "sphere" { Fit::Sphere } else { Fit::Box },
-            tighten: p.get_bool("tighten"),
-            delayed: (p.get_bool("tighten") && p.get_bool("delayed")).then(|| DelayedRead::new(gpu, "csm.delayed", PROBE_BYTES)),
+            fit: Fit::Box,
+            tighten: false,
+            delayed: None,
             pcf: p.get_u32("pcf"),
             dir: direction,
             params,
@@ -191,6 +219,7 @@ impl Cascaded {
             sampler,
             reduce: MinMax::new(gpu, "csm.reduce", 3),
             probe: gpu.storage("csm.probe", PROBE_BYTES),
+            sample_fit: None,
         })
     }
 
@@ -212,6 +241,9 @@ impl Cascaded {
 impl Technique for Cascaded {
     /// Depth reduction on the GPU and one readback (with `tighten`), the fit on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        if self.sample_fit.is_some() {
+            return sdsm::prepare(self, gpu, f, rec);
+        }
         self.depth_range = None;
         if let Some(d) = self.delayed.as_mut() {
             // the previous frame's range (None on the first frame: the whole frustum), then this
@@ -241,20 +273,18 @@ impl Technique for Cascaded {
             cascades::manual_splits(frustum.near, frustum.far, &self.manual).map_err(|e| GpuError::Invalid(format!("csm: {e}")))?
         };
         self.boxes = cascades::fit_cascades(&frustum, self.dir, &f.scene.bounds, &splits, self.res, self.snap, self.fit);
-        for (i, b) in self.boxes.iter().enumerate() {
-            self.params.cascades[i] = CascadeU { view_proj: b.view_proj.to_cols_array_2d(), info: [b.texel, b.d0, b.d1, 0.0] };
-            rec.write_buffer(&self.depth_uniforms[i], 0, bytemuck::bytes_of(&b.view_proj.to_cols_array_2d()));
-        }
-        rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        let boxes: Vec<(Mat4, f32)> = self.boxes.iter().map(|b| (b.view_proj, b.texel)).collect();
+        self.upload(rec, &boxes, &splits);
         rec.cpu("csm.fit", t0.elapsed().as_secs_f64() * 1e3);
         Ok(())
     }
 
     fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let views: Vec<_> = (0..self.count as u32).map(|c| self.layer_view(c)).collect();
-        rec.stage("csm.render", |enc| {
+        let stage = format!("{}.render", self.name);
+        rec.stage(&stage, |enc| {
             for (c, view) in views.iter().enumerate() {
-                let mut pass = raster::begin_pass(enc, "csm.render", &[], view);
+                let mut pass = raster::begin_pass(enc, &stage, &[], view);
                 pass.set_pipeline(&self.depth_pipeline);
                 pass.set_bind_group(0, &self.depth_groups[c], &[]);
                 pass.set_bind_group(1, &f.scene.group, &[]);
@@ -278,6 +308,16 @@ impl Technique for Cascaded {
 }
 
 impl Cascaded {
+    /// Writes the cascades' (world -> light clip, world texel size) and their slices of view
+    /// depth (`splits`, n + 1) into the evaluation's and the depth passes' uniforms.
+    fn upload(&mut self, rec: &mut Recorder, boxes: &[(Mat4, f32)], splits: &[f32]) {
+        for (i, (view_proj, texel)) in boxes.iter().enumerate() {
+            self.params.cascades[i] = CascadeU { view_proj: view_proj.to_cols_array_2d(), info: [*texel, splits[i], splits[i + 1], 0.0] };
+            rec.write_buffer(&self.depth_uniforms[i], 0, bytemuck::bytes_of(&view_proj.to_cols_array_2d()));
+        }
+        rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+    }
+
     /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
     fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
@@ -300,7 +340,7 @@ impl Cascaded {
                 chosen.as_entire_binding(),
             ],
         );
-        self.eval.record(gpu, rec, "csm.evaluate", &self.counts, &group, w, h, counting);
+        self.eval.record(gpu, rec, &format!("{}.evaluate", self.name), &self.counts, &group, w, h, counting);
         Ok(())
     }
 }

@@ -1,5 +1,6 @@
 //! `csm`'s report: memory, per-cascade splits and texel sizes, sampling over all cascades,
-//! each cascade's depth and count maps, and the cascade each pixel used.
+//! each cascade's depth and count maps, and the cascade each pixel used; for `sdsm` also its
+//! fitted boxes against the frustum slices' (`SampleFit::counters`).
 
 use shadowlab_core::metrics::sampling_stats;
 
@@ -15,18 +16,29 @@ const COLOURS: [[u8; 3]; 8] =
 pub(super) fn report(t: &Cascaded, gpu: &Gpu) -> TechniqueReport {
     let texels = t.res as usize * t.res as usize;
     let counts: Vec<u32> = gpu.read_buffer_as(&t.counts, t.count * texels);
-    let mut r =
-        TechniqueReport { shadow_data_bytes: (t.count * texels * 4) as u64, sampling: Some(sampling_stats(&counts)), ..Default::default() };
+    // sdsm keeps its reduction's output too
+    let extra = if t.sample_fit.is_some() { super::sdsm::OUT_BYTES } else { 0 };
+    let mut r = TechniqueReport {
+        shadow_data_bytes: (t.count * texels * 4) as u64 + extra,
+        sampling: Some(sampling_stats(&counts)),
+        ..Default::default()
+    };
     let c = &mut r.counters;
     c.insert("cascades".into(), t.count as f64);
     c.insert("shadow_map_texels".into(), (t.count * texels) as f64);
-    if let Some(b) = t.boxes.first() {
-        c.insert("split_0".into(), b.d0 as f64);
+    // the cascades as the evaluation used them (csm: the slice boxes; sdsm: the fitted ones,
+    // their larger texel side)
+    let used = &t.params.cascades[..t.boxes.len()];
+    if let Some(u) = used.first() {
+        c.insert("split_0".into(), u.info[1] as f64);
     }
-    for (i, b) in t.boxes.iter().enumerate() {
-        c.insert(format!("split_{}", i + 1), b.d1 as f64);
-        c.insert(format!("texel_{i}"), b.texel as f64);
-        c.insert(format!("box_side_{i}"), 2.0 * b.half as f64);
+    for (i, u) in used.iter().enumerate() {
+        c.insert(format!("split_{}", i + 1), u.info[2] as f64);
+        c.insert(format!("texel_{i}"), u.info[0] as f64);
+        c.insert(format!("box_side_{i}"), u.info[0] as f64 * t.res as f64);
+    }
+    if let Some(s) = &t.sample_fit {
+        s.counters(&t.boxes, c);
     }
     if let Some((lo, hi)) = t.depth_range {
         c.insert("gbuffer_depth_min".into(), lo as f64);
