@@ -11,6 +11,7 @@
 //! - `mdsm`: multiple-depth selection and PCF(k,n)
 //! - `min_sm`: rotating calipers and the minimal shadow frustum (MSF)
 //! - `sv`: silhouette edges of closed meshes for shadow volumes
+//! - `virtual_sm`: clipmap pages, level choice and page pool of `virtual`
 //! - `warp`: RTW and NoTW warping functions
 
 pub mod csm;
@@ -22,4 +23,5 @@ pub mod lt;
 pub mod mdsm;
 pub mod min_sm;
 pub mod sv;
+pub mod virtual_sm;
 pub mod warp;
