@@ -42,7 +42,7 @@ impl Clipmap {
     /// The clipmap of a light travelling along `dir` over `bounds`, windows centred on `eye`.
     /// `virtual_res` must be a multiple of `page_res`.
     pub fn new(dir: Vec3, bounds: &Bounds, eye: Vec3, levels: u32, virtual_res: u32, page_res: u32, extent0: f32) -> Clipmap {
-        assert!(levels >= 1 && page_res >= 1 && virtual_res % page_res == 0, "virtual_res must be a multiple of page_res");
+        assert!(levels >= 1 && page_res.is_power_of_two() && virtual_res % page_res == 0, "page_res: a power of two dividing virtual_res");
         let (right, up, dir) = light_basis(dir);
         let depths = bounds.corners().map(|c| c.dot(dir));
         let (lo, hi) = depths.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &d| (a.min(d), b.max(d)));
@@ -78,10 +78,20 @@ impl Clipmap {
         self.extent0 * (1u64 << k) as f32 / self.virtual_res as f32
     }
 
+    /// Texels per world unit at level k: `(virtual_res / extent0) 2^-k` (halving is exact, so
+    /// the GPU, given level 0's value, computes the same number).
+    pub fn inv_texel(&self, k: u32) -> f32 {
+        let mut s = self.virtual_res as f32 / self.extent0;
+        for _ in 0..k {
+            s *= 0.5;
+        }
+        s
+    }
+
     /// Global texel coordinates of world point p at level k (continuous).
     pub fn texel_coords(&self, k: u32, p: Vec3) -> Vec2 {
-        let t = self.texel(k);
-        Vec2::new(p.dot(self.right) / t, -p.dot(self.up) / t)
+        let s = self.inv_texel(k);
+        Vec2::new(p.dot(self.right) * s, -p.dot(self.up) * s)
     }
 
     /// Linear light depth of p (0 near the light, 1 far).
@@ -98,7 +108,7 @@ impl Clipmap {
 
     /// The page of global texel coordinates g (continuous) at any level.
     pub fn page_of(&self, g: Vec2) -> IVec2 {
-        (g / self.page_res as f32).floor().as_ivec2()
+        (g * (1.0 / self.page_res as f32)).floor().as_ivec2()
     }
 
     /// Whether page `pg` lies in level k's window.
@@ -124,6 +134,35 @@ impl Clipmap {
         let x = o.x + (sx - o.x).rem_euclid(n);
         let y = o.y + (sy - o.y).rem_euclid(n);
         PageKey { level: k as u32, x, y }
+    }
+
+    /// The pages view sample p marks (as mark.wgsl does): at the level its footprint asks for
+    /// (`level_for`), or the first coarser one whose window holds them, the pages under the
+    /// corners of the square of `reach` texels around p (the PCF taps after the normal offset);
+    /// and the same corners' pages of the coarsest level, so that a sample whose pages fall back
+    /// always finds a mapped coarser page. Empty where no window holds p.
+    pub fn sample_pages(&self, p: Vec3, footprint: f32, scale: f32, reach: f32) -> Vec<PageKey> {
+        let corners = |k: u32| {
+            let g = self.texel_coords(k, p);
+            [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(sx, sy)| self.page_of(g + Vec2::new(sx, sy) * reach))
+        };
+        let mut out = Vec::new();
+        let mut k = level_for(footprint, self.texel(0), scale, self.levels);
+        while k < self.levels {
+            let c = corners(k);
+            if c.iter().all(|pg| self.in_window(k, *pg)) {
+                out.extend(c.iter().map(|pg| PageKey { level: k, x: pg.x, y: pg.y }));
+                break;
+            }
+            k += 1;
+        }
+        let top = self.levels - 1;
+        if k < top {
+            out.extend(corners(top).iter().filter(|pg| self.in_window(top, **pg)).map(|pg| PageKey { level: top, x: pg.x, y: pg.y }));
+        }
+        out.sort();
+        out.dedup();
+        out
     }
 
     /// The orthographic view-projection of one page: its light-space square to NDC x/y in
@@ -163,16 +202,23 @@ impl Clipmap {
     }
 }
 
-/// The level a view sample asks for: `ceil(log2(footprint / t0)) + bias`, clamped to the
-/// levels, computed without a logarithm so that the GPU gives the same answer: the smallest
-/// integer L >= 0 with t0 2^L >= footprint (`footprint` = the pixel's world size at the sample).
-pub fn level_for(footprint: f32, texel0: f32, bias: i32, levels: u32) -> u32 {
-    let (mut l, mut t) = (0i32, texel0);
-    while l < 62 && t < footprint {
+/// The level a view sample asks for: `ceil(log2(footprint / t0) + bias)` (UE5's resolution
+/// LOD bias), clamped to the levels; computed without a logarithm so that the GPU gives the
+/// same answer: the smallest integer L >= 0 with `t0 2^L >= footprint 2^bias`
+/// (`footprint` = the pixel's world size at the sample; `scale` = [`bias_scale`]`(bias)`).
+pub fn level_for(footprint: f32, texel0: f32, scale: f32, levels: u32) -> u32 {
+    let f = footprint * scale;
+    let (mut l, mut t) = (0u32, texel0);
+    while l + 1 < levels && t < f {
         t *= 2.0;
         l += 1;
     }
-    (l + bias).clamp(0, levels as i32 - 1) as u32
+    l
+}
+
+/// `2^bias`, the footprint's factor for a resolution bias (negative: finer levels).
+pub fn bias_scale(bias: f32) -> f32 {
+    bias.exp2()
 }
 
 /// World size of one pixel per unit of distance from the eye: `2 tan(fov_y / 2) / height`.

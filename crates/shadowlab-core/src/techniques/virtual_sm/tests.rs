@@ -13,15 +13,15 @@ fn clipmap(eye: Vec3) -> Clipmap {
 
 #[test]
 fn level_is_the_ceiling_of_log2_of_footprint_over_texel_plus_bias() {
-    assert_eq!(level_for(0.5, 1.0, 0, 8), 0);
-    assert_eq!(level_for(1.0, 1.0, 0, 8), 0);
-    assert_eq!(level_for(1.5, 1.0, 0, 8), 1);
-    assert_eq!(level_for(2.0, 1.0, 0, 8), 1);
-    assert_eq!(level_for(2.001, 1.0, 0, 8), 2);
-    assert_eq!(level_for(100.0, 1.0, 0, 8), 7, "clamped to the coarsest level");
-    assert_eq!(level_for(5.0, 1.0, -1, 8), 2);
-    assert_eq!(level_for(1.5, 1.0, -3, 8), 0, "clamped to level 0");
-    assert_eq!(level_for(1.5, 1.0, 2, 8), 3);
+    assert_eq!(level_for(0.5, 1.0, bias_scale(0.0), 8), 0);
+    assert_eq!(level_for(1.0, 1.0, bias_scale(0.0), 8), 0);
+    assert_eq!(level_for(1.5, 1.0, bias_scale(0.0), 8), 1);
+    assert_eq!(level_for(2.0, 1.0, bias_scale(0.0), 8), 1);
+    assert_eq!(level_for(2.001, 1.0, bias_scale(0.0), 8), 2);
+    assert_eq!(level_for(100.0, 1.0, bias_scale(0.0), 8), 7, "clamped to the coarsest level");
+    assert_eq!(level_for(5.0, 1.0, bias_scale(-1.0), 8), 2);
+    assert_eq!(level_for(1.5, 1.0, bias_scale(-3.0), 8), 0, "clamped to level 0");
+    assert_eq!(level_for(1.5, 1.0, bias_scale(2.0), 8), 3);
     let pa = pixel_angle(90.0, 1000);
     assert!((pa - 0.002).abs() < 1e-7);
 }
@@ -162,4 +162,22 @@ fn cached_pages_keep_their_slots_and_stale_ones_are_rendered_again() {
     assert_eq!(cache.resident(), 4);
     cache.clear();
     assert_eq!(cache.allocate(&[key(0, 0, 0)]).render.len(), 1);
+}
+
+#[test]
+fn a_sample_marks_its_kernel_pages_and_the_coarsest_level() {
+    let c = clipmap(Vec3::ZERO);
+    let t0 = c.texel(0);
+    // footprint 3 t0: level 2; a point 1 texel of level 2 right of a page border (x = 0)
+    let p = c.right * (c.texel(2) * 1.0) - c.up * (c.texel(2) * 64.0);
+    let pages = c.sample_pages(p, 3.0 * t0, 1.0, 2.5);
+    let want = vec![key(3, -1, 0), key(3, 0, 0), key(2, -1, 0), key(2, 0, 0)];
+    assert_eq!(pages, want);
+    // reach 0.5: one page of level 2, one of level 3
+    assert_eq!(c.sample_pages(p, 3.0 * t0, 1.0, 0.5), vec![key(3, 0, 0), key(2, 0, 0)]);
+    // far from the eye, out of level 0's window (8 pages of 2 m around 0): level 1 instead
+    let q = c.right * 9.0 - c.up;
+    assert_eq!(c.sample_pages(q, 0.1 * t0, 1.0, 0.5), vec![key(3, 0, 0), key(1, 2, 0)]);
+    // outside every window: nothing
+    assert!(c.sample_pages(c.right * 1000.0, t0, 1.0, 0.5).is_empty());
 }
