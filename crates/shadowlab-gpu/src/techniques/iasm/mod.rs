@@ -12,7 +12,7 @@
 //! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::techniques::iasm`.
 
 mod atlas;
-mod chunks;
+pub(crate) mod chunks;
 mod gpu;
 mod images;
 mod plan;
