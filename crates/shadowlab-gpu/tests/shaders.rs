@@ -389,3 +389,13 @@ fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {
     }
     assert_eq!(most.len(), FOLDERS.len(), "a folder of FOLDERS no longer needs more than the default: {most:?}");
 }
+
+#[test]
+fn virtual_params_layout_matches_rust() {
+    use shadowlab_gpu::techniques::virtual_sm::VirtualParams;
+    let all = shadowlab_gpu::registry::shaders();
+    let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
+    let f = fields!(VirtualParams; right, up, dir, view, dims, bias, pcf, origins);
+    check_all(&get("virtual_sm/mark.wgsl"), "VirtualParams", size_of::<VirtualParams>(), f);
+    check_all(&get("virtual_sm/eval.wgsl"), "VirtualParams", size_of::<VirtualParams>(), f);
+}
