@@ -88,6 +88,18 @@ impl PageCache {
         keys.into_iter().filter(|k| self.resident.remove(k).is_some()).count()
     }
 
+    /// Forgets the resident pages for which `stale` holds; returns how many.
+    pub fn invalidate_if(&mut self, mut stale: impl FnMut(&PageKey) -> bool) -> usize {
+        let before = self.resident.len();
+        self.resident.retain(|k, _| !stale(k));
+        before - self.resident.len()
+    }
+
+    /// The resident pages, in priority order.
+    pub fn resident_pages(&self) -> impl Iterator<Item = &PageKey> {
+        self.resident.keys()
+    }
+
     /// Assigns slots to `requested` (any order, duplicates allowed) for a new frame.
     pub fn allocate(&mut self, requested: &[PageKey]) -> Allocation {
         self.frame += 1;

@@ -180,6 +180,19 @@ impl Clipmap {
         Mat4::from_cols(rx, ry, rz, Vec4::new(0.0, 0.0, 0.0, 1.0)).transpose()
     }
 
+    /// Whether page `key` (any level, inside its window or not) overlaps the light-space
+    /// rectangle of world box b (closed intervals: touching counts).
+    pub fn page_overlaps(&self, key: &PageKey, b: &Bounds) -> bool {
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for c in b.corners() {
+            let g = self.texel_coords(key.level, c);
+            lo = lo.min(g);
+            hi = hi.max(g);
+        }
+        let (a, z) = (self.page_of(lo), self.page_of(hi));
+        (a.x..=z.x).contains(&key.x) && (a.y..=z.y).contains(&key.y)
+    }
+
     /// Pages of level k overlapping the world box b (light-space rectangle of its corners),
     /// limited to the window, in (y, x) order.
     pub fn pages_touching(&self, k: u32, b: &Bounds) -> Vec<PageKey> {

@@ -160,6 +160,8 @@ fn cached_pages_keep_their_slots_and_stale_ones_are_rendered_again() {
     assert_eq!(c.render, vec![(key(0, 5, 0), 3), (key(0, 6, 0), 2)]);
     assert!(!cache.is_resident(&key(0, 2, 0)));
     assert_eq!(cache.resident(), 4);
+    assert_eq!(cache.invalidate_if(|k| k.x >= 5), 2);
+    assert_eq!(cache.resident_pages().copied().collect::<Vec<_>>(), vec![key(0, 0, 0), key(0, 1, 0)]);
     cache.clear();
     assert_eq!(cache.allocate(&[key(0, 0, 0)]).render.len(), 1);
 }

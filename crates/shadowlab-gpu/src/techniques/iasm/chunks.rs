@@ -14,7 +14,7 @@ use crate::{binding, Gpu, GpuError};
 /// World AABBs of chunks of `chunk` triangles in vertex order, computed once on the GPU (the
 /// lab keeps no CPU copy of the vertices). Returns the boxes; a chunk with a moving triangle
 /// gets `scene.bounds` (swept over the animation).
-pub(crate) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Vec<(Vec3, Vec3)>, GpuError> {
+pub(super) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Vec<(Vec3, Vec3)>, GpuError> {
     let n = scene.triangle_count.div_ceil(chunk).max(1) as usize;
     let d = &gpu.device;
     let init: Vec<u32> = (0..n).flat_map(|_| [u32::MAX, u32::MAX, u32::MAX, 0, 0, 0]).collect();

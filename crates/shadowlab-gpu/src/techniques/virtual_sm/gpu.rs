@@ -7,16 +7,16 @@ use shadowlab_core::params::ParamValues;
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, Allocation, Clipmap, PageCache, PageKey};
 
+use super::bounds::ChunkBounds;
 use super::{eval_source, mark_source, page_source, VirtualParams, MAX_LEVELS};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{view_layout, EvalPipelines, FrameInputs, Technique, TechniqueReport};
-use crate::techniques::iasm::chunks::chunk_bounds;
 use crate::{binding, raster, Gpu, GpuError};
 
 /// Triangles per culling chunk (iasm's chunks): a page draws the chunks whose light-space
 /// rectangle overlaps it. Smaller: tighter culling, more draws per page.
-const CHUNK_TRIANGLES: u32 = 1024;
+pub const CHUNK_TRIANGLES: u32 = 1024;
 
 /// A chunk: triangle range and its light-space rectangle (x, y of the light basis).
 struct Chunk {
@@ -24,7 +24,18 @@ struct Chunk {
     end: u32,
     lo: Vec2,
     hi: Vec2,
-    world: Bounds,
+}
+
+impl Chunk {
+    fn new(first: u32, end: u32, world: &Bounds, right: Vec3, up: Vec3) -> Chunk {
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for c in world.corners() {
+            let q = Vec2::new(c.dot(right), c.dot(up));
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        Chunk { first, end, lo, hi }
+    }
 }
 
 pub struct VirtualShadows {
@@ -46,6 +57,15 @@ pub struct VirtualShadows {
     pub(super) cols: u32,
     pub(super) rows: u32,
     chunks: Vec<Chunk>,
+    /// The chunks of moving triangles (`dynamic_first..`), bounded every frame; the last
+    /// frame's boxes (None before the first).
+    dynamic: Option<ChunkBounds>,
+    dynamic_boxes: Option<Vec<Bounds>>,
+    /// Index of the first dynamic chunk in `chunks`.
+    dynamic_chunk0: usize,
+    pub(super) invalidated: usize,
+    pub(super) invalidated_total: u64,
+    probe: wgpu::Buffer,
     pub(super) atlas: wgpu::Texture,
     uniform: wgpu::Buffer,
     pub(super) requests: wgpu::Buffer,
@@ -102,21 +122,31 @@ impl VirtualShadows {
         let page_pipeline = raster::depth_pipeline(gpu, "virtual.page", &page_source(), &[&page_layout, &scene.layout], scene.has_cutouts);
         let clear_pipeline = clear_pipeline(gpu, &page_source(), &[&page_layout, &scene.layout]);
         let (right, up, _) = shadowlab_core::techniques::iasm::light_basis(direction);
-        let chunks = chunk_bounds(gpu, scene, CHUNK_TRIANGLES)?
-            .into_iter()
-            .enumerate()
-            .map(|(i, (lo, hi))| {
-                let world = Bounds { min: lo, max: hi };
-                let (mut a, mut b) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-                for c in world.corners() {
-                    let q = Vec2::new(c.dot(right), c.dot(up));
-                    a = a.min(q);
-                    b = b.max(q);
-                }
+        // static chunks: bounded once here; moving ones: every frame (placeholder: the scene)
+        let mut chunks = Vec::new();
+        let split = scene.dynamic_first.min(scene.triangle_count);
+        if split > 0 {
+            let b = ChunkBounds::new(gpu, scene, "virtual.static_bounds", 0, split, CHUNK_TRIANGLES);
+            let mut enc = d.create_command_encoder(&Default::default());
+            b.record(&mut enc, scene);
+            gpu.submit(enc.finish());
+            gpu.take_error()?;
+            let boxes = ChunkBounds::parse(&gpu.read_buffer_as::<u32>(&b.boxes, b.count as usize * 6));
+            for (i, w) in boxes.iter().enumerate() {
                 let first = i as u32 * CHUNK_TRIANGLES;
-                Chunk { first, end: (first + CHUNK_TRIANGLES).min(scene.triangle_count), lo: a, hi: b, world }
-            })
-            .collect();
+                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(split), w, right, up));
+            }
+        }
+        let dynamic_chunk0 = chunks.len();
+        let dynamic = (split < scene.triangle_count)
+            .then(|| ChunkBounds::new(gpu, scene, "virtual.dynamic_bounds", split, scene.triangle_count, CHUNK_TRIANGLES));
+        if let Some(b) = &dynamic {
+            for i in 0..b.count {
+                let first = split + i * CHUNK_TRIANGLES;
+                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(scene.triangle_count), &scene.bounds, right, up));
+            }
+        }
+        let probe = gpu.storage("virtual.probe", table_len * 4 + dynamic.as_ref().map_or(0, |b| b.count as u64 * 24));
         let kernel_half = (p.get_u32("pcf") as f32 - 1.0) * 0.5;
         Ok(VirtualShadows {
             dir: direction,
@@ -137,6 +167,12 @@ impl VirtualShadows {
             cols,
             rows,
             chunks,
+            dynamic,
+            dynamic_boxes: None,
+            dynamic_chunk0,
+            invalidated: 0,
+            invalidated_total: 0,
+            probe,
             atlas,
             uniform,
             requests,
@@ -161,6 +197,16 @@ impl VirtualShadows {
     /// The last frame's allocation (mapped, rendered, cached, fallen-back pages).
     pub fn allocation(&self) -> &Allocation {
         &self.alloc
+    }
+
+    /// The page pool and its resident pages.
+    pub fn cache(&self) -> &PageCache {
+        &self.cache
+    }
+
+    /// Resident pages the last frame dropped because a moving chunk swept over them.
+    pub fn invalidated(&self) -> usize {
+        self.invalidated
     }
 
     /// The pages requested in the last frame (priority order, from the GPU's marks).
@@ -230,12 +276,41 @@ impl Technique for VirtualShadows {
         rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
         let group =
             f.view_group(gpu, "virtual.mark", &self.mark_layout, &[self.uniform.as_entire_binding(), self.requests.as_entire_binding()]);
+        let table_bytes = c.table_len() as u64 * 4;
         rec.stage("virtual.mark", |enc| {
             enc.clear_buffer(&self.requests, 0, None);
             gpu.dispatch_2d(enc, "virtual.mark", &self.mark, &[&group], f.gbuffer.width, f.gbuffer.height);
+            enc.copy_buffer_to_buffer(&self.requests, 0, &self.probe, 0, table_bytes);
+            if let Some(b) = &self.dynamic {
+                b.record(enc, f.scene);
+                enc.copy_buffer_to_buffer(&b.boxes, 0, &self.probe, table_bytes, b.count as u64 * 24);
+            }
         });
-        let flags: Vec<u32> = rec.read_buffer_as(&self.requests, c.table_len(), "virtual.readback");
+        let words = c.table_len() + self.dynamic.as_ref().map_or(0, |b| b.count as usize * 6);
+        let probe: Vec<u32> = rec.read_buffer_as(&self.probe, words, "virtual.readback");
         let t0 = std::time::Instant::now();
+        let (flags, boxes) = probe.split_at(c.table_len());
+        self.invalidated = 0;
+        if self.dynamic.is_some() {
+            let now = ChunkBounds::parse(boxes);
+            // a chunk that moved invalidates the resident pages its old and new boxes cover
+            if let Some(before) = &self.dynamic_boxes {
+                for (a, b) in before.iter().zip(&now) {
+                    if a != b {
+                        let mut swept = *a;
+                        swept.grow(b.min);
+                        swept.grow(b.max);
+                        self.invalidated += self.cache.invalidate_if(|k| c.page_overlaps(k, &swept));
+                    }
+                }
+            }
+            for (i, b) in now.iter().enumerate() {
+                let ch = &mut self.chunks[self.dynamic_chunk0 + i];
+                *ch = Chunk::new(ch.first, ch.end, b, c.right, c.up);
+            }
+            self.dynamic_boxes = Some(now);
+        }
+        self.invalidated_total += self.invalidated as u64;
         let mut req: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f != 0).map(|(i, _)| c.key_of_index(i)).collect();
         req.sort();
         self.alloc = self.cache.allocate(&req);
@@ -312,7 +387,7 @@ impl VirtualShadows {
         let (lo, hi) = Self::page_rect(c, k);
         let mut out: Vec<(u32, u32)> = Vec::new();
         for ch in &self.chunks {
-            if ch.hi.x < lo.x || ch.lo.x > hi.x || ch.hi.y < lo.y || ch.lo.y > hi.y || ch.world.min.x > ch.world.max.x {
+            if ch.hi.x < lo.x || ch.lo.x > hi.x || ch.hi.y < lo.y || ch.lo.y > hi.y {
                 continue;
             }
             match out.last_mut() {

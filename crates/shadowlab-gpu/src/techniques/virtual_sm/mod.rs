@@ -12,12 +12,13 @@
 //! the new pages, each with its own orthographic frustum into its slot, with the scene's chunks
 //! culled per page; `evaluate` looks every PCF tap up through the page table (eval.wgsl).
 
+mod bounds;
 mod gpu;
 mod params;
 mod report;
 
 use bytemuck::{Pod, Zeroable};
-pub use gpu::VirtualShadows;
+pub use gpu::{VirtualShadows, CHUNK_TRIANGLES};
 pub use params::*;
 
 use crate::shaders::compose_depth;

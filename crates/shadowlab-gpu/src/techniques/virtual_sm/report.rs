@@ -26,6 +26,8 @@ pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
     c.insert("pages_fallen_back".into(), a.fallen_back.len() as f64);
     c.insert("pages_rendered_total".into(), t.rendered_total as f64);
     c.insert("frames".into(), t.frames as f64);
+    c.insert("pages_invalidated".into(), t.invalidated as f64);
+    c.insert("pages_invalidated_total".into(), t.invalidated_total as f64);
     c.insert("pool_pages".into(), slots as f64);
     c.insert("pool_bytes".into(), pool_bytes as f64);
     c.insert("page_table_bytes".into(), table_bytes as f64);
