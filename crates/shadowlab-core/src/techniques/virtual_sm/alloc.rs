@@ -38,6 +38,43 @@ impl Ord for PageKey {
     }
 }
 
+/// The requested pages plus the fallback pages a full pool needs: while the first `slots`
+/// pages in priority order leave some requested pages out, each left-out page of level k adds
+/// the `candidates` of level k + 1 within one page of its parent (the pages its samples would
+/// read one level coarser: mark.wgsl flags them as candidates), until nothing more is added.
+/// Without a full pool this is `requested`. Sorted, without duplicates.
+pub fn with_fallbacks(requested: &[PageKey], candidates: &[PageKey], slots: usize) -> Vec<PageKey> {
+    let mut req: Vec<PageKey> = requested.to_vec();
+    req.sort();
+    req.dedup();
+    let mut pending: std::collections::BTreeSet<PageKey> = candidates.iter().copied().collect();
+    for k in &req {
+        pending.remove(k);
+    }
+    let mut done_from = slots;
+    while req.len() > slots && !pending.is_empty() {
+        // parents (with their neighbours) of the pages left out
+        let wanted: std::collections::BTreeSet<(u32, i32, i32)> = req[slots.min(done_from)..]
+            .iter()
+            .flat_map(|f| {
+                let (px, py) = (f.x.div_euclid(2), f.y.div_euclid(2));
+                (-1..=1).flat_map(move |dy| (-1..=1).map(move |dx| (f.level + 1, px + dx, py + dy)))
+            })
+            .collect();
+        let add: Vec<PageKey> = pending.iter().filter(|c| wanted.contains(&(c.level, c.x, c.y))).copied().collect();
+        if add.is_empty() {
+            break;
+        }
+        for a in &add {
+            pending.remove(a);
+        }
+        req.extend(add);
+        req.sort();
+        done_from = slots;
+    }
+    req
+}
+
 /// One frame's outcome.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Allocation {

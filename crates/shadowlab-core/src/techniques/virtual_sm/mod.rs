@@ -13,7 +13,7 @@
 //! Stored depth: orthographic, linear, 0 = near the light.
 
 mod alloc;
-pub use alloc::{Allocation, PageCache, PageKey};
+pub use alloc::{with_fallbacks, Allocation, PageCache, PageKey};
 
 use glam::{IVec2, Mat4, Vec2, Vec3, Vec4};
 

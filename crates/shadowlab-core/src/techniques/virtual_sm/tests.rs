@@ -183,3 +183,26 @@ fn a_sample_marks_its_kernel_pages_and_the_coarsest_level() {
     // outside every window: nothing
     assert!(c.sample_pages(c.right * 1000.0, t0, 1.0, 0.5).is_empty());
 }
+
+#[test]
+fn left_out_pages_bring_their_coarser_candidates() {
+    // 3 slots; five level-0 pages wanted; candidates at level 1 near their parents and far away
+    let req = [key(0, 0, 0), key(0, 1, 0), key(0, 2, 0), key(0, 3, 0), key(0, 8, 8)];
+    let cand = [key(1, 1, 0), key(1, 0, 0), key(1, 4, 4), key(1, 20, 20), key(2, 0, 0)];
+    // room for everything: nothing added
+    assert_eq!(with_fallbacks(&req, &cand, 5), {
+        let mut r = req.to_vec();
+        r.sort();
+        r
+    });
+    let out = with_fallbacks(&req, &cand, 3);
+    // the two level-1 candidates near parents (0,0)/(1,0) come first; then (1,4,4) for (0,8,8)
+    // once it is left out; (1,20,20) is near nothing, (2,0,0) is two levels up
+    assert_eq!(&out[..3], &[key(1, 0, 0), key(1, 1, 0), key(1, 4, 4)]);
+    assert!(!out.contains(&key(1, 20, 20)) && !out.contains(&key(2, 0, 0)));
+    assert_eq!(out.len(), 8);
+    // the allocation then maps the coarse ones and counts the finest as fallen back
+    let a = PageCache::new(3).allocate(&out);
+    assert_eq!(a.mapped.iter().map(|m| m.0).collect::<Vec<_>>(), vec![key(1, 0, 0), key(1, 1, 0), key(1, 4, 4)]);
+    assert_eq!(a.fallen_back.len(), 5);
+}

@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 use shadowlab_core::scene::Bounds;
-use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, Allocation, Clipmap, PageCache, PageKey};
+use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, with_fallbacks, Allocation, Clipmap, PageCache, PageKey};
 
 use super::bounds::ChunkBounds;
 use super::{eval_source, mark_source, page_source, VirtualParams, MAX_LEVELS};
@@ -64,6 +64,8 @@ pub struct VirtualShadows {
     /// Index of the first dynamic chunk in `chunks`.
     dynamic_chunk0: usize,
     pub(super) invalidated: usize,
+    /// Fallback pages (one level coarser) the last frame added for pages a full pool left out.
+    pub(super) fallback_added: usize,
     pub(super) invalidated_total: u64,
     probe: wgpu::Buffer,
     pub(super) atlas: wgpu::Texture,
@@ -94,7 +96,8 @@ impl VirtualShadows {
         }
         let max = gpu.limits.max_texture_dimension_2d;
         let slots = (p.get("pool_mib") * 1048576.0 / (page_res as f64 * page_res as f64 * 4.0)).floor() as u32;
-        let cols = slots.min(max / page_res).max(1);
+        // near-square atlas: a power-of-two column count around sqrt(slots), full rows only
+        let cols = ((slots as f64).sqrt().ceil() as u32).next_power_of_two().min(max / page_res).max(1);
         let rows = (slots / cols).min(max / page_res);
         if rows == 0 {
             return Err(GpuError::Invalid(format!("virtual: pool_mib {} holds no page of {page_res}^2", p.get("pool_mib"))));
@@ -171,6 +174,7 @@ impl VirtualShadows {
             dynamic_boxes: None,
             dynamic_chunk0,
             invalidated: 0,
+            fallback_added: 0,
             invalidated_total: 0,
             probe,
             atlas,
@@ -311,9 +315,12 @@ impl Technique for VirtualShadows {
             self.dynamic_boxes = Some(now);
         }
         self.invalidated_total += self.invalidated as u64;
-        let mut req: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f != 0).map(|(i, _)| c.key_of_index(i)).collect();
+        let mut req: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f & 1 != 0).map(|(i, _)| c.key_of_index(i)).collect();
         req.sort();
-        self.alloc = self.cache.allocate(&req);
+        let cand: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f == 2).map(|(i, _)| c.key_of_index(i)).collect();
+        let all = with_fallbacks(&req, &cand, self.cache.slots() as usize);
+        self.fallback_added = all.len() - req.len();
+        self.alloc = self.cache.allocate(&all);
         self.requested = req;
         let mut table = vec![0u32; c.table_len()];
         for (k, s) in &self.alloc.mapped {

@@ -27,6 +27,7 @@ pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
     c.insert("pages_rendered_total".into(), t.rendered_total as f64);
     c.insert("frames".into(), t.frames as f64);
     c.insert("pages_invalidated".into(), t.invalidated as f64);
+    c.insert("pages_fallback_added".into(), t.fallback_added as f64);
     c.insert("pages_invalidated_total".into(), t.invalidated_total as f64);
     c.insert("pool_pages".into(), slots as f64);
     c.insert("pool_bytes".into(), pool_bytes as f64);
@@ -46,8 +47,9 @@ pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
     if !a.fallen_back.is_empty() {
         let finest = a.fallen_back.iter().map(|p| p.level).min().unwrap_or(0);
         r.degraded.push(format!(
-            "virtual: page pool full ({slots} pages): {} requested pages fell back to coarser levels (finest level {finest})",
-            a.fallen_back.len()
+            "virtual: page pool full ({slots} pages): {} pages fell back to coarser levels (finest level {finest}; {} fallback pages added)",
+            a.fallen_back.len(),
+            t.fallback_added
         ));
     }
     if unresolved > 0 {
