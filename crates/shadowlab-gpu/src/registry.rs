@@ -6,7 +6,7 @@ use shadowlab_core::light::Light;
 use shadowlab_core::params::{ParamValues, TechniqueSpec};
 
 use crate::technique::TechniqueInfo;
-use crate::techniques::{csm, cube, dpsm, filtered, iasm, lt, mdsm, min_sm, sm, sv, warp};
+use crate::techniques::{csm, cube, dpsm, filtered, iasm, lt, mdsm, min_sm, sm, sv, virtual_sm, warp};
 use crate::GpuError;
 
 /// Every technique, in listing order.
@@ -33,6 +33,7 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &lt::LT_INFO,
     &lt::LTT_INFO,
     &lt::HYBRID_INFO,
+    &virtual_sm::INFO,
 ];
 
 /// (file name, composed source) of every shader the crate uses: the shared passes' and every

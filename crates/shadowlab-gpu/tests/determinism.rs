@@ -98,3 +98,17 @@ fn every_technique_twice_on_the_stress_scenes() {
         assert!(ran.iter().any(|w| w.starts_with(&format!("{} on eaves", info.name))), "{} never ran on eaves", info.name);
     }
 }
+
+/// `virtual` with a pool too small for its pages: the finest fall back, counted, and two fresh
+/// runs give the same bits (the allocation follows page order, not the marking's atomics).
+#[test]
+fn virtual_pool_exhaustion_is_deterministic_and_flagged() {
+    let Some(gpu) = gpu() else { return };
+    for (spec, full) in [("virtual:pool_mib=0.25,resolution_bias=-1", true), ("virtual", false)] {
+        let (a, b) = twice(&gpu, "courtyard", 0, spec);
+        assert!(bit_equal(&a, &b), "{spec}: two runs differ");
+        assert_eq!(a.report.counters, b.report.counters);
+        assert_eq!(!a.report.degraded.is_empty(), full, "{spec}: {:?}", a.report.degraded);
+        assert_eq!(a.report.counters["pages_fallen_back"] > 0.0, full);
+    }
+}

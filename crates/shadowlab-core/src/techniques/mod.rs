@@ -12,6 +12,7 @@
 //! - `min_sm`: rotating calipers and the minimal shadow frustum (MSF)
 //! - `sdsm`: sample-distribution splits and boxes fitted to the samples (`sdsm`, GPU half in `csm/`)
 //! - `sv`: silhouette edges of closed meshes for shadow volumes
+//! - `virtual_sm`: clipmap pages, level choice and page pool of `virtual`
 //! - `warp`: RTW and NoTW warping functions
 
 pub mod csm;
@@ -24,4 +25,5 @@ pub mod mdsm;
 pub mod min_sm;
 pub mod sdsm;
 pub mod sv;
+pub mod virtual_sm;
 pub mod warp;

@@ -13,4 +13,5 @@ pub mod min_sm;
 pub mod pictures;
 pub mod sm;
 pub mod sv;
+pub mod virtual_sm;
 pub mod warp;

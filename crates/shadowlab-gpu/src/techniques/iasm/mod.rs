@@ -15,7 +15,7 @@ mod atlas;
 mod chunks;
 mod gpu;
 mod images;
-mod plan;
+pub(crate) mod plan;
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::params::family;
@@ -30,7 +30,7 @@ const PARAMS_WGSL: &str = include_str!("params.wgsl");
 const ANALYSIS_WGSL: &str = include_str!("analysis.wgsl");
 const RENDER_WGSL: &str = include_str!("render.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
-const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
+pub(crate) const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
 const PROBE_WGSL: &str = include_str!("probe.wgsl");
 const ATLAS_WGSL: &str = include_str!("atlas.wgsl");
 const EVAL_ATLAS_WGSL: &str = include_str!("eval_atlas.wgsl");

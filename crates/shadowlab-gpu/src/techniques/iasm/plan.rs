@@ -18,7 +18,7 @@ pub struct TileStats {
     pub outside: u32,
 }
 
-pub(super) fn unkey(k: u32) -> f32 {
+pub(crate) fn unkey(k: u32) -> f32 {
     f32::from_bits(if k & 0x8000_0000 != 0 { k & 0x7fff_ffff } else { !k })
 }
 

@@ -1,0 +1,68 @@
+// Evaluation through the page table: the sample's level (choose_level), the `sm` bias family
+// in texels of that level, then each of the NxN PCF taps looked up through the page table
+// (a tap across a page border reads the neighbouring page: no guard band needed) and compared
+// with its atlas texel (lit where depth <= stored, as the comparison sampler of `sm`). Where a
+// tap's page is not mapped (fallen back) the whole kernel moves to the next coarser level.
+// No mapped level: lit (the allocation counts those pages; the report says so). With
+// COUNT_SAMPLES the samples are counted per level used (lab only).
+
+@group(0) @binding(6) var<uniform> vp: VirtualParams;
+@group(0) @binding(7) var<storage, read> page_table: array<u32>;
+@group(0) @binding(8) var atlas: texture_depth_2d;
+@group(0) @binding(9) var<storage, read_write> counts: array<atomic<u32>>;
+
+// Visibility of p from level k, or -1 where a tap's page is not mapped at k.
+fn lookup(k: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
+    let kw = i32(vp.pcf.x);
+    let half = f32(kw - 1) * 0.5;
+    let q = biased_point(p, n, l, 1.0 / inv_texel(k), vp.bias, half);
+    let g = texel_coords(k, q);
+    let z = light_depth(q);
+    if z > 1.0 {
+        return 1.0;
+    }
+    let pr = i32(vp.dims.z);
+    let cols = i32(vp.dims.w);
+    var lit = 0.0;
+    for (var y = 0; y < kw; y++) {
+        for (var x = 0; x < kw; x++) {
+            let tap = vec2<i32>(floor(g + vec2<f32>(f32(x), f32(y)) - half));
+            let pg = vec2<i32>(floor(vec2<f32>(tap) * (1.0 / f32(pr))));
+            if !in_window(k, pg) {
+                return -1.0;
+            }
+            let e = page_table[table_index(k, pg)];
+            if e == 0u {
+                return -1.0;
+            }
+            let slot = i32(e - 1u);
+            let texel = vec2<i32>(slot % cols, slot / cols) * pr + (tap - pg * pr);
+            let d = textureLoad(atlas, texel, 0);
+            lit += select(0.0, 1.0, z <= d);
+        }
+    }
+    return lit / f32(kw * kw);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let l = to_light(light, s.p);
+    var v = 1.0;
+    var used = vp.dims.x;
+    for (var k = choose_level(s.p); k < vp.dims.x; k++) {
+        let r = lookup(k, s.p, s.n, l);
+        if r >= 0.0 {
+            v = r;
+            used = k;
+            break;
+        }
+    }
+    if COUNT_SAMPLES {
+        atomicAdd(&counts[used], 1u);
+    }
+    visibility[s.i] = v;
+}

@@ -1,0 +1,424 @@
+//! `virtual`'s passes: marking, the readback and CPU allocation (`prepare`), page rendering
+//! into the atlas (`render`), evaluation through the page table (`evaluate`).
+
+use glam::{Vec2, Vec3};
+use shadowlab_core::light::Light;
+use shadowlab_core::params::ParamValues;
+use shadowlab_core::scene::Bounds;
+use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, with_fallbacks, Allocation, Clipmap, PageCache, PageKey};
+
+use super::bounds::ChunkBounds;
+use super::{eval_source, mark_source, page_source, VirtualParams, MAX_LEVELS};
+use crate::record::Recorder;
+use crate::scene_gpu::GpuScene;
+use crate::technique::{view_layout, EvalPipelines, FrameInputs, Technique, TechniqueReport};
+use crate::{binding, raster, Gpu, GpuError};
+
+/// Triangles per culling chunk (iasm's chunks): a page draws the chunks whose light-space
+/// rectangle overlaps it. Smaller: tighter culling, more draws per page.
+pub const CHUNK_TRIANGLES: u32 = 1024;
+
+/// A chunk: triangle range and its light-space rectangle (x, y of the light basis).
+struct Chunk {
+    first: u32,
+    end: u32,
+    lo: Vec2,
+    hi: Vec2,
+}
+
+impl Chunk {
+    fn new(first: u32, end: u32, world: &Bounds, right: Vec3, up: Vec3) -> Chunk {
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for c in world.corners() {
+            let q = Vec2::new(c.dot(right), c.dot(up));
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        Chunk { first, end, lo, hi }
+    }
+}
+
+pub struct VirtualShadows {
+    pub(super) dir: Vec3,
+    pub(super) levels: u32,
+    pub(super) virtual_res: u32,
+    pub(super) page_res: u32,
+    pub(super) extent0: f32,
+    pub(super) bias_scale: f32,
+    pub(super) reach: f32,
+    pub(super) params: VirtualParams,
+    pub(super) clipmap: Option<Clipmap>,
+    pub(super) cache: PageCache,
+    pub(super) alloc: Allocation,
+    /// Requested pages of the last frame (priority order).
+    pub(super) requested: Vec<PageKey>,
+    pub(super) frames: u64,
+    pub(super) rendered_total: u64,
+    pub(super) cols: u32,
+    pub(super) rows: u32,
+    chunks: Vec<Chunk>,
+    /// The chunks of moving triangles (`dynamic_first..`), bounded every frame; the last
+    /// frame's boxes (None before the first).
+    dynamic: Option<ChunkBounds>,
+    dynamic_boxes: Option<Vec<Bounds>>,
+    /// Index of the first dynamic chunk in `chunks`.
+    dynamic_chunk0: usize,
+    pub(super) invalidated: usize,
+    /// Fallback pages (one level coarser) the last frame added for pages a full pool left out.
+    pub(super) fallback_added: usize,
+    pub(super) invalidated_total: u64,
+    probe: wgpu::Buffer,
+    pub(super) atlas: wgpu::Texture,
+    uniform: wgpu::Buffer,
+    pub(super) requests: wgpu::Buffer,
+    page_table: wgpu::Buffer,
+    page_mats: wgpu::Buffer,
+    pub(super) counts: wgpu::Buffer,
+    mark_layout: wgpu::BindGroupLayout,
+    mark: wgpu::ComputePipeline,
+    eval_layout: wgpu::BindGroupLayout,
+    eval: EvalPipelines,
+    page_group: wgpu::BindGroup,
+    page_pipeline: wgpu::RenderPipeline,
+    clear_pipeline: wgpu::RenderPipeline,
+}
+
+impl VirtualShadows {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<VirtualShadows, GpuError> {
+        let Light::Directional { direction } = *light else {
+            return Err(GpuError::Invalid(format!("virtual supports directional lights only (got a {} light)", light.kind())));
+        };
+        let (virtual_res, page_res, levels) = (p.get_u32("virtual_res"), p.get_u32("page_res"), p.get_u32("levels"));
+        if !page_res.is_power_of_two() || virtual_res % page_res != 0 {
+            return Err(GpuError::Invalid(format!(
+                "virtual: page_res {page_res} must be a power of two dividing virtual_res {virtual_res}"
+            )));
+        }
+        let max = gpu.limits.max_texture_dimension_2d;
+        let slots = (p.get("pool_mib") * 1048576.0 / (page_res as f64 * page_res as f64 * 4.0)).floor() as u32;
+        // near-square atlas: a power-of-two column count around sqrt(slots), full rows only
+        let cols = ((slots as f64).sqrt().ceil() as u32).next_power_of_two().min(max / page_res).max(1);
+        let rows = (slots / cols).min(max / page_res);
+        if rows == 0 {
+            return Err(GpuError::Invalid(format!("virtual: pool_mib {} holds no page of {page_res}^2", p.get("pool_mib"))));
+        }
+        let d = &gpu.device;
+        let atlas = raster::depth_target(gpu, "virtual.atlas", cols * page_res, rows * page_res, 1, wgpu::TextureUsages::empty());
+        let pages_per_side = virtual_res / page_res;
+        let table_len = (levels * pages_per_side * pages_per_side) as u64;
+        let params = VirtualParams::zeroed_for(p, levels, pages_per_side, page_res, cols);
+        let uniform = gpu.uniform("virtual.params", &params);
+        let requests = gpu.storage("virtual.requests", table_len * 4);
+        let page_table = gpu.storage("virtual.page_table", table_len * 4);
+        let page_mats = gpu.storage("virtual.page_view_proj", (cols * rows) as u64 * 64);
+        let counts = gpu.storage("virtual.counts", (MAX_LEVELS as u64 + 1) * 4);
+        let mark_layout = view_layout(gpu, "virtual.mark", &[binding::uniform(), binding::storage(false)]);
+        let mark = gpu.compute_pipeline("virtual.mark", &mark_source(), "main", &[&mark_layout]);
+        let eval_layout = view_layout(
+            gpu,
+            "virtual.eval",
+            &[binding::uniform(), binding::storage(true), binding::texture_depth(), binding::storage(false)],
+        );
+        let eval = EvalPipelines::new(gpu, "virtual.eval", &eval_source(), &eval_layout, &[]);
+        let page_layout = binding::layout(d, "virtual.page", wgpu::ShaderStages::VERTEX, &[binding::storage(true)]);
+        let page_group = binding::group(d, "virtual.page", &page_layout, &[page_mats.as_entire_binding()]);
+        let page_pipeline = raster::depth_pipeline(gpu, "virtual.page", &page_source(), &[&page_layout, &scene.layout], scene.has_cutouts);
+        let clear_pipeline = clear_pipeline(gpu, &page_source(), &[&page_layout, &scene.layout]);
+        let (right, up, _) = shadowlab_core::techniques::iasm::light_basis(direction);
+        // static chunks: bounded once here; moving ones: every frame (placeholder: the scene)
+        let mut chunks = Vec::new();
+        let split = scene.dynamic_first.min(scene.triangle_count);
+        if split > 0 {
+            let b = ChunkBounds::new(gpu, scene, "virtual.static_bounds", 0, split, CHUNK_TRIANGLES);
+            let mut enc = d.create_command_encoder(&Default::default());
+            b.record(&mut enc, scene);
+            gpu.submit(enc.finish());
+            gpu.take_error()?;
+            let boxes = ChunkBounds::parse(&gpu.read_buffer_as::<u32>(&b.boxes, b.count as usize * 6));
+            for (i, w) in boxes.iter().enumerate() {
+                let first = i as u32 * CHUNK_TRIANGLES;
+                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(split), w, right, up));
+            }
+        }
+        let dynamic_chunk0 = chunks.len();
+        let dynamic = (split < scene.triangle_count)
+            .then(|| ChunkBounds::new(gpu, scene, "virtual.dynamic_bounds", split, scene.triangle_count, CHUNK_TRIANGLES));
+        if let Some(b) = &dynamic {
+            for i in 0..b.count {
+                let first = split + i * CHUNK_TRIANGLES;
+                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(scene.triangle_count), &scene.bounds, right, up));
+            }
+        }
+        let probe = gpu.storage("virtual.probe", table_len * 4 + dynamic.as_ref().map_or(0, |b| b.count as u64 * 24));
+        let kernel_half = (p.get_u32("pcf") as f32 - 1.0) * 0.5;
+        Ok(VirtualShadows {
+            dir: direction,
+            levels,
+            virtual_res,
+            page_res,
+            extent0: p.get("level0_extent") as f32,
+            bias_scale: bias_scale(p.get("resolution_bias") as f32),
+            // the kernel, the normal offset's sideways shift, one texel of rounding
+            reach: kernel_half + p.get("normal_offset") as f32 + 1.0,
+            params,
+            clipmap: None,
+            cache: PageCache::new(cols * rows),
+            alloc: Allocation::default(),
+            requested: Vec::new(),
+            frames: 0,
+            rendered_total: 0,
+            cols,
+            rows,
+            chunks,
+            dynamic,
+            dynamic_boxes: None,
+            dynamic_chunk0,
+            invalidated: 0,
+            fallback_added: 0,
+            invalidated_total: 0,
+            probe,
+            atlas,
+            uniform,
+            requests,
+            page_table,
+            page_mats,
+            counts,
+            mark_layout,
+            mark,
+            eval_layout,
+            eval,
+            page_group,
+            page_pipeline,
+            clear_pipeline,
+        })
+    }
+
+    /// The clipmap of the last frame.
+    pub fn clipmap(&self) -> Option<&Clipmap> {
+        self.clipmap.as_ref()
+    }
+
+    /// The last frame's allocation (mapped, rendered, cached, fallen-back pages).
+    pub fn allocation(&self) -> &Allocation {
+        &self.alloc
+    }
+
+    /// The page pool and its resident pages.
+    pub fn cache(&self) -> &PageCache {
+        &self.cache
+    }
+
+    /// Resident pages the last frame dropped because a moving chunk swept over them.
+    pub fn invalidated(&self) -> usize {
+        self.invalidated
+    }
+
+    /// The pages requested in the last frame (priority order, from the GPU's marks).
+    pub fn requested(&self) -> &[PageKey] {
+        &self.requested
+    }
+
+    /// Forgets the pages over world box `b` at every level (moving geometry); returns how many
+    /// resident pages were dropped.
+    pub fn invalidate_box(&mut self, b: &Bounds) -> usize {
+        let Some(c) = &self.clipmap else { return 0 };
+        let keys: Vec<PageKey> = (0..self.levels).flat_map(|k| c.pages_touching(k, b)).collect();
+        self.cache.invalidate(&keys)
+    }
+
+    fn page_rect(c: &Clipmap, k: &PageKey) -> (Vec2, Vec2) {
+        let s = c.texel(k.level) * c.page_res as f32;
+        (Vec2::new(k.x as f32 * s, -(k.y as f32 + 1.0) * s), Vec2::new((k.x as f32 + 1.0) * s, -(k.y as f32) * s))
+    }
+}
+
+impl VirtualParams {
+    fn zeroed_for(p: &ParamValues, levels: u32, n: u32, page_res: u32, cols: u32) -> VirtualParams {
+        let mut v: VirtualParams = bytemuck::Zeroable::zeroed();
+        v.dims = [levels, n, page_res, cols];
+        v.bias = [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32];
+        v.pcf = [p.get_u32("pcf"), 0, 0, 0];
+        v
+    }
+}
+
+/// The slot clear: `vs_clear` at depth 1, depth test Always, no fragment stage.
+fn clear_pipeline(gpu: &Gpu, source: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
+    let module = gpu.shader("virtual.clear", source);
+    let layout = gpu.pipeline_layout("virtual.clear", layouts);
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("virtual.clear"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_clear"), compilation_options: Default::default(), buffers: &[] },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: raster::DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+impl Technique for VirtualShadows {
+    /// Marking on the GPU, one readback, the allocation and page table on the CPU.
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        let c = Clipmap::new(self.dir, &f.scene.bounds, f.camera.position, self.levels, self.virtual_res, self.page_res, self.extent0);
+        let v = &mut self.params;
+        v.right = c.right.extend(c.texel(0)).into();
+        v.up = c.up.extend(c.inv_texel(0)).into();
+        v.dir = c.dir.extend(c.z_near).into();
+        v.view = [c.z_far, pixel_angle(f.camera.fov_y_deg, f.gbuffer.height), self.bias_scale, self.reach];
+        for (k, o) in c.origins.iter().enumerate() {
+            v.origins[k] = [o.x, o.y, 0, 0];
+        }
+        rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
+        let group =
+            f.view_group(gpu, "virtual.mark", &self.mark_layout, &[self.uniform.as_entire_binding(), self.requests.as_entire_binding()]);
+        let table_bytes = c.table_len() as u64 * 4;
+        rec.stage("virtual.mark", |enc| {
+            enc.clear_buffer(&self.requests, 0, None);
+            gpu.dispatch_2d(enc, "virtual.mark", &self.mark, &[&group], f.gbuffer.width, f.gbuffer.height);
+            enc.copy_buffer_to_buffer(&self.requests, 0, &self.probe, 0, table_bytes);
+            if let Some(b) = &self.dynamic {
+                b.record(enc, f.scene);
+                enc.copy_buffer_to_buffer(&b.boxes, 0, &self.probe, table_bytes, b.count as u64 * 24);
+            }
+        });
+        let words = c.table_len() + self.dynamic.as_ref().map_or(0, |b| b.count as usize * 6);
+        let probe: Vec<u32> = rec.read_buffer_as(&self.probe, words, "virtual.readback");
+        let t0 = std::time::Instant::now();
+        let (flags, boxes) = probe.split_at(c.table_len());
+        self.invalidated = 0;
+        if self.dynamic.is_some() {
+            let now = ChunkBounds::parse(boxes);
+            // a chunk that moved invalidates the resident pages its old and new boxes cover
+            if let Some(before) = &self.dynamic_boxes {
+                for (a, b) in before.iter().zip(&now) {
+                    if a != b {
+                        let mut swept = *a;
+                        swept.grow(b.min);
+                        swept.grow(b.max);
+                        self.invalidated += self.cache.invalidate_if(|k| c.page_overlaps(k, &swept));
+                    }
+                }
+            }
+            for (i, b) in now.iter().enumerate() {
+                let ch = &mut self.chunks[self.dynamic_chunk0 + i];
+                *ch = Chunk::new(ch.first, ch.end, b, c.right, c.up);
+            }
+            self.dynamic_boxes = Some(now);
+        }
+        self.invalidated_total += self.invalidated as u64;
+        let mut req: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f & 1 != 0).map(|(i, _)| c.key_of_index(i)).collect();
+        req.sort();
+        let cand: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f == 2).map(|(i, _)| c.key_of_index(i)).collect();
+        let all = with_fallbacks(&req, &cand, self.cache.slots() as usize);
+        self.fallback_added = all.len() - req.len();
+        self.alloc = self.cache.allocate(&all);
+        self.requested = req;
+        let mut table = vec![0u32; c.table_len()];
+        for (k, s) in &self.alloc.mapped {
+            table[c.table_index(k.level, glam::IVec2::new(k.x, k.y))] = s + 1;
+        }
+        rec.write_buffer(&self.page_table, 0, bytemuck::cast_slice(&table));
+        let mats: Vec<[[f32; 4]; 4]> = self.alloc.render.iter().map(|(k, _)| c.page_view_proj(*k).to_cols_array_2d()).collect();
+        rec.write_buffer(&self.page_mats, 0, bytemuck::cast_slice(&mats));
+        self.clipmap = Some(c);
+        self.frames += 1;
+        self.rendered_total += self.alloc.render.len() as u64;
+        rec.cpu("virtual.allocate", t0.elapsed().as_secs_f64() * 1e3);
+        Ok(())
+    }
+
+    /// The new pages, each cleared and drawn with its chunks into its slot.
+    fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        let (Some(c), false) = (&self.clipmap, self.alloc.render.is_empty()) else { return Ok(()) };
+        let view = self.atlas.create_view(&Default::default());
+        let pr = self.page_res;
+        let draws: Vec<Vec<(u32, u32)>> = self.alloc.render.iter().map(|(k, _)| self.page_draws(c, k)).collect();
+        rec.stage("virtual.render", |enc| {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("virtual.render"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &self.page_group, &[]);
+            pass.set_bind_group(1, &f.scene.group, &[]);
+            for (i, ((_, slot), ranges)) in self.alloc.render.iter().zip(&draws).enumerate() {
+                let (x, y) = ((slot % self.cols) * pr, (slot / self.cols) * pr);
+                pass.set_viewport(x as f32, y as f32, pr as f32, pr as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, pr, pr);
+                pass.set_pipeline(&self.clear_pipeline);
+                pass.draw(0..3, 0..1);
+                pass.set_pipeline(&self.page_pipeline);
+                let inst = i as u32;
+                for &(a, b) in ranges {
+                    pass.draw(a * 3..b * 3, inst..inst + 1);
+                }
+            }
+        });
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, false);
+        Ok(())
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval_pass(gpu, f, rec, true);
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        super::report::report(self, gpu)
+    }
+}
+
+impl VirtualShadows {
+    /// Triangle ranges of the chunks overlapping page `k` (adjacent chunks merged).
+    fn page_draws(&self, c: &Clipmap, k: &PageKey) -> Vec<(u32, u32)> {
+        let (lo, hi) = Self::page_rect(c, k);
+        let mut out: Vec<(u32, u32)> = Vec::new();
+        for ch in &self.chunks {
+            if ch.hi.x < lo.x || ch.lo.x > hi.x || ch.hi.y < lo.y || ch.lo.y > hi.y {
+                continue;
+            }
+            match out.last_mut() {
+                Some(last) if last.1 == ch.first => last.1 = ch.end,
+                _ => out.push((ch.first, ch.end)),
+            }
+        }
+        out
+    }
+
+    fn eval_pass(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) {
+        let atlas_view = self.atlas.create_view(&Default::default());
+        let group = f.view_group(
+            gpu,
+            "virtual.eval",
+            &self.eval_layout,
+            &[
+                self.uniform.as_entire_binding(),
+                self.page_table.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&atlas_view),
+                self.counts.as_entire_binding(),
+            ],
+        );
+        let stage = if counting { "virtual.analysis" } else { "virtual.evaluate" };
+        self.eval.record(gpu, rec, stage, &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
+    }
+}

@@ -1,0 +1,53 @@
+// Page marking: every evaluated view sample flags the pages it will read (Clipmap::sample_pages):
+// at its level (or the first coarser one whose window holds them) the pages under the corners
+// of the square of `reach` texels around it, and the same corners' pages of the coarsest level
+// (the fallback of last resort), flag 1; the corners' pages one level coarser, flag 2: the
+// candidates the allocation maps when a full pool leaves the finer page out (alloc.rs
+// `with_fallbacks`). Flags are set with atomicOr: the result is the same set in any order.
+
+@group(0) @binding(6) var<uniform> vp: VirtualParams;
+@group(0) @binding(7) var<storage, read_write> requests: array<atomic<u32>>;
+
+fn mark_level(k: u32, g: vec2<f32>, all_or_none: bool, flag: u32) -> bool {
+    let r = vp.view.w;
+    var c: array<vec2<i32>, 4>;
+    c[0] = page_of(g + vec2<f32>(-r, -r));
+    c[1] = page_of(g + vec2<f32>(r, -r));
+    c[2] = page_of(g + vec2<f32>(-r, r));
+    c[3] = page_of(g + vec2<f32>(r, r));
+    var inside = true;
+    for (var i = 0; i < 4; i++) {
+        inside = inside && in_window(k, c[i]);
+    }
+    if all_or_none && !inside {
+        return false;
+    }
+    for (var i = 0; i < 4; i++) {
+        if in_window(k, c[i]) {
+            atomicOr(&requests[table_index(k, c[i])], flag);
+        }
+    }
+    return true;
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    let top = vp.dims.x - 1u;
+    var k = choose_level(s.p);
+    while k <= top {
+        if mark_level(k, texel_coords(k, s.p), true, 1u) {
+            if k < top {
+                mark_level(k + 1u, texel_coords(k + 1u, s.p), false, 2u);
+            }
+            break;
+        }
+        k++;
+    }
+    if k < top {
+        mark_level(top, texel_coords(top, s.p), false, 1u);
+    }
+}

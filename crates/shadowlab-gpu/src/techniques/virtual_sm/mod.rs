@@ -1,0 +1,86 @@
+//! `virtual`: virtual (page-based) shadow maps for directional lights, after UE5's design.
+//! Clipmap levels around the camera, each a virtual map of `virtual_res` texels a side in
+//! pages of `page_res`; only the pages view samples need are rendered, into slots of one
+//! Depth32Float atlas (the physical pool, `pool_mib`), and kept across frames while nothing
+//! moved over them. The CPU half (level geometry, page math, the pool) is
+//! `shadowlab_core::techniques::virtual_sm`. (The folder is `virtual_sm`: `virtual` is a Rust
+//! keyword, and `vsm` is variance shadow maps.) Stored depth: orthographic, linear, 0 = near.
+//!
+//! Per frame: `prepare` marks the requested pages on the GPU (mark.wgsl), reads the flags back
+//! (one stall, `virtual.readback`), and allocates slots on the CPU in a fixed priority order
+//! (coarse levels first; a full pool makes the finest pages fall back, counted); `render` draws
+//! the new pages, each with its own orthographic frustum into its slot, with the scene's chunks
+//! culled per page; `evaluate` looks every PCF tap up through the page table (eval.wgsl).
+
+mod bounds;
+mod gpu;
+mod params;
+mod report;
+
+use bytemuck::{Pod, Zeroable};
+pub use gpu::{VirtualShadows, CHUNK_TRIANGLES};
+pub use params::*;
+
+use crate::shaders::compose_depth;
+use crate::technique::{compose_view, TechniqueInfo};
+
+const PAGES_WGSL: &str = include_str!("pages.wgsl");
+const MARK_WGSL: &str = include_str!("mark.wgsl");
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+const PAGE_WGSL: &str = include_str!("page.wgsl");
+
+/// Levels the uniform holds (WGSL `origins`).
+pub const MAX_LEVELS: usize = 24;
+
+pub fn shaders() -> Vec<(&'static str, String)> {
+    vec![("virtual_sm/mark.wgsl", mark_source()), ("virtual_sm/eval.wgsl", eval_source()), ("virtual_sm/page.wgsl", page_source())]
+}
+
+fn mark_source() -> String {
+    compose_view(&format!("{PAGES_WGSL}{MARK_WGSL}"), false)
+}
+
+fn eval_source() -> String {
+    compose_view(&format!("{PAGES_WGSL}{}{EVAL_WGSL}", crate::techniques::sm::BIAS_WGSL), false)
+}
+
+fn page_source() -> String {
+    compose_depth(PAGE_WGSL)
+}
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "virtual",
+    summary: "virtual shadow maps: clipmap levels of 16K virtual texels in 128^2 pages; only the pages view samples need are rendered, cached across frames",
+    cost: "a marking pass, one readback (a sync), per new page one atlas viewport with culled chunks; N^2 page-table lookups per pixel",
+    quality: "about one texel per pixel everywhere (resolution_bias); a full pool makes fine pages fall back to coarser ones (reported)",
+    source: "Epic Games, Unreal Engine 5 virtual shadow maps (2021); clipmaps: Tanner, Migdal, Jones 1998",
+    lights: &["directional"],
+    params: PARAMS,
+    stalls: "virtual.readback: the page requests read back for the CPU allocation (every frame)",
+    needs: "",
+    compare: &[],
+    shaders,
+    create: |gpu, scene, p, light| Ok(Box::new(VirtualShadows::new(gpu, scene, p, light)?)),
+};
+
+/// WGSL `VirtualParams` (pages.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct VirtualParams {
+    /// xyz: light x axis; w: world size of a level-0 texel.
+    pub right: [f32; 4],
+    /// xyz: light y axis; w: level-0 texels per world unit.
+    pub up: [f32; 4],
+    /// xyz: light direction; w: light depth of depth 0.
+    pub dir: [f32; 4],
+    /// x: light depth of depth 1, y: pixel angle, z: 2^resolution_bias, w: marking reach (texels).
+    pub view: [f32; 4],
+    /// levels, pages per side, page side, atlas columns.
+    pub dims: [u32; 4],
+    /// bias, slope_bias, normal_offset, max_slope.
+    pub bias: [f32; 4],
+    /// x: PCF width.
+    pub pcf: [u32; 4],
+    /// xy: window origins per level (pages).
+    pub origins: [[i32; 4]; MAX_LEVELS],
+}

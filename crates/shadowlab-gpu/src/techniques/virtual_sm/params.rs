@@ -1,0 +1,74 @@
+//! `virtual`'s parameter table: the page geometry of UE5's virtual shadow maps, the pool, and
+//! `sm`'s PCF and bias family (biases in texels of the level a sample uses).
+
+use shadowlab_core::params::family::{BIAS, MAX_SLOPE, NORMAL_OFFSET, PCF, SLOPE_BIAS};
+use shadowlab_core::params::ParamDef;
+
+/// Virtual texels per level side: UE5's 16K virtual maps. Lower: coarser levels sooner (more
+/// levels needed); higher: more pages per level (bigger page table and request buffer).
+pub const DEFAULT_VIRTUAL_RES: f64 = 16384.0;
+/// Page side: UE5's 128 x 128 pages. Smaller pages waste less pool on partly used pages but
+/// need more draws; larger pages fewer draws, more waste.
+pub const DEFAULT_PAGE_RES: f64 = 128.0;
+/// Clipmap levels: enough that the coarsest one covers any scene at the default level-0
+/// extent (2^15 x 1.28 m). Too few: distant samples clamp to a too-fine level whose window
+/// does not hold them (lit).
+pub const DEFAULT_LEVELS: f64 = 16.0;
+/// World side of level 0: UE5's first clipmap level 6 (radius 2^6 cm, so 1.28 m across) in
+/// scene units taken as metres. Too large: near samples get coarser texels than their pixels.
+pub const DEFAULT_LEVEL0_EXTENT: f64 = 1.28;
+/// Resolution (LOD) bias: 0 = the level whose texel is the first at least as large as the
+/// pixel's footprint. Negative: finer (more pages); positive: coarser.
+pub const DEFAULT_RESOLUTION_BIAS: f64 = 0.0;
+/// Physical pool: 12 MiB, the memory of `csm`'s default 3 x 1024^2 maps (issue 17's
+/// equal-memory comparison): 192 pages of 128^2.
+pub const DEFAULT_POOL_MIB: f64 = 12.0;
+
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef::integer(
+        "virtual_res",
+        DEFAULT_VIRTUAL_RES,
+        256.0,
+        65536.0,
+        "virtual texels per clipmap level side (a multiple of page_res)",
+        "UE5 virtual shadow maps: 16K",
+    ),
+    ParamDef::integer("page_res", DEFAULT_PAGE_RES, 16.0, 8192.0, "page side in texels (a power of two)", "UE5 virtual shadow maps: 128"),
+    ParamDef::integer(
+        "levels",
+        DEFAULT_LEVELS,
+        1.0,
+        24.0,
+        "clipmap levels; level k covers 2^k x level0_extent",
+        "shadowlab: covers 42 km at the default extent",
+    ),
+    ParamDef::number(
+        "level0_extent",
+        DEFAULT_LEVEL0_EXTENT,
+        1e-4,
+        1e6,
+        "world side of clipmap level 0 (scene units)",
+        "UE5 r.Shadow.Virtual.Clipmap.FirstLevel = 6 (radius 2^6 cm)",
+    ),
+    ParamDef::number(
+        "resolution_bias",
+        DEFAULT_RESOLUTION_BIAS,
+        -8.0,
+        8.0,
+        "level = ceil(log2(pixel footprint / level-0 texel) + bias); negative: finer texels, more pages",
+        "UE5 r.Shadow.Virtual.ResolutionLodBiasDirectional",
+    ),
+    ParamDef::number(
+        "pool_mib",
+        DEFAULT_POOL_MIB,
+        0.0625,
+        2048.0,
+        "physical page pool (MiB of Depth32Float pages)",
+        "csm's 3 x 1024^2 (issue 17)",
+    ),
+    PCF,
+    BIAS,
+    SLOPE_BIAS,
+    MAX_SLOPE,
+    NORMAL_OFFSET,
+];

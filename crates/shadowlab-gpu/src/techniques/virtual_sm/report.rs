@@ -1,0 +1,87 @@
+//! `virtual`'s report: pages marked, rendered, cached and fallen back in the last frame, the
+//! pool's and page table's bytes, samples per level, and a picture of the marked pages.
+
+use shadowlab_core::techniques::virtual_sm::PageKey;
+
+use super::gpu::VirtualShadows;
+use super::MAX_LEVELS;
+use crate::technique::{NamedImage, TechniqueReport};
+use crate::Gpu;
+
+/// A colour per level (cycled): fine levels warm, coarse cold.
+const LEVEL_COLOURS: [[u8; 3]; 8] =
+    [[230, 40, 40], [240, 140, 30], [230, 220, 40], [60, 200, 60], [40, 200, 200], [50, 110, 230], [140, 60, 220], [220, 60, 180]];
+
+pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
+    let a = &t.alloc;
+    let slots = t.cols * t.rows;
+    let pool_bytes = slots as u64 * (t.page_res as u64).pow(2) * 4;
+    let n = t.virtual_res / t.page_res;
+    let table_bytes = t.levels as u64 * (n as u64).pow(2) * 4;
+    let mut r = TechniqueReport { shadow_data_bytes: pool_bytes + table_bytes, ..Default::default() };
+    let c = &mut r.counters;
+    c.insert("pages_marked".into(), t.requested.len() as f64);
+    c.insert("pages_rendered".into(), a.render.len() as f64);
+    c.insert("pages_cached".into(), a.cached as f64);
+    c.insert("pages_fallen_back".into(), a.fallen_back.len() as f64);
+    c.insert("pages_rendered_total".into(), t.rendered_total as f64);
+    c.insert("frames".into(), t.frames as f64);
+    c.insert("pages_invalidated".into(), t.invalidated as f64);
+    c.insert("pages_fallback_added".into(), t.fallback_added as f64);
+    c.insert("pages_invalidated_total".into(), t.invalidated_total as f64);
+    c.insert("pool_pages".into(), slots as f64);
+    c.insert("pool_bytes".into(), pool_bytes as f64);
+    c.insert("page_table_bytes".into(), table_bytes as f64);
+    c.insert("request_bytes".into(), table_bytes as f64);
+    let counts: Vec<u32> = gpu.read_buffer_as(&t.counts, MAX_LEVELS + 1);
+    let total: u64 = counts.iter().map(|&x| x as u64).sum();
+    for k in 0..t.levels as usize {
+        let marked = t.requested.iter().filter(|p| p.level == k as u32).count();
+        if marked > 0 || counts[k] > 0 {
+            c.insert(format!("pages_marked_level_{k}"), marked as f64);
+            c.insert(format!("pixels_in_level_{k}"), counts[k] as f64 / total.max(1) as f64);
+        }
+    }
+    let unresolved = counts[t.levels as usize];
+    c.insert("pixels_unresolved".into(), unresolved as f64);
+    if !a.fallen_back.is_empty() {
+        let finest = a.fallen_back.iter().map(|p| p.level).min().unwrap_or(0);
+        r.degraded.push(format!(
+            "virtual: page pool full ({slots} pages): {} pages fell back to coarser levels (finest level {finest}; {} fallback pages added)",
+            a.fallen_back.len(),
+            t.fallback_added
+        ));
+    }
+    if unresolved > 0 {
+        r.degraded.push(format!("virtual: {unresolved} pixels found no mapped page at any level and were taken as lit"));
+    }
+    r.images.push(marked_picture(t));
+    r
+}
+
+/// The marked pages of each level that has any, as an N x N grid of the level's window,
+/// side by side, each marked page in its level's colour (fallen-back pages dimmed).
+fn marked_picture(t: &VirtualShadows) -> NamedImage {
+    let n = (t.virtual_res / t.page_res) as usize;
+    let levels: Vec<u32> = (0..t.levels).filter(|k| t.requested.iter().any(|p| p.level == *k)).collect();
+    let cells = levels.len().max(1);
+    let (w, h) = (cells * (n + 2), n + 2);
+    let mut rgba = vec![0u8; w * h * 4];
+    for px in rgba.chunks_exact_mut(4) {
+        px.copy_from_slice(&[24, 24, 24, 255]);
+    }
+    let fallen: std::collections::BTreeSet<PageKey> = t.alloc.fallen_back.iter().copied().collect();
+    if let Some(c) = &t.clipmap {
+        for (i, &k) in levels.iter().enumerate() {
+            let o = c.origins[k as usize];
+            for p in t.requested.iter().filter(|p| p.level == k) {
+                let (x, y) = ((p.x - o.x) as usize, (p.y - o.y) as usize);
+                let col = LEVEL_COLOURS[k as usize % LEVEL_COLOURS.len()];
+                let dim = if fallen.contains(p) { 3 } else { 1 };
+                let at = ((y + 1) * w + i * (n + 2) + x + 1) * 4;
+                rgba[at..at + 4].copy_from_slice(&[col[0] / dim, col[1] / dim, col[2] / dim, 255]);
+            }
+        }
+    }
+    NamedImage { name: "marked pages per level (coloured by level)".into(), width: w as u32, height: h as u32, rgba }
+}
