@@ -83,7 +83,8 @@ fn every_claim_names_known_techniques_parameters_and_setups() {
             Some(r) => vec![r.as_str().unwrap()],
             None => c["runs"].as_array().unwrap().iter().map(|r| r.as_str().unwrap()).collect(),
         };
-        let mut labels: Vec<&str> = c.get("labels").and_then(|l| l.as_array()).map(|l| l.iter().map(|x| x.as_str().unwrap()).collect()).unwrap_or_default();
+        let mut labels: Vec<&str> =
+            c.get("labels").and_then(|l| l.as_array()).map(|l| l.iter().map(|x| x.as_str().unwrap()).collect()).unwrap_or_default();
         labels.extend(["label", "num", "den"].iter().filter_map(|k| c.get(*k).and_then(|v| v.as_str())));
         assert!(!labels.is_empty(), "{id}");
         for r in run_ids {
@@ -143,7 +144,8 @@ fn missing_setups_are_not_comparable_and_bad_arguments_are_errors() {
     let empty = tmp("no-setups");
     std::fs::create_dir_all(&empty).unwrap();
     // seed 000's runs are all setup files: none is there
-    let run = bin().args(["reproduce", "000", "--size", "32x32", "--quiet", "--out"]).arg(&out).arg("--setups").arg(&empty).output().unwrap();
+    let run =
+        bin().args(["reproduce", "000", "--size", "32x32", "--quiet", "--out"]).arg(&out).arg("--setups").arg(&empty).output().unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let r = json(out.join("reproduce.json"));
     let verdicts = r["verdicts"].as_array().unwrap();
