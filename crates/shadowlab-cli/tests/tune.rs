@@ -96,8 +96,8 @@ fn halving_finds_the_grid_choice_for_fewer_full_size_points() {
     if std::env::var("SHADOWLAB_SKIP_GPU_TESTS").as_deref() == Ok("1") {
         return;
     }
-    // one candidate is clearly best: a 2048 texel map against maps of 8..56 texels
-    let spec = "sm:res=8|16|24|32|40|48|56|2048";
+    // one candidate is clearly best: a 2048 texel map against maps of 16..64 texels
+    let spec = "sm:res=16|24|32|40|48|56|64|2048";
     let common = ["-t", spec, "--train", "courtyard", "--size", "128x128"];
     let (g_out, h_out) = (tmp("grid"), tmp("halving"));
     let grid = run_tune(&g_out, &common);
