@@ -8,6 +8,7 @@ mod listing;
 mod metrics;
 mod output;
 mod report;
+mod reproduce;
 mod sweep;
 mod view;
 
@@ -87,6 +88,8 @@ enum Command {
     Sweep(sweep::args::SweepCli),
     #[command(about = sweep::tune::TUNE_ABOUT, long_about = sweep::tune::TUNE_LONG)]
     Tune(sweep::tune::TuneArgs),
+    #[command(about = reproduce::ABOUT, long_about = reproduce::LONG)]
+    Reproduce(reproduce::ReproduceArgs),
     /// Time every stage on the built-in scenes (and sponza/conference when present)
     Bench {
         /// Setup files to benchmark (default: the built-in scenes plus setups/sponza.toml and setups/conference.toml when their scenes exist)
@@ -138,6 +141,7 @@ fn main() {
         Command::View(args) => view::view(&args),
         Command::Sweep(cli) => sweep::main(&cli),
         Command::Tune(args) => sweep::tune::tune(&args),
+        Command::Reproduce(args) => reproduce::reproduce(&args),
         Command::Bench { setup, size, frames, out } => bench::bench(&setup, &size, frames, out.as_deref()),
     };
     if let Err(e) = result {
