@@ -125,7 +125,7 @@ impl VirtualShadows {
         let page_pipeline = raster::depth_pipeline(gpu, "virtual.page", &page_source(), &[&page_layout, &scene.layout], scene.has_cutouts);
         let clear_pipeline = clear_pipeline(gpu, &page_source(), &[&page_layout, &scene.layout]);
         let (right, up, _) = shadowlab_core::techniques::iasm::light_basis(direction);
-        // static chunks: bounded once here; moving ones: every frame (placeholder: the scene)
+        // static chunks: bounded once here, at creation; moving ones: every frame (prepare)
         let mut chunks = Vec::new();
         let split = scene.dynamic_first.min(scene.triangle_count);
         if split > 0 {
