@@ -156,3 +156,54 @@ fn two_fresh_runs_give_the_same_bits() {
         assert!(a.report.degraded.is_empty());
     }
 }
+
+#[test]
+fn delayed_boxes_follow_the_cameras_motion() {
+    let Some(gpu) = gpu() else { return };
+    // four frames apart on the city's path, on its second leg: a step of metres and a turn
+    // towards the next key, where last frame's bounds alone leave samples outside every box
+    // (they count as lit)
+    let scene = builtin("city").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let cams = shadowlab_core::camera::path_cameras(&scene.camera, &scene.camera_path, 24);
+    let (a, b) = (cams[8], cams[12]);
+    let light = scene.lights[0];
+    let Light::Directional { direction } = light else { panic!("city's light 0 is directional") };
+    let lv = light_view(direction);
+    let (va, vb) = (lab.view(&a, &a, &light, 160, 120).unwrap(), lab.view(&b, &a, &light, 160, 120).unwrap());
+    // samples of the second view outside every fitted box, and the run's counters
+    let outside = |s: &str| {
+        let mut t = instance(&lab, &va, s);
+        lab.step(&va, &mut t, false, 1).unwrap();
+        let run = lab.step(&vb, &mut t, false, 1).unwrap();
+        let c = run.report.counters.clone();
+        assert_eq!(c["bounds_source"], 2.0, "{s}: the previous frame's bounds");
+        let bx = boxes(&c, 3);
+        let n = vb
+            .position
+            .iter()
+            .zip(&vb.mask)
+            .filter(|(p, m)| {
+                let q = (lv * Vec3::new(p[0], p[1], p[2]).extend(1.0)).xyz().as_dvec3();
+                **m != 0 && !bx.iter().any(|b| q.x > b[0] && q.x < b[1] && q.y > b[2] && q.y < b[3] && q.z < b[4] && q.z > b[5])
+            })
+            .count();
+        (n, c)
+    };
+    let (n0, c0) = outside("sdsm:delayed=true,reach=0");
+    let (n1, c1) = outside("sdsm:delayed=true");
+    let evaluated = vb.mask.iter().filter(|m| **m != 0).count();
+    // the sweep is the CPU's motion at each cascade's far split, in light view
+    let m = shadowlab_core::techniques::sdsm::CameraMotion::between(&a, &b, 160.0 / 120.0);
+    for k in 0..3 {
+        let want = lv.transform_vector3(m.displacement(c1[&format!("split_{}", k + 1)] as f32));
+        for (axis, w) in ["x", "y", "z"].iter().zip(want.to_array()) {
+            let got = c1[&format!("reach_{k}_{axis}")] as f32;
+            assert!((got - w).abs() <= 1e-4 * w.abs().max(1.0), "cascade {k} {axis}: {got} vs {w}");
+        }
+        assert!(c0[&format!("reach_{k}_x")] == 0.0, "reach=0 does not move the bounds");
+    }
+    eprintln!("outside every box: {n0} unswept, {n1} swept, of {evaluated}");
+    assert!(n0 > evaluated / 200, "the step leaves samples out of last frame's boxes ({n0} of {evaluated}): not a test of the sweep");
+    assert!(n1 * 5 < n0, "swept boxes leave {n1} samples outside every box, against {n0} unswept (of {evaluated})");
+}

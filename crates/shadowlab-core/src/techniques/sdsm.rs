@@ -10,7 +10,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
 
 use super::csm::{depth_range, practical_splits, snap_to_texel, CascadeBox};
-use crate::camera::orthographic;
+use crate::camera::{orthographic, Camera};
 use crate::scene::Bounds;
 
 /// Pure logarithmic partition between the samples' min and max depth: Lauritzen et al. 2011
@@ -60,6 +60,43 @@ pub struct SampleBounds {
     pub hi: Vec3,
     /// Samples reduced into the cascade.
     pub samples: u32,
+}
+
+impl SampleBounds {
+    /// The bounds swept along `step` (light x, y, z: the union with themselves moved by it)
+    /// and then grown by `grow` world units on every side.
+    pub fn swept(&self, step: Vec3, grow: f32) -> SampleBounds {
+        let g = Vec3::splat(grow);
+        SampleBounds { lo: self.lo.min(self.lo + step) - g, hi: self.hi.max(self.hi + step) + g, samples: self.samples }
+    }
+}
+
+/// The camera's motion between two frames, as the delayed `sdsm` needs it to move last frame's
+/// sample bounds to this frame's view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraMotion {
+    /// The camera's step (world).
+    pub step: Vec3,
+    /// The change of the unit forward direction (world): times a view depth, how far the turn
+    /// moves the view's centre at that depth.
+    pub turn: Vec3,
+    /// Distance / view depth at the far corners of the frustum (`to`'s lens at the aspect).
+    pub corner: f32,
+}
+
+impl CameraMotion {
+    pub fn between(from: &Camera, to: &Camera, aspect: f32) -> CameraMotion {
+        let fa = (from.target - from.position).normalize_or_zero();
+        let fb = (to.target - to.position).normalize_or_zero();
+        let t = (0.5 * to.fov_y_deg.to_radians()).tan();
+        CameraMotion { step: to.position - from.position, turn: fb - fa, corner: (1.0 + t * t * (1.0 + aspect * aspect)).sqrt() }
+    }
+
+    /// How far (world) the view moves at view depth `depth`: the step plus the turn's
+    /// displacement there, out to the frustum's corner.
+    pub fn displacement(&self, depth: f32) -> Vec3 {
+        self.step + self.turn * (depth * self.corner)
+    }
 }
 
 /// One cascade's box fitted to its samples: a rectangle in light x/y (its own texel size per
@@ -304,5 +341,21 @@ mod tests {
         let s = fit_to_samples(&slice, &b, &scene, 1024, true, 3.0, None);
         assert!(s.half.x >= slice.half && s.half.x < slice.half * 1.06, "{} vs {}", s.half.x, slice.half);
         assert!(s.origin.x - s.half.x <= b.lo.x && s.origin.x + s.half.x >= b.hi.x, "holds the samples along x");
+    }
+
+    #[test]
+    fn camera_motion_is_the_step_plus_the_turn() {
+        let a = Camera::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), 90.0, 0.1, 100.0);
+        assert_eq!(CameraMotion::between(&a, &a, 1.0).displacement(50.0), Vec3::ZERO);
+        let b = Camera { position: Vec3::new(3.0, 0.0, 4.0), target: Vec3::new(3.0, 0.0, 3.0), ..a };
+        assert_eq!(CameraMotion::between(&a, &b, 1.0).displacement(10.0), Vec3::new(3.0, 0.0, 4.0));
+        // a turn of 0.1 rad: the centre's move at the frustum corner (90 degrees, square: sqrt(3) x depth)
+        let c = Camera { target: Vec3::new(0.1f32.sin(), 0.0, -0.1f32.cos()), ..a };
+        let d = CameraMotion::between(&a, &c, 1.0).displacement(10.0);
+        let chord = 2.0 * 0.05f32.sin() * 10.0 * 3.0f32.sqrt();
+        assert!((d.length() - chord).abs() < 1e-4 && d.x > 0.0, "{d}");
+        // swept bounds: extended towards the step only, then grown on every side
+        let s = SampleBounds { lo: Vec3::ZERO, hi: Vec3::ONE, samples: 7 }.swept(Vec3::new(2.0, -1.0, 0.0), 0.5);
+        assert_eq!((s.lo, s.hi, s.samples), (Vec3::new(-0.5, -1.5, -0.5), Vec3::new(3.5, 1.5, 1.5), 7));
     }
 }

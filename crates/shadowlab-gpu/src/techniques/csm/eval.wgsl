@@ -2,8 +2,8 @@
 // view depths holds its linear depth; inside the blend band at the far end of a slice it mixes
 // in the next cascade. Per cascade: normal offset and constant bias in texels of that cascade,
 // projection into its orthographic box, NxN PCF of hardware comparisons (the receiver-plane
-// kernel bias of `sm`). A sample outside the chosen box tries the next cascades, then counts
-// as lit. Also counts view samples per texel (all cascades) and records the cascade used.
+// kernel bias of `sm`). A sample outside the chosen box tries the next cascades, then the
+// finer ones, then counts as lit. Also counts view samples per texel (all cascades) and records the cascade used.
 
 struct Cascade {
     view_proj: mat4x4<f32>,
@@ -74,6 +74,14 @@ fn resolve(first: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
         let v = lookup(c, p, n, l);
         if v >= 0.0 {
             return vec2<f32>(v, f32(c));
+        }
+    }
+    // then the finer ones (a fitted box from last frame's samples can miss a sample that the
+    // camera's motion moved across a split, away from the camera)
+    for (var c = first; c > 0u; c--) {
+        let v = lookup(c - 1u, p, n, l);
+        if v >= 0.0 {
+            return vec2<f32>(v, f32(c - 1u));
         }
     }
     return vec2<f32>(1.0, f32(count - 1u));

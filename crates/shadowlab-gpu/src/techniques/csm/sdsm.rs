@@ -12,9 +12,10 @@ use std::collections::BTreeMap;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
+use shadowlab_core::camera::Camera;
 use shadowlab_core::params::{ParamDef, ParamValues};
 use shadowlab_core::techniques::csm::{self as cascades, light_view, CascadeBox, Fit, ViewFrustum, DEPTH_STEPS_PER_OCTAVE};
-use shadowlab_core::techniques::sdsm::{self as fit, FittedBox, SampleBounds};
+use shadowlab_core::techniques::sdsm::{self as fit, CameraMotion, FittedBox, SampleBounds};
 
 use super::{Cascaded, BIAS_PARAM, BLEND, CASCADES, MAX_SLOPE_PARAM, NORMAL_OFFSET_PARAM, PCF_PARAM, RES_PARAM};
 use crate::record::{DelayedRead, Recorder};
@@ -59,7 +60,8 @@ pub const SDSM_PARAMS: &[ParamDef] = &[
     ParamDef::number("lambda", fit::DEFAULT_LAMBDA as f64, 0.0, 1.0, "split blend between the samples' min and max depth: 1 logarithmic, 0 uniform; low: coarse near cascade", "Lauritzen et al. 2011 section 3.1 (log partitioning of the tight range)"),
     BLEND,
     ParamDef::flag("snap", true, "snap each fitted box: half sides rounded up to 2^(1/16) steps (a fixed set of texel sizes, at most 9 % more area), kept from the last frame until the samples need 2 steps less, and the origin moved by whole texels of that size: the map does not shimmer while the size holds", "Valient 2008 (stable CSM) applied to fitted bounds; steps: shadowlab_core::techniques::sdsm::SIZE_STEPS_PER_OCTAVE"),
-    ParamDef::flag("delayed", false, "use the previous frame's reduction (splits and bounds, read back without a stall; frame 0 uses the frustum-slice fit) instead of this frame's (one sync); a sample the camera moved out of last frame's boxes falls to the next cascade, or counts as lit", "Lauritzen et al. 2011 (GPU-only fit) / shadowlab's recorded-frame seam (docs/bench/recorded_frame.md)"),
+    ParamDef::flag("delayed", false, "use the previous frame's reduction (splits and bounds, read back without a stall; frame 0 uses the frustum-slice fit) instead of this frame's (one sync), each cascade's bounds swept by `reach` x the camera's motion since; a sample outside its cascade's box tries the coarser cascades, then the finer ones, then counts as lit", "Lauritzen et al. 2011 (GPU-only fit) / shadowlab's recorded-frame seam (docs/bench/recorded_frame.md)"),
+    ParamDef::number("reach", 1.0, 0.0, 4.0, "with delayed: grow each cascade's last-frame sample bounds by this x the camera's motion since that frame (swept along how far the view moved at the cascade's far split: the step plus the turn's displacement there, shadowlab_core::techniques::sdsm::CameraMotion); 0: as read back; higher: more margin for what the motion uncovers, coarser texels while moving", "shadowlab (1 = the motion bound for points that stay in view); measured in docs/bench/sdsm.md"),
     BIAS_PARAM,
     NORMAL_OFFSET_PARAM,
     PCF_PARAM,
@@ -109,6 +111,13 @@ pub(super) struct SampleFit {
     bounds: Vec<Option<SampleBounds>>,
     fitted: Vec<Option<FittedBox>>,
     source: Source,
+    /// `reach` (delayed only: 0 otherwise).
+    reach: f32,
+    /// The camera of the frame whose reduction the delayed copy holds.
+    read_camera: Option<Camera>,
+    /// The last frame's sweep of each cascade's bounds (light view, world units; the
+    /// `reach_i_*` counters).
+    swept: Vec<Vec3>,
 }
 
 /// One readback, decoded.
@@ -169,6 +178,9 @@ impl SampleFit {
             bounds: Vec::new(),
             fitted: Vec::new(),
             source: Source::SliceFit,
+            reach: if p.get_bool("delayed") { p.get("reach") as f32 } else { 0.0 },
+            read_camera: None,
+            swept: Vec::new(),
         }
     }
 
@@ -204,6 +216,12 @@ impl SampleFit {
             c.insert(format!("slice_texel_{i}"), s.texel as f64);
             let b = self.bounds.get(i).copied().flatten();
             c.insert(format!("samples_{i}"), b.map_or(0.0, |b| b.samples as f64));
+            if self.delayed.is_some() {
+                let d = self.swept.get(i).copied().unwrap_or(Vec3::ZERO);
+                for (k, v) in [("x", d.x), ("y", d.y), ("z", d.z)] {
+                    c.insert(format!("reach_{i}_{k}"), v as f64);
+                }
+            }
             let Some(fb) = self.fitted.get(i).copied().flatten() else {
                 c.insert(format!("area_ratio_{i}"), 1.0);
                 continue;
@@ -241,18 +259,20 @@ pub(super) fn prepare(t: &mut Cascaded, gpu: &Gpu, f: &FrameInputs, rec: &mut Re
     s.reduce_params.far = frustum.far;
     rec.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&s.reduce_params));
     let depth = &t.reduce;
-    let (words, source) = if let Some(d) = s.delayed.as_mut() {
+    let (words, source, read_camera) = if let Some(d) = s.delayed.as_mut() {
         let prev = d.take::<u32>(gpu, OUT_WORDS);
+        let read_camera = if prev.is_some() { s.read_camera.take() } else { None };
         rec.stage("sdsm.analyze", |enc| s.record(gpu, enc, f, depth));
         let d = s.delayed.as_mut().expect("delayed");
         d.record(rec, &s.out);
-        (prev, Source::PreviousFrame)
+        s.read_camera = Some(f.camera);
+        (prev, Source::PreviousFrame, read_camera)
     } else {
         rec.stage("sdsm.analyze", |enc| s.record(gpu, enc, f, depth));
         let t0 = std::time::Instant::now();
         let w: Vec<u32> = rec.read_buffer_as(&s.out, OUT_WORDS, "sdsm.readback");
         rec.cpu("sdsm.readback", t0.elapsed().as_secs_f64() * 1e3);
-        (Some(w), Source::ThisFrame)
+        (Some(w), Source::ThisFrame, None)
     };
 
     let t0 = std::time::Instant::now();
@@ -260,10 +280,18 @@ pub(super) fn prepare(t: &mut Cascaded, gpu: &Gpu, f: &FrameInputs, rec: &mut Re
     let (splits, bounds, source) = match words.and_then(|w| decode_out(&w, count)) {
         Some(r) => {
             t.depth_range = Some(r.range);
-            (r.splits, r.bounds, source)
+            // delayed: what the camera's motion since that frame brings into view next to
+            // last frame's samples (0 for a still camera: the bounds as read)
+            let aspect = f.gbuffer.width as f32 / f.gbuffer.height.max(1) as f32;
+            let motion = read_camera.map(|c| CameraMotion::between(&c, &f.camera, aspect)).filter(|_| s.reach > 0.0);
+            let lv = light_view(t.dir);
+            s.swept = (0..count).map(|i| motion.map_or(Vec3::ZERO, |m| lv.transform_vector3(m.displacement(r.splits[i + 1])) * s.reach)).collect();
+            let bounds = r.bounds.iter().zip(&s.swept).map(|(b, &d)| b.map(|b| b.swept(d, 0.0))).collect();
+            (r.splits, bounds, source)
         }
         None => {
             t.depth_range = None;
+            s.swept = vec![Vec3::ZERO; count];
             (fit::sample_splits(frustum.near, frustum.far, None, count, t.lambda), vec![None; count], Source::SliceFit)
         }
     };
