@@ -11,7 +11,7 @@ use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, PageKey, Projection};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
-use shadowlab_gpu::technique::{submit_frame, Technique};
+use shadowlab_gpu::technique::submit_frame;
 use shadowlab_gpu::techniques::virtual_sm::VirtualShadows;
 
 mod common;
