@@ -1,6 +1,8 @@
-//! CPU half of `virtual`, virtual (page-based) shadow maps for directional lights, after the
-//! UE5 design: clipmap levels around the camera, each a virtual map of `virtual_res` texels a
-//! side in pages of `page_res` texels; level k covers 2^k times level 0's extent.
+//! CPU half of `virtual`, virtual (page-based) shadow maps after the UE5 design. Directional
+//! lights: clipmap levels around the camera, each a virtual map of `virtual_res` texels a side
+//! in pages of `page_res` texels; level k covers 2^k times level 0's extent. Spot lights: one
+//! perspective virtual map of the cone with a mip chain (level k: `virtual_res / 2^k` texels a
+//! side, the same pages), see `spot.rs`; the rest of this file serves both.
 //!
 //! Light space (`iasm::light_basis`): `x` = right, `y` = up, depth = distance along the
 //! direction the light travels. Global texel coordinates of level k: `gx = x / t_k`,
@@ -10,31 +12,36 @@
 //! which is snapped to whole pages around the camera, so a page keeps its content (and its
 //! cache entry) while the camera moves. The page table slot of a page is
 //! `(py mod N) N + (px mod N)` (clipmap wrap: unique inside the window).
-//! Stored depth: orthographic, linear, 0 = near the light.
+//! Stored depth: orthographic, linear, 0 = near the light (spot: post-projective, 0 = near).
 
 mod alloc;
+mod spot;
 pub use alloc::{with_fallbacks, Allocation, PageCache, PageKey};
+pub use spot::{spot_levels, Projection};
 
 use glam::{IVec2, Mat4, Vec2, Vec3, Vec4};
 
 use super::iasm::light_basis;
 use crate::scene::Bounds;
 
-/// The clipmap of one directional light for one view.
+/// The clipmap of one directional light (or the mip chain of one spot light) for one view.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clipmap {
+    /// Orthographic (directional) or the spot's perspective.
+    pub projection: Projection,
     pub right: Vec3,
     pub up: Vec3,
     pub dir: Vec3,
     pub levels: u32,
     pub virtual_res: u32,
     pub page_res: u32,
-    /// World side of level 0.
+    /// World side of level 0 (spot: 2, the NDC side of the map).
     pub extent0: f32,
-    /// Light depth range (distance along the light) of the scene, with a margin.
+    /// Light depth range (distance along the light) of the scene, with a margin (spot: the
+    /// perspective's near and far planes).
     pub z_near: f32,
     pub z_far: f32,
-    /// Per level: global page coordinates of the window's first page.
+    /// Per level: global page coordinates of the window's first page (spot: 0).
     pub origins: Vec<IVec2>,
 }
 
@@ -48,6 +55,7 @@ impl Clipmap {
         let (lo, hi) = depths.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &d| (a.min(d), b.max(d)));
         let margin = bounds.diagonal().max(1e-6) * 1e-3;
         let mut c = Clipmap {
+            projection: Projection::Ortho,
             right,
             up,
             dir,
@@ -90,13 +98,7 @@ impl Clipmap {
 
     /// Global texel coordinates of world point p at level k (continuous).
     pub fn texel_coords(&self, k: u32, p: Vec3) -> Vec2 {
-        let s = self.inv_texel(k);
-        Vec2::new(p.dot(self.right) * s, -p.dot(self.up) * s)
-    }
-
-    /// Linear light depth of p (0 near the light, 1 far).
-    pub fn depth(&self, p: Vec3) -> f32 {
-        (p.dot(self.dir) - self.z_near) / (self.z_far - self.z_near)
+        self.light_coords(p) * self.inv_texel(k)
     }
 
     /// The window origin (in pages) of level k centred on `eye`: the eye's page minus N/2.
@@ -114,7 +116,7 @@ impl Clipmap {
     /// Whether page `pg` lies in level k's window.
     pub fn in_window(&self, k: u32, pg: IVec2) -> bool {
         let d = pg - self.origins[k as usize];
-        let n = self.pages_per_side() as i32;
+        let n = self.side(k);
         d.x >= 0 && d.y >= 0 && d.x < n && d.y < n
     }
 
@@ -144,10 +146,10 @@ impl Clipmap {
     pub fn sample_pages(&self, p: Vec3, footprint: f32, scale: f32, reach: f32) -> Vec<PageKey> {
         let corners = |k: u32| {
             let g = self.texel_coords(k, p);
-            [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(sx, sy)| self.page_of(g + Vec2::new(sx, sy) * reach))
+            [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(sx, sy)| self.page_at(k, g + Vec2::new(sx, sy) * reach))
         };
         let mut out = Vec::new();
-        let mut k = level_for(footprint, self.texel(0), scale, self.levels);
+        let mut k = level_for(footprint, self.texel0_at(p), scale, self.levels);
         while k < self.levels {
             let c = corners(k);
             if c.iter().all(|pg| self.in_window(k, *pg)) {
@@ -168,6 +170,9 @@ impl Clipmap {
     /// The orthographic view-projection of one page: its light-space square to NDC x/y in
     /// [-1, 1] (NDC y = +1 at the page's top row), depth to [0, 1] as [`depth`](Self::depth).
     pub fn page_view_proj(&self, key: PageKey) -> Mat4 {
+        if let Projection::Persp { .. } = self.projection {
+            return self.spot_page_view_proj(key);
+        }
         let s = self.texel(key.level) * self.page_res as f32;
         let x0 = key.x as f32 * s;
         let y_top = -(key.y as f32) * s;
@@ -183,12 +188,7 @@ impl Clipmap {
     /// Whether page `key` (any level, inside its window or not) overlaps the light-space
     /// rectangle of world box b (closed intervals: touching counts).
     pub fn page_overlaps(&self, key: &PageKey, b: &Bounds) -> bool {
-        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-        for c in b.corners() {
-            let g = self.texel_coords(key.level, c);
-            lo = lo.min(g);
-            hi = hi.max(g);
-        }
+        let Some((lo, hi)) = self.texel_rect(key.level, b) else { return true };
         let (a, z) = (self.page_of(lo), self.page_of(hi));
         (a.x..=z.x).contains(&key.x) && (a.y..=z.y).contains(&key.y)
     }
@@ -196,15 +196,12 @@ impl Clipmap {
     /// Pages of level k overlapping the world box b (light-space rectangle of its corners),
     /// limited to the window, in (y, x) order.
     pub fn pages_touching(&self, k: u32, b: &Bounds) -> Vec<PageKey> {
-        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-        for c in b.corners() {
-            let g = self.texel_coords(k, c);
-            lo = lo.min(g);
-            hi = hi.max(g);
-        }
-        let n = self.pages_per_side() as i32;
+        let n = self.side(k);
         let o = self.origins[k as usize];
-        let (p0, p1) = (self.page_of(lo).max(o), self.page_of(hi).min(o + IVec2::splat(n - 1)));
+        let (p0, p1) = match self.texel_rect(k, b) {
+            Some((lo, hi)) => (self.page_of(lo).max(o), self.page_of(hi).min(o + IVec2::splat(n - 1))),
+            None => (o, o + IVec2::splat(n - 1)),
+        };
         let mut out = Vec::new();
         for y in p0.y..=p1.y {
             for x in p0.x..=p1.x {
@@ -212,6 +209,26 @@ impl Clipmap {
             }
         }
         out
+    }
+
+    /// The texel rectangle of level k covered by world box b (its corners' light coordinates),
+    /// None where it spans the whole map (a corner behind a spot light).
+    pub fn texel_rect(&self, k: u32, b: &Bounds) -> Option<(Vec2, Vec2)> {
+        let (lo, hi) = self.light_rect(b)?;
+        let s = self.inv_texel(k);
+        Some((lo * s, hi * s))
+    }
+
+    /// The light-coordinate rectangle of world box b (see [`light_coords`](Self::light_coords)),
+    /// None where it spans the whole map (a corner at or behind a spot light's plane).
+    pub fn light_rect(&self, b: &Bounds) -> Option<(Vec2, Vec2)> {
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for c in b.corners() {
+            let g = self.light_coords_in_front(c)?;
+            lo = lo.min(g);
+            hi = hi.max(g);
+        }
+        Some((lo, hi))
     }
 }
 
@@ -241,3 +258,5 @@ pub fn pixel_angle(fov_y_deg: f32, height: u32) -> f32 {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod spot_tests;

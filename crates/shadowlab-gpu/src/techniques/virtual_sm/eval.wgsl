@@ -1,5 +1,5 @@
 // Evaluation through the page table: the sample's level (choose_level), the `sm` bias family
-// in texels of that level, then each of the NxN PCF taps looked up through the page table
+// in texels of that level (a spot's texel at the sample's light depth), then each of the NxN PCF taps looked up through the page table
 // (a tap across a page border reads the neighbouring page: no guard band needed) and compared
 // with its atlas texel (lit where depth <= stored, as the comparison sampler of `sm`). Where a
 // tap's page is not mapped (fallen back) the whole kernel moves to the next coarser level.
@@ -15,7 +15,7 @@
 fn lookup(k: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     let kw = i32(vp.pcf.x);
     let half = f32(kw - 1) * 0.5;
-    let q = biased_point(p, n, l, 1.0 / inv_texel(k), vp.bias, half);
+    let q = biased_point(p, n, l, texel_world(k, p), vp.bias, half);
     let g = texel_coords(k, q);
     let z = light_depth(q);
     if z > 1.0 {
@@ -23,10 +23,13 @@ fn lookup(k: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     }
     let pr = i32(vp.dims.z);
     let cols = i32(vp.dims.w);
+    // a spot map clamps taps to its edge (sm's clamp-to-edge sampler)
+    let edge = select(vec2<i32>(i32(0x7fffffff)), vec2<i32>(side(k) * pr - 1), is_spot());
+    let lo = select(vec2<i32>(i32(-0x7fffffff)), vec2<i32>(0), is_spot());
     var lit = 0.0;
     for (var y = 0; y < kw; y++) {
         for (var x = 0; x < kw; x++) {
-            let tap = vec2<i32>(floor(g + vec2<f32>(f32(x), f32(y)) - half));
+            let tap = clamp(vec2<i32>(floor(g + vec2<f32>(f32(x), f32(y)) - half)), lo, edge);
             let pg = vec2<i32>(floor(vec2<f32>(tap) * (1.0 / f32(pr))));
             if !in_window(k, pg) {
                 return -1.0;

@@ -1,13 +1,15 @@
 //! `virtual`'s passes: marking, the readback and CPU allocation (`prepare`), page rendering
 //! into the atlas (`render`), evaluation through the page table (`evaluate`).
 
-use glam::{Vec2, Vec3};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 use shadowlab_core::scene::Bounds;
-use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, with_fallbacks, Allocation, Clipmap, PageCache, PageKey};
+use shadowlab_core::techniques::virtual_sm::{
+    bias_scale, pixel_angle, with_fallbacks, Allocation, Clipmap, PageCache, PageKey, Projection,
+};
 
 use super::bounds::ChunkBounds;
+use super::draw::{clear_pipeline, page_draws, Chunk};
 use super::{eval_source, mark_source, page_source, VirtualParams, MAX_LEVELS};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -18,28 +20,8 @@ use crate::{binding, raster, Gpu, GpuError};
 /// rectangle overlaps it. Smaller: tighter culling, more draws per page.
 pub const CHUNK_TRIANGLES: u32 = 1024;
 
-/// A chunk: triangle range and its light-space rectangle (x, y of the light basis).
-struct Chunk {
-    first: u32,
-    end: u32,
-    lo: Vec2,
-    hi: Vec2,
-}
-
-impl Chunk {
-    fn new(first: u32, end: u32, world: &Bounds, right: Vec3, up: Vec3) -> Chunk {
-        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-        for c in world.corners() {
-            let q = Vec2::new(c.dot(right), c.dot(up));
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
-        Chunk { first, end, lo, hi }
-    }
-}
-
 pub struct VirtualShadows {
-    pub(super) dir: Vec3,
+    pub(super) light: Light,
     pub(super) levels: u32,
     pub(super) virtual_res: u32,
     pub(super) page_res: u32,
@@ -85,15 +67,17 @@ pub struct VirtualShadows {
 
 impl VirtualShadows {
     pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<VirtualShadows, GpuError> {
-        let Light::Directional { direction } = *light else {
-            return Err(GpuError::Invalid(format!("virtual supports directional lights only (got a {} light)", light.kind())));
-        };
         let (virtual_res, page_res, levels) = (p.get_u32("virtual_res"), p.get_u32("page_res"), p.get_u32("levels"));
         if !page_res.is_power_of_two() || virtual_res % page_res != 0 {
             return Err(GpuError::Invalid(format!(
                 "virtual: page_res {page_res} must be a power of two dividing virtual_res {virtual_res}"
             )));
         }
+        let extent0 = p.get("level0_extent") as f32;
+        // the light's projection at creation (the light never moves): chunk rectangles, levels
+        let proto = Clipmap::for_light(light, &scene.bounds, scene.bounds.center(), levels, virtual_res, page_res, extent0)
+            .ok_or_else(|| GpuError::Invalid(format!("virtual supports directional and spot lights (got a {} light)", light.kind())))?;
+        let levels = proto.levels;
         let max = gpu.limits.max_texture_dimension_2d;
         let slots = (p.get("pool_mib") * 1048576.0 / (page_res as f64 * page_res as f64 * 4.0)).floor() as u32;
         // near-square atlas: a power-of-two column count around sqrt(slots), full rows only
@@ -106,7 +90,7 @@ impl VirtualShadows {
         let atlas = raster::depth_target(gpu, "virtual.atlas", cols * page_res, rows * page_res, 1, wgpu::TextureUsages::empty());
         let pages_per_side = virtual_res / page_res;
         let table_len = (levels * pages_per_side * pages_per_side) as u64;
-        let params = VirtualParams::zeroed_for(p, levels, pages_per_side, page_res, cols);
+        let params = VirtualParams::zeroed_for(p, &proto, pages_per_side, page_res, cols);
         let uniform = gpu.uniform("virtual.params", &params);
         let requests = gpu.storage("virtual.requests", table_len * 4);
         let page_table = gpu.storage("virtual.page_table", table_len * 4);
@@ -124,7 +108,6 @@ impl VirtualShadows {
         let page_group = binding::group(d, "virtual.page", &page_layout, &[page_mats.as_entire_binding()]);
         let page_pipeline = raster::depth_pipeline(gpu, "virtual.page", &page_source(), &[&page_layout, &scene.layout], scene.has_cutouts);
         let clear_pipeline = clear_pipeline(gpu, &page_source(), &[&page_layout, &scene.layout]);
-        let (right, up, _) = shadowlab_core::techniques::iasm::light_basis(direction);
         // static chunks: bounded once here, at creation; moving ones: every frame (prepare)
         let mut chunks = Vec::new();
         let split = scene.dynamic_first.min(scene.triangle_count);
@@ -137,7 +120,7 @@ impl VirtualShadows {
             let boxes = ChunkBounds::parse(&gpu.read_buffer_as::<u32>(&b.boxes, b.count as usize * 6));
             for (i, w) in boxes.iter().enumerate() {
                 let first = i as u32 * CHUNK_TRIANGLES;
-                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(split), w, right, up));
+                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(split), w, &proto));
             }
         }
         let dynamic_chunk0 = chunks.len();
@@ -146,17 +129,17 @@ impl VirtualShadows {
         if let Some(b) = &dynamic {
             for i in 0..b.count {
                 let first = split + i * CHUNK_TRIANGLES;
-                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(scene.triangle_count), &scene.bounds, right, up));
+                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(scene.triangle_count), &scene.bounds, &proto));
             }
         }
         let probe = gpu.storage("virtual.probe", table_len * 4 + dynamic.as_ref().map_or(0, |b| b.count as u64 * 24));
         let kernel_half = (p.get_u32("pcf") as f32 - 1.0) * 0.5;
         Ok(VirtualShadows {
-            dir: direction,
+            light: *light,
             levels,
             virtual_res,
             page_res,
-            extent0: p.get("level0_extent") as f32,
+            extent0,
             bias_scale: bias_scale(p.get("resolution_bias") as f32),
             // the kernel, the normal offset's sideways shift, one texel of rounding
             reach: kernel_half + p.get("normal_offset") as f32 + 1.0,
@@ -226,51 +209,30 @@ impl VirtualShadows {
         self.cache.invalidate(&keys)
     }
 
-    fn page_rect(c: &Clipmap, k: &PageKey) -> (Vec2, Vec2) {
-        let s = c.texel(k.level) * c.page_res as f32;
-        (Vec2::new(k.x as f32 * s, -(k.y as f32 + 1.0) * s), Vec2::new((k.x as f32 + 1.0) * s, -(k.y as f32) * s))
-    }
 }
 
 impl VirtualParams {
-    fn zeroed_for(p: &ParamValues, levels: u32, n: u32, page_res: u32, cols: u32) -> VirtualParams {
+    fn zeroed_for(p: &ParamValues, proto: &Clipmap, n: u32, page_res: u32, cols: u32) -> VirtualParams {
+        let levels = proto.levels;
         let mut v: VirtualParams = bytemuck::Zeroable::zeroed();
         v.dims = [levels, n, page_res, cols];
         v.bias = [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32];
         v.pcf = [p.get_u32("pcf"), 0, 0, 0];
+        if let Projection::Persp { position, tan_half } = proto.projection {
+            v.pcf[1] = 1;
+            v.spot = position.extend(tan_half).into();
+        }
         v
     }
-}
-
-/// The slot clear: `vs_clear` at depth 1, depth test Always, no fragment stage.
-fn clear_pipeline(gpu: &Gpu, source: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
-    let module = gpu.shader("virtual.clear", source);
-    let layout = gpu.pipeline_layout("virtual.clear", layouts);
-    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("virtual.clear"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_clear"), compilation_options: Default::default(), buffers: &[] },
-        primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: raster::DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: None,
-        multiview_mask: None,
-        cache: None,
-    })
 }
 
 impl Technique for VirtualShadows {
     /// Marking on the GPU, one readback, the allocation and page table on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let c = Clipmap::new(self.dir, &f.scene.bounds, f.camera.position, self.levels, self.virtual_res, self.page_res, self.extent0);
+        let c = Clipmap::for_light(&self.light, &f.scene.bounds, f.camera.position, self.levels, self.virtual_res, self.page_res, self.extent0)
+            .expect("a light kind checked at creation");
         let v = &mut self.params;
-        v.right = c.right.extend(c.texel(0)).into();
+        v.right = c.right.extend(c.texel0_scale()).into();
         v.up = c.up.extend(c.inv_texel(0)).into();
         v.dir = c.dir.extend(c.z_near).into();
         v.view = [c.z_far, pixel_angle(f.camera.fov_y_deg, f.gbuffer.height), self.bias_scale, self.reach];
@@ -310,7 +272,7 @@ impl Technique for VirtualShadows {
             }
             for (i, b) in now.iter().enumerate() {
                 let ch = &mut self.chunks[self.dynamic_chunk0 + i];
-                *ch = Chunk::new(ch.first, ch.end, b, c.right, c.up);
+                *ch = Chunk::new(ch.first, ch.end, b, &c);
             }
             self.dynamic_boxes = Some(now);
         }
@@ -341,7 +303,7 @@ impl Technique for VirtualShadows {
         let (Some(c), false) = (&self.clipmap, self.alloc.render.is_empty()) else { return Ok(()) };
         let view = self.atlas.create_view(&Default::default());
         let pr = self.page_res;
-        let draws: Vec<Vec<(u32, u32)>> = self.alloc.render.iter().map(|(k, _)| self.page_draws(c, k)).collect();
+        let draws: Vec<Vec<(u32, u32)>> = self.alloc.render.iter().map(|(k, _)| page_draws(&self.chunks, c, k)).collect();
         rec.stage("virtual.render", |enc| {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("virtual.render"),
@@ -389,22 +351,6 @@ impl Technique for VirtualShadows {
 }
 
 impl VirtualShadows {
-    /// Triangle ranges of the chunks overlapping page `k` (adjacent chunks merged).
-    fn page_draws(&self, c: &Clipmap, k: &PageKey) -> Vec<(u32, u32)> {
-        let (lo, hi) = Self::page_rect(c, k);
-        let mut out: Vec<(u32, u32)> = Vec::new();
-        for ch in &self.chunks {
-            if ch.hi.x < lo.x || ch.lo.x > hi.x || ch.hi.y < lo.y || ch.lo.y > hi.y {
-                continue;
-            }
-            match out.last_mut() {
-                Some(last) if last.1 == ch.first => last.1 = ch.end,
-                _ => out.push((ch.first, ch.end)),
-            }
-        }
-        out
-    }
-
     fn eval_pass(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) {
         let atlas_view = self.atlas.create_view(&Default::default());
         let group = f.view_group(

@@ -11,10 +11,10 @@
 fn mark_level(k: u32, g: vec2<f32>, all_or_none: bool, flag: u32) -> bool {
     let r = vp.view.w;
     var c: array<vec2<i32>, 4>;
-    c[0] = page_of(g + vec2<f32>(-r, -r));
-    c[1] = page_of(g + vec2<f32>(r, -r));
-    c[2] = page_of(g + vec2<f32>(-r, r));
-    c[3] = page_of(g + vec2<f32>(r, r));
+    c[0] = page_at(k, g + vec2<f32>(-r, -r));
+    c[1] = page_at(k, g + vec2<f32>(r, -r));
+    c[2] = page_at(k, g + vec2<f32>(-r, r));
+    c[3] = page_at(k, g + vec2<f32>(r, r));
     var inside = true;
     for (var i = 0; i < 4; i++) {
         inside = inside && in_window(k, c[i]);

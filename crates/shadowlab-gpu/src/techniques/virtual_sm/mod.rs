@@ -1,18 +1,21 @@
-//! `virtual`: virtual (page-based) shadow maps for directional lights, after UE5's design.
-//! Clipmap levels around the camera, each a virtual map of `virtual_res` texels a side in
-//! pages of `page_res`; only the pages view samples need are rendered, into slots of one
-//! Depth32Float atlas (the physical pool, `pool_mib`), and kept across frames while nothing
-//! moved over them. The CPU half (level geometry, page math, the pool) is
-//! `shadowlab_core::techniques::virtual_sm`. (The folder is `virtual_sm`: `virtual` is a Rust
-//! keyword, and `vsm` is variance shadow maps.) Stored depth: orthographic, linear, 0 = near.
+//! `virtual`: virtual (page-based) shadow maps for directional and spot lights, after UE5's
+//! design. Directional: clipmap levels around the camera, each a virtual map of `virtual_res`
+//! texels a side in pages of `page_res`. Spot: one perspective virtual map of the cone with a
+//! mip chain (level k: `virtual_res / 2^k` texels a side) in the same pages. Only the pages
+//! view samples need are rendered, into slots of one Depth32Float atlas (the physical pool,
+//! `pool_mib`), and kept across frames while nothing moved over them. The CPU half (level
+//! geometry, projections, page math, the pool) is `shadowlab_core::techniques::virtual_sm`.
+//! (The folder is `virtual_sm`: `virtual` is a Rust keyword, and `vsm` is variance shadow
+//! maps.) Stored depth: 0 = near; linear (directional) or post-projective (spot, as `sm`).
 //!
 //! Per frame: `prepare` marks the requested pages on the GPU (mark.wgsl), reads the flags back
 //! (one stall, `virtual.readback`), and allocates slots on the CPU in a fixed priority order
 //! (coarse levels first; a full pool makes the finest pages fall back, counted); `render` draws
-//! the new pages, each with its own orthographic frustum into its slot, with the scene's chunks
+//! the new pages, each with its own frustum (orthographic, or the spot's narrowed) into its slot, with the scene's chunks
 //! culled per page; `evaluate` looks every PCF tap up through the page table (eval.wgsl).
 
 mod bounds;
+mod draw;
 mod gpu;
 mod params;
 mod report;
@@ -50,11 +53,11 @@ fn page_source() -> String {
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "virtual",
-    summary: "virtual shadow maps: clipmap levels of 16K virtual texels in 128^2 pages; only the pages view samples need are rendered, cached across frames",
+    summary: "virtual shadow maps: clipmap levels (spot: one map's mip chain) of 16K virtual texels in 128^2 pages; only the pages view samples need are rendered, cached across frames",
     cost: "a marking pass, one readback (a sync), per new page one atlas viewport with culled chunks; N^2 page-table lookups per pixel",
     quality: "about one texel per pixel everywhere (resolution_bias); a full pool makes fine pages fall back to coarser ones (reported)",
     source: "Epic Games, Unreal Engine 5 virtual shadow maps (2021); clipmaps: Tanner, Migdal, Jones 1998",
-    lights: &["directional"],
+    lights: &["directional", "spot"],
     params: PARAMS,
     stalls: "virtual.readback: the page requests read back for the CPU allocation (every frame)",
     needs: "",
@@ -67,7 +70,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct VirtualParams {
-    /// xyz: light x axis; w: world size of a level-0 texel.
+    /// xyz: light x axis; w: world size of a level-0 texel (spot: per unit of light depth).
     pub right: [f32; 4],
     /// xyz: light y axis; w: level-0 texels per world unit.
     pub up: [f32; 4],
@@ -79,8 +82,10 @@ pub struct VirtualParams {
     pub dims: [u32; 4],
     /// bias, slope_bias, normal_offset, max_slope.
     pub bias: [f32; 4],
-    /// x: PCF width.
+    /// x: PCF width, y: projection (0 orthographic, 1 spot).
     pub pcf: [u32; 4],
+    /// Spot: xyz position, w tan(cone half-angle).
+    pub spot: [f32; 4],
     /// xy: window origins per level (pages).
     pub origins: [[i32; 4]; MAX_LEVELS],
 }

@@ -39,7 +39,7 @@ pub const PARAMS: &[ParamDef] = &[
         DEFAULT_LEVELS,
         1.0,
         24.0,
-        "clipmap levels; level k covers 2^k x level0_extent",
+        "clipmap levels; level k covers 2^k x level0_extent (spot: mip levels of the one map, at most down to one page)",
         "shadowlab: covers 42 km at the default extent",
     ),
     ParamDef::number(
@@ -47,7 +47,7 @@ pub const PARAMS: &[ParamDef] = &[
         DEFAULT_LEVEL0_EXTENT,
         1e-4,
         1e6,
-        "world side of clipmap level 0 (scene units)",
+        "world side of clipmap level 0 (scene units; directional lights only)",
         "UE5 r.Shadow.Virtual.Clipmap.FirstLevel = 6 (radius 2^6 cm)",
     ),
     ParamDef::number(
@@ -55,8 +55,8 @@ pub const PARAMS: &[ParamDef] = &[
         DEFAULT_RESOLUTION_BIAS,
         -8.0,
         8.0,
-        "level = ceil(log2(pixel footprint / level-0 texel) + bias); negative: finer texels, more pages",
-        "UE5 r.Shadow.Virtual.ResolutionLodBiasDirectional",
+        "level = ceil(log2(pixel footprint / level-0 texel at the sample) + bias); negative: finer texels, more pages",
+        "UE5 r.Shadow.Virtual.ResolutionLodBiasDirectional (spot: ...ResolutionLodBiasLocal)",
     ),
     ParamDef::number(
         "pool_mib",

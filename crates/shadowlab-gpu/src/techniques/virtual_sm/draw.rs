@@ -1,0 +1,69 @@
+//! Page drawing helpers of `virtual`: the culling chunks (triangle ranges with their
+//! light-coordinate rectangles), the chunks a page draws, and the slot-clear pipeline.
+
+use glam::Vec2;
+use shadowlab_core::scene::Bounds;
+use shadowlab_core::techniques::virtual_sm::{Clipmap, PageKey};
+
+use crate::{raster, Gpu};
+
+/// A chunk: triangle range and its rectangle in level-0 light coordinates
+/// (`Clipmap::light_rect`; unbounded where it spans the whole map).
+pub(super) struct Chunk {
+    pub first: u32,
+    pub end: u32,
+    lo: Vec2,
+    hi: Vec2,
+}
+
+impl Chunk {
+    pub fn new(first: u32, end: u32, world: &Bounds, c: &Clipmap) -> Chunk {
+        let (lo, hi) = c.light_rect(world).unwrap_or((Vec2::splat(f32::NEG_INFINITY), Vec2::splat(f32::INFINITY)));
+        Chunk { first, end, lo, hi }
+    }
+}
+
+/// The rectangle of page `k` in level-0 light coordinates.
+fn page_rect(c: &Clipmap, k: &PageKey) -> (Vec2, Vec2) {
+    let s = c.texel(k.level) * c.page_res as f32;
+    (Vec2::new(k.x as f32 * s, k.y as f32 * s), Vec2::new((k.x as f32 + 1.0) * s, (k.y as f32 + 1.0) * s))
+}
+
+/// Triangle ranges of the chunks overlapping page `k` (adjacent chunks merged).
+pub(super) fn page_draws(chunks: &[Chunk], c: &Clipmap, k: &PageKey) -> Vec<(u32, u32)> {
+    let (lo, hi) = page_rect(c, k);
+    let mut out: Vec<(u32, u32)> = Vec::new();
+    for ch in chunks {
+        if ch.hi.x < lo.x || ch.lo.x > hi.x || ch.hi.y < lo.y || ch.lo.y > hi.y {
+            continue;
+        }
+        match out.last_mut() {
+            Some(last) if last.1 == ch.first => last.1 = ch.end,
+            _ => out.push((ch.first, ch.end)),
+        }
+    }
+    out
+}
+
+/// The slot clear: `vs_clear` at depth 1, depth test Always, no fragment stage.
+pub(super) fn clear_pipeline(gpu: &Gpu, source: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
+    let module = gpu.shader("virtual.clear", source);
+    let layout = gpu.pipeline_layout("virtual.clear", layouts);
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("virtual.clear"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_clear"), compilation_options: Default::default(), buffers: &[] },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: raster::DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
