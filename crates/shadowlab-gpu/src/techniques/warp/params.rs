@@ -179,7 +179,7 @@ pub const STRENGTH: ParamDef = ParamDef::number(
 /// whiteboard streaks of conference sun). `cube-notw`/`dpsm-notw` keep mode 0: mode 2 brings
 /// acne to them (docs/bench/point_quality.md).
 pub const DEFAULT_BIAS_MODE: f64 = 2.0;
-pub const BIAS_MODE: ParamDef = ParamDef::integer("bias_mode", DEFAULT_BIAS_MODE, 0.0, 3.0, "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side", "shadowlab measurement (docs/bench/warp_bias.md)");
+pub const BIAS_MODE: ParamDef = ParamDef::integer("bias_mode", DEFAULT_BIAS_MODE, 0.0, 4.0, "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side, 4 = mode 2 with J the secant Jacobian of the warped texel the sample falls in (its corners pulled back exactly; bounded across the warp's kinks)", "shadowlab measurement (docs/bench/warp_bias.md)");
 /// Cap of bias mode 2's footprint, in cropped texels; 0 = 1 / MIN_WARP_SCALE (8, as mode 0).
 pub const DEFAULT_FOOTPRINT_CAP: f64 = 0.0;
 pub const FOOTPRINT_CAP: ParamDef = ParamDef::number(
