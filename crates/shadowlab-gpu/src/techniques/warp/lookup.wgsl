@@ -84,12 +84,12 @@ fn edge_warp(rows: bool, a: u32, b: u32, t: f32, k: u32, n: u32) -> f32 {
     return f32(k) / f32(n) + wp.strength * mix(oa, ob, t);
 }
 
-// The x with edge_warp's function(x) = target, exactly (warp.rs `invert_pl`): the function is
+// The x with edge_warp's function(x) = goal, exactly (warp.rs `invert_pl`): the function is
 // monotonic and piecewise linear with kinks at the texel edges only, so bisection over the edges
 // finds the segment and its line gives x. Outside [0,1) the warp is the identity.
-fn invert_1d(rows: bool, a: u32, b: u32, t: f32, target: f32) -> f32 {
-    if target < 0.0 || target >= 1.0 {
-        return target;
+fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32) -> f32 {
+    if goal < 0.0 || goal >= 1.0 {
+        return goal;
     }
     var n = textureDimensions(warp_y).y;
     if rows {
@@ -102,7 +102,7 @@ fn invert_1d(rows: bool, a: u32, b: u32, t: f32, target: f32) -> f32 {
     while hi - lo > 1u {
         let mid = (lo + hi) / 2u;
         let f = edge_warp(rows, a, b, t, mid, n);
-        if f <= target {
+        if f <= goal {
             lo = mid;
             flo = f;
         } else {
@@ -110,12 +110,12 @@ fn invert_1d(rows: bool, a: u32, b: u32, t: f32, target: f32) -> f32 {
             fhi = f;
         }
     }
-    let s = select(0.0, clamp((target - flo) / (fhi - flo), 0.0, 1.0), fhi > flo);
+    let s = select(0.0, clamp((goal - flo) / (fhi - flo), 0.0, 1.0), fhi > flo);
     return (f32(lo) + s) / f32(n);
 }
 
 // The exact inverse of `warp` (warp.rs `Warp2D::unapply`): the column pass reads its functions
-// at x', which the target gives, so y is one 1D inversion; the row pass reads its functions at
+// at x', which the goal gives, so y is one 1D inversion; the row pass reads its functions at
 // y, so x is another.
 fn unwarp_exact(t: vec2<f32>) -> vec2<f32> {
     if wp.warped < 0.5 {
