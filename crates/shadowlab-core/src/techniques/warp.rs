@@ -138,6 +138,57 @@ impl Warp2D {
     }
 }
 
+/// The x (increasing in [0,1]) where the monotonic piecewise-linear f, with f(0) = 0, f(1) = 1
+/// and one kink per texel edge k / res (`f(k)` gives its value there), reaches `target`:
+/// bisection over the edges, then the linear segment solved exactly. Outside [0,1) f is the
+/// identity (the offsets vanish there). The GPU `invert_pl` in lookup.wgsl.
+pub fn invert_pl(f: impl Fn(usize) -> f32, res: usize, target: f32) -> f32 {
+    if !(0.0..1.0).contains(&target) {
+        return target;
+    }
+    // invariant: f(lo) <= target < f(hi) (edge indices)
+    let (mut lo, mut hi) = (0usize, res);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if f(mid) <= target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let (a, b) = (f(lo), f(hi));
+    let t = if b > a { ((target - a) / (b - a)).clamp(0.0, 1.0) } else { 0.0 };
+    (lo as f32 + t) / res as f32
+}
+
+impl Warp2D {
+    /// The exact inverse of `apply` (no iteration): the column pass y' = y + o_y(y) uses the
+    /// functions at x', which the target gives, so y is one 1D inversion; then the row pass
+    /// x' = x + o_x(x) uses the functions at y, so x is another. Both 1D functions are
+    /// monotonic and piecewise linear with kinks only at texel edges (the interpolation weight
+    /// between functions is fixed by the other coordinate).
+    pub fn unapply(&self, xw: f32, yw: f32) -> (f32, f32) {
+        let res = self.res;
+        let edge = |o: &dyn Fn(f32) -> f32, k: usize| {
+            let x = k as f32 / res as f32;
+            if k >= res { 1.0 } else { x + o(x) }
+        };
+        let (a, b, t) = neighbours(xw, res, self.interp);
+        let (ca, cb) = (self.column(a), self.column(b));
+        let oy = |y: f32| {
+            let (p, q) = (eval_offset(&ca, y), eval_offset(&cb, y));
+            p + (q - p) * t
+        };
+        let y = invert_pl(|k| edge(&oy, k), res, yw);
+        let (a, b, t) = neighbours(y, res, self.interp);
+        let ox = |x: f32| {
+            let (p, q) = (eval_offset(self.row(a), x), eval_offset(self.row(b), x));
+            p + (q - p) * t
+        };
+        (invert_pl(|k| edge(&ox, k), res, xw), y)
+    }
+}
+
 /// Sample counts per texel of `points`, optionally after the row pass only or the full warp.
 pub fn count_map(points: &[[f32; 2]], res: usize, warp: Option<(&Warp2D, bool)>) -> Vec<u32> {
     let mut c = vec![0u32; res * res];
@@ -271,3 +322,7 @@ pub fn gradient_footprint(a1: [f32; 2], a2: [f32; 2], j0: [f32; 2], j1: [f32; 2]
 #[cfg(test)]
 #[path = "warp_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "warp_kinks_tests.rs"]
+mod kinks_tests;

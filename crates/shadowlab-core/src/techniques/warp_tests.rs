@@ -1,6 +1,6 @@
 use super::*;
 
-fn lcg(seed: &mut u64) -> f32 {
+pub(super) fn lcg(seed: &mut u64) -> f32 {
     *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
     ((*seed >> 40) as f32) / (1u64 << 24) as f32
 }

@@ -1,6 +1,7 @@
 // Fragment stage of the warped depth pass with `exact_depth` (see depth.wgsl): the fragment's
 // warped map coordinate t is pulled back through the warp by Newton steps on warp(u) = t
-// (lookup.wgsl `unwarp`: 3 steps, forward-difference Jacobian over half a texel), and the
+// (lookup.wgsl `unwarp`: 3 steps, forward-difference Jacobian over half a texel; or exactly,
+// `unwarp_exact`, with `exact_inverse`), and the
 // depth of the piece's plane at u is written (paraboloid: the distance along the direction of u
 // to the triangle's plane). Clamped to the piece corners' depth range, so a
 // bad inversion is never worse than the interpolated depth's worst case.
@@ -14,7 +15,12 @@ fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
         return in.clip.z;
     }
     let res = wp.res;
-    let inv = unwarp(in.clip.xy / res, in.u);
+    var inv = vec3<f32>(0.0);
+    if wp.exact_inverse > 0.5 {
+        inv = vec3<f32>(unwarp_exact(in.clip.xy / res), 0.0);
+    } else {
+        inv = unwarp(in.clip.xy / res, in.u);
+    }
     // not converged: the rasterised depth
     if inv.z > FALLBACK {
         return in.clip.z;

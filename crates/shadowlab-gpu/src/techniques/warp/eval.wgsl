@@ -5,8 +5,10 @@
 // warp's Jacobian J (finite differences over one texel): mode 0, the cropped texel divided by
 // the smallest singular value of J (isotropic: the largest footprint, which leaks where the
 // warp compresses one direction); mode 1, divided only where J magnifies every direction; mode
-// 2 (notw's default), the footprint along the receiver's depth-gradient direction,
-// `gradient_footprint` (docs/bench/warp_bias.md). Also counts the samples per warped texel
+// 2, the footprint along the receiver's depth-gradient direction, `gradient_footprint`
+// (docs/bench/warp_bias.md); mode 3, mode 2's largest at the sample and one texel to each side;
+// mode 4, mode 2's with J the secant Jacobian of the warped texel the sample falls in
+// (`texel_jacobian`: exact across the warp's kinks, docs/bench/warp_kinks.md). Also counts the samples per warped texel
 // (sampling statistics after warping).
 
 @group(0) @binding(10) var shadow_map: texture_depth_2d;
@@ -81,6 +83,27 @@ fn gradient_footprint(p: vec3<f32>, n: vec3<f32>, l: vec3<f32>, r: vec4<f32>, j:
     return min(length(z), cap);
 }
 
+// Secant Jacobian of the warped texel that contains c (bias mode 4): the texel's corners pulled
+// back through the warp exactly (lookup.wgsl `unwarp_exact`) span M (cropped per warped
+// texel), J = M^-1 / res. Where the warp is linear over the texel this is the Jacobian; across
+// a kink it is the texel's own extent, which the central difference at the sample can
+// underestimate several times (docs/bench/warp_kinks.md). None (w = 0) off the map.
+fn texel_jacobian(c: vec2<f32>) -> mat2x2<f32> {
+    let res = wp.res;
+    if any(c < vec2<f32>(0.0)) || any(c >= vec2<f32>(1.0)) {
+        return mat2x2<f32>(vec2<f32>(0.0), vec2<f32>(0.0));
+    }
+    let t = floor(c * res);
+    let a = unwarp_exact(t / res);
+    let m0 = unwarp_exact((t + vec2<f32>(1.0, 0.0)) / res) - a;
+    let m1 = unwarp_exact((t + vec2<f32>(0.0, 1.0)) / res) - a;
+    let det = (m0.x * m1.y - m1.x * m0.y) * res;
+    if abs(det) < 1e-20 {
+        return mat2x2<f32>(vec2<f32>(0.0), vec2<f32>(0.0));
+    }
+    return mat2x2<f32>(vec2<f32>(m1.y, -m0.y) / det, vec2<f32>(-m1.x, m0.x) / det);
+}
+
 // Central-difference Jacobian of the warp at u over +-h: columns d warp / dx, d warp / dy.
 fn jacobian(u: vec2<f32>, h: f32) -> mat2x2<f32> {
     let jx = (warp(u + vec2<f32>(h, 0.0)) - warp(u - vec2<f32>(h, 0.0))) / (2.0 * h);
@@ -121,7 +144,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if wp.warped > 0.5 {
         let j = jacobian(u0, 0.5 / res);
         let sv = singular_values(j[0], j[1]);
-        if wp.bias_mode > 2.5 {
+        if wp.bias_mode > 3.5 {
+            // mode 4: the secant Jacobian of the warped texel the sample falls in (the central
+            // difference where that texel is off the map or collapsed)
+            var jt = texel_jacobian(c0);
+            if jt[0].x * jt[1].y - jt[1].x * jt[0].y == 0.0 {
+                jt = j;
+            }
+            texel = gradient_footprint(p, n, l, r, jt, texel);
+        } else if wp.bias_mode > 2.5 {
             // mode 3: the largest gradient footprint at u0 and one texel to each side (the
             // warp's kinks: the Jacobian changes within a texel)
             var f = gradient_footprint(p, n, l, r, j, texel);

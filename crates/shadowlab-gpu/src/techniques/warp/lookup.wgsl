@@ -64,6 +64,71 @@ fn warp(u: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(xw, u.y + alpha * mix(offset_y(u32(b.x), u.y), offset_y(u32(b.y), u.y), b.z));
 }
 
+// x' of one 1D function pair at texel edge k of n (x = k / n): x + alpha * the offsets of
+// functions a and b mixed by t; the row functions (warp_x) if `rows`, else the columns (warp_y).
+fn edge_warp(rows: bool, a: u32, b: u32, t: f32, k: u32, n: u32) -> f32 {
+    if k == 0u || k >= n {
+        return f32(min(k, n)) / f32(n);
+    }
+    var oa = 0.0;
+    var ob = 0.0;
+    if rows {
+        let h = textureDimensions(warp_x).y - 1u;
+        oa = textureLoad(warp_x, vec2<u32>(k - 1u, min(a, h)), 0).x;
+        ob = textureLoad(warp_x, vec2<u32>(k - 1u, min(b, h)), 0).x;
+    } else {
+        let w = textureDimensions(warp_y).x - 1u;
+        oa = textureLoad(warp_y, vec2<u32>(min(a, w), k - 1u), 0).x;
+        ob = textureLoad(warp_y, vec2<u32>(min(b, w), k - 1u), 0).x;
+    }
+    return f32(k) / f32(n) + wp.strength * mix(oa, ob, t);
+}
+
+// The x with edge_warp's function(x) = goal, exactly (warp.rs `invert_pl`): the function is
+// monotonic and piecewise linear with kinks at the texel edges only, so bisection over the edges
+// finds the segment and its line gives x. Outside [0,1) the warp is the identity.
+fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32) -> f32 {
+    if goal < 0.0 || goal >= 1.0 {
+        return goal;
+    }
+    var n = textureDimensions(warp_y).y;
+    if rows {
+        n = textureDimensions(warp_x).x;
+    }
+    var lo = 0u;
+    var hi = n;
+    var flo = 0.0;
+    var fhi = 1.0;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        let f = edge_warp(rows, a, b, t, mid, n);
+        if f <= goal {
+            lo = mid;
+            flo = f;
+        } else {
+            hi = mid;
+            fhi = f;
+        }
+    }
+    let s = select(0.0, clamp((goal - flo) / (fhi - flo), 0.0, 1.0), fhi > flo);
+    return (f32(lo) + s) / f32(n);
+}
+
+// The exact inverse of `warp` (warp.rs `Warp2D::unapply`): the column pass reads its functions
+// at x', which the goal gives, so y is one 1D inversion; the row pass reads its functions at
+// y, so x is another.
+fn unwarp_exact(t: vec2<f32>) -> vec2<f32> {
+    if wp.warped < 0.5 {
+        return t;
+    }
+    let res = u32(wp.res);
+    let interp = wp.interp != 0u;
+    let b = neighbours(t.x, res, interp);
+    let y = invert_1d(false, u32(b.x), u32(b.y), b.z, t.y);
+    let a = neighbours(y, res, interp);
+    return vec2<f32>(invert_1d(true, u32(a.x), u32(a.y), a.z, t.x), y);
+}
+
 // Clip position of a world point in the warped map (Algorithm 1 of seed 000): crop to the DV,
 // warp, back to clip space. Behind a spot light only the (affine) crop applies.
 fn warped_clip(p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {

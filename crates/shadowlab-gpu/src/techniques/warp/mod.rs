@@ -185,7 +185,8 @@ pub struct WarpParams {
     pub depth_clamp: f32,
     /// Smallest warped extent (texels) of an edge that subdivision splits; 0 = no bound.
     pub min_piece: f32,
-    pub pad0: f32,
+    /// 1 = exact inversion in the exact depth pass (`exact_inverse`)
+    pub exact_inverse: f32,
     pub pad1: f32,
     pub pad2: f32,
 }
@@ -395,7 +396,7 @@ impl Warped {
             footprint_cap: k.footprint_cap,
             depth_clamp: k.depth_clamp as f32,
             min_piece: k.min_piece,
-            pad0: 0.0,
+            exact_inverse: if k.exact_inverse { 1.0 } else { 0.0 },
             pad1: 0.0,
             pad2: 0.0,
         };

@@ -179,7 +179,7 @@ pub const STRENGTH: ParamDef = ParamDef::number(
 /// whiteboard streaks of conference sun). `cube-notw`/`dpsm-notw` keep mode 0: mode 2 brings
 /// acne to them (docs/bench/point_quality.md).
 pub const DEFAULT_BIAS_MODE: f64 = 2.0;
-pub const BIAS_MODE: ParamDef = ParamDef::integer("bias_mode", DEFAULT_BIAS_MODE, 0.0, 3.0, "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side", "shadowlab measurement (docs/bench/warp_bias.md)");
+pub const BIAS_MODE: ParamDef = ParamDef::integer("bias_mode", DEFAULT_BIAS_MODE, 0.0, 4.0, "world size of a warped texel for the bias and normal offset: 0 = cropped texel / smallest singular value of the warp's Jacobian (isotropic), 1 = cropped texel shrunk only where the warp magnifies in every direction, 2 = footprint along the receiver's depth gradient |J^-T A^-T m|, capped, 3 = the largest of mode 2's at the sample and one texel to each side, 4 = mode 2 with J the secant Jacobian of the warped texel the sample falls in (its corners pulled back exactly; bounded across the warp's kinks)", "shadowlab measurement (docs/bench/warp_bias.md)");
 /// Cap of bias mode 2's footprint, in cropped texels; 0 = 1 / MIN_WARP_SCALE (8, as mode 0).
 pub const DEFAULT_FOOTPRINT_CAP: f64 = 0.0;
 pub const FOOTPRINT_CAP: ParamDef = ParamDef::number(
@@ -202,6 +202,18 @@ pub const DEPTH_CLAMP: ParamDef = ParamDef::integer(
     1.0,
     "exact_depth: clamp the plane depth to the corner depths of 0 = the piece, 1 = the whole triangle",
     "shadowlab measurement (docs/bench/warp_bias.md)",
+);
+
+/// Exact depth: invert the warp at each fragment exactly (1D bisections over the texel edges,
+/// lookup.wgsl `unwarp_exact`) instead of 3 Newton steps, whose forward-difference Jacobian
+/// straddles the warp's kinks (a residual above 0.25 warped texels falls back to the
+/// interpolated depth, off by up to the subdivision bend). Off: the Newton steps.
+pub const DEFAULT_EXACT_INVERSE: f64 = 0.0;
+pub const EXACT_INVERSE: ParamDef = ParamDef::flag(
+    "exact_inverse",
+    DEFAULT_EXACT_INVERSE != 0.0,
+    "exact_depth: pull fragments back through the warp exactly (bisection over the texel edges of the two 1D passes) instead of 3 Newton steps; no fallback to the interpolated depth",
+    "shadowlab (NoTW kinks, issue 18; docs/bench/warp_kinks.md)",
 );
 
 /// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
@@ -239,7 +251,8 @@ const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A]
 }
 
 /// notw's own list: `NOTW_PARAMS` plus the warp strength and the bias footprint parameters.
-pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<17, 4, 21>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP]);
+pub const NOTW_OWN_PARAMS: &[ParamDef] =
+    &concat::<17, 5, 22>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE]);
 
 /// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
 /// run with; the gradient footprint (2) was measured for `notw` only.
@@ -298,6 +311,8 @@ pub(super) struct Knobs {
     pub bias_mode: u32,
     pub footprint_cap: f32,
     pub depth_clamp: u32,
+    /// Exact inversion in the exact depth pass (declared by `notw` only).
+    pub exact_inverse: bool,
 }
 
 impl Knobs {
@@ -323,6 +338,7 @@ impl Knobs {
             bias_mode: p.get_u32("bias_mode"),
             footprint_cap: p.get("footprint_cap") as f32,
             depth_clamp: p.get_u32("depth_clamp"),
+            exact_inverse: p.0.contains_key("exact_inverse") && p.get_bool("exact_inverse"),
         }
     }
 }

@@ -60,7 +60,8 @@ struct WarpParams {
     // subdivision: an edge whose warped image spans less than this (warped texels) is not
     // split; 0 = no bound
     min_piece: f32,
-    pad0: f32,
+    // 1 = exact depth inverts the warp exactly (unwarp_exact), 0 = Newton steps (unwarp)
+    exact_inverse: f32,
     pad1: f32,
     pad2: f32,
 }
