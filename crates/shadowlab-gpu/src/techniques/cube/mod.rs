@@ -150,6 +150,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     w::BIAS_MODE.with_default(DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS),
     w::FOOTPRINT_CAP,
     w::DEPTH_CLAMP,
+    w::EXACT_INVERSE,
 ];
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {

@@ -145,6 +145,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     ),
     warp::FOOTPRINT_CAP,
     warp::DEPTH_CLAMP,
+    warp::EXACT_INVERSE,
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {

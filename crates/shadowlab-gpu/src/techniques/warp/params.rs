@@ -311,7 +311,7 @@ pub(super) struct Knobs {
     pub bias_mode: u32,
     pub footprint_cap: f32,
     pub depth_clamp: u32,
-    /// Exact inversion in the exact depth pass (declared by `notw` only).
+    /// Exact inversion in the exact depth pass (the NoTW variants: notw, cube-notw, dpsm-notw).
     pub exact_inverse: bool,
 }
 
@@ -338,7 +338,7 @@ impl Knobs {
             bias_mode: p.get_u32("bias_mode"),
             footprint_cap: p.get("footprint_cap") as f32,
             depth_clamp: p.get_u32("depth_clamp"),
-            exact_inverse: p.0.contains_key("exact_inverse") && p.get_bool("exact_inverse"),
+            exact_inverse: notw && p.get_bool("exact_inverse"),
         }
     }
 }
