@@ -51,7 +51,8 @@ fn fitted_square_contains_every_evaluated_sample_and_is_smaller() {
         let tol = 1e-4 * p.size;
         assert!((got_lo - lo).abs().max_element() <= tol && (got_hi - hi).abs().max_element() <= tol, "{name}: {got_lo} {got_hi} vs {lo} {hi}");
         // tight: at most the extent, its margin, two steps and one size step larger
-        let need = (hi - lo).max_element() * 1.02 / (1.0 - 2.0 / 64.0);
+        let margin = fit.params.get("margin") as f32;
+        let need = (hi - lo).max_element() * (1.0 + 2.0 * margin) / (1.0 - 2.0 / 64.0);
         assert!(p.size <= need * 1.0444 + tol, "{name}: side {} for extent {}", p.size, (hi - lo).max_element());
         assert!(p.size <= fixed.report.counters["square_side"] as f32 + tol, "{name}: larger than the scene's extent");
         // memory: the same tiles as the fixed placement
