@@ -134,7 +134,7 @@ fn samples_outside_the_square_are_counted_and_lit() {
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 128);
     // a 2 m square ahead of the camera cannot hold the whole 10 m plane in view
-    let run = lab.run(&v, &TechniqueSpec::parse("iasm:size=2").unwrap(), 1).unwrap();
+    let run = lab.run(&v, &TechniqueSpec::parse("iasm:fit=fixed,size=2").unwrap(), 1).unwrap();
     let c = &run.report.counters;
     let inside: f64 = (0..16).map(|t| c[&format!("tile{t:02}.samples")]).sum();
     let evaluated = v.mask.iter().filter(|m| **m != 0).count() as f64;
@@ -161,7 +161,7 @@ fn analysis_matches_a_cpu_recount_of_samples_and_importance() {
     let scene = builtin("courtyard").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 256);
-    let run = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
+    let run = lab.run(&v, &TechniqueSpec::parse("iasm:fit=fixed").unwrap(), 1).unwrap();
     let c = &run.report.counters;
     let shadowlab_core::light::Light::Directional { direction } = v.light else { panic!() };
     let cam = scene.camera;

@@ -12,6 +12,8 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
+pub mod fit;
+
 /// Tiles per side (thesis 3.2: 4x4 tiles).
 pub const TILES_PER_SIDE: u32 = 4;
 pub const TILE_COUNT: usize = 16;

@@ -24,6 +24,7 @@ use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFru
 
 pub use params::*;
 pub use sdsm::{SdsmReduce, OUT_BYTES as SDSM_BOUNDS_BYTES, SDSM_INFO, SDSM_PARAMS};
+pub(crate) use sdsm::{decode_bounds, BoundsReduce, OUT_WORDS as SDSM_OUT_WORDS};
 
 use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, MinMax};

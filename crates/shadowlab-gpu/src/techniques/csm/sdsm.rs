@@ -96,8 +96,7 @@ pub(super) enum Source {
 
 /// SDSM's part of a [`Cascaded`]: the bounds reduction and the last fit.
 pub(super) struct SampleFit {
-    pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
+    reduce: BoundsReduce,
     reduce_params: SdsmReduce,
     uniform: wgpu::Buffer,
     out: wgpu::Buffer,
@@ -134,28 +133,64 @@ fn decode_out(w: &[u32], count: usize) -> Option<Readback> {
     }
     let range = decode([w[0], w[1]])?;
     let splits = (0..=count).map(|i| f32::from_bits(w[4 + i])).collect();
-    let bounds = (0..count)
-        .map(|c| {
-            let b = &w[16 + 8 * c..24 + 8 * c];
-            (b[6] > 0).then(|| SampleBounds {
-                lo: Vec3::new(from_order_key(!b[0]), from_order_key(!b[1]), from_order_key(!b[2])),
-                hi: Vec3::new(from_order_key(b[3]), from_order_key(b[4]), from_order_key(b[5])),
-                samples: b[6],
-            })
-        })
-        .collect();
+    let bounds = (0..count).map(|c| decode_bounds(w, c)).collect();
     Some(Readback { range, splits, bounds })
+}
+
+/// Cascade `c`'s light-space sample bounds in the reduction's words (None: no sample).
+pub(crate) fn decode_bounds(w: &[u32], c: usize) -> Option<SampleBounds> {
+    let b = &w[16 + 8 * c..24 + 8 * c];
+    (b[6] > 0).then(|| SampleBounds {
+        lo: Vec3::new(from_order_key(!b[0]), from_order_key(!b[1]), from_order_key(!b[2])),
+        hi: Vec3::new(from_order_key(b[3]), from_order_key(b[4]), from_order_key(b[5])),
+        samples: b[6],
+    })
+}
+
+/// The sample-bounds reduction (`sdsm_bounds.wgsl`) as shared plumbing: `sdsm` reduces per
+/// cascade; `iasm:fit=view` uses it with one cascade (every sample in cascade 0, the depth
+/// range unused) for the bounds of all evaluated samples in its own light basis.
+pub(crate) struct BoundsReduce {
+    pub pipeline: wgpu::ComputePipeline,
+    pub layout: wgpu::BindGroupLayout,
+}
+
+impl BoundsReduce {
+    pub fn new(gpu: &Gpu, label: &str) -> BoundsReduce {
+        let layout = binding::layout(
+            &gpu.device,
+            label,
+            wgpu::ShaderStages::COMPUTE,
+            &[binding::uniform(), binding::texture_float(), binding::storage(true), binding::storage(true), binding::storage(false)],
+        );
+        let pipeline = gpu.compute_pipeline(label, &format!("{ORDER_KEY_WGSL}{BOUNDS_WGSL}"), "main", &[&layout]);
+        BoundsReduce { pipeline, layout }
+    }
+
+    /// Clears `out` (OUT_BYTES) and reduces the evaluated samples of `f` into it with the
+    /// parameters in `uniform` (`SdsmReduce`) and the [min, max] view depth in `depth_mm`.
+    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str, f: &FrameInputs, uniform: &wgpu::Buffer, depth_mm: &wgpu::Buffer, out: &wgpu::Buffer) {
+        let view = f.gbuffer.position.create_view(&Default::default());
+        let group = binding::group(
+            &gpu.device,
+            label,
+            &self.layout,
+            &[
+                uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view),
+                f.gbuffer.mask.as_entire_binding(),
+                depth_mm.as_entire_binding(),
+                out.as_entire_binding(),
+            ],
+        );
+        enc.clear_buffer(out, 0, None);
+        let (w, h) = (f.gbuffer.width.div_ceil(PER_THREAD), f.gbuffer.height.div_ceil(PER_THREAD));
+        gpu.dispatch_2d(enc, label, &self.pipeline, &[&group], w, h);
+    }
 }
 
 impl SampleFit {
     pub(super) fn new(gpu: &Gpu, p: &ParamValues, dir: Vec3, count: usize) -> SampleFit {
-        let layout = binding::layout(
-            &gpu.device,
-            "sdsm.bounds",
-            wgpu::ShaderStages::COMPUTE,
-            &[binding::uniform(), binding::texture_float(), binding::storage(true), binding::storage(true), binding::storage(false)],
-        );
-        let pipeline = gpu.compute_pipeline("sdsm.bounds", &format!("{ORDER_KEY_WGSL}{BOUNDS_WGSL}"), "main", &[&layout]);
         let reduce_params = SdsmReduce {
             light_view: light_view(dir).to_cols_array_2d(),
             near: 0.0,
@@ -168,8 +203,7 @@ impl SampleFit {
             pad2: 0.0,
         };
         SampleFit {
-            pipeline,
-            layout,
+            reduce: BoundsReduce::new(gpu, "sdsm.bounds"),
             uniform: gpu.uniform("sdsm.bounds", &reduce_params),
             reduce_params,
             out: gpu.storage("sdsm.bounds", OUT_BYTES),
@@ -187,22 +221,7 @@ impl SampleFit {
     /// Records the bounds reduction (after `depth`'s min/max reduction of the same frame).
     fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, f: &FrameInputs, depth: &crate::reduce::MinMax) {
         depth.record(gpu, enc, "sdsm.reduce", &f.gbuffer.position, &f.gbuffer.mask);
-        let view = f.gbuffer.position.create_view(&Default::default());
-        let group = binding::group(
-            &gpu.device,
-            "sdsm.bounds",
-            &self.layout,
-            &[
-                self.uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view),
-                f.gbuffer.mask.as_entire_binding(),
-                depth.result.as_entire_binding(),
-                self.out.as_entire_binding(),
-            ],
-        );
-        enc.clear_buffer(&self.out, 0, None);
-        let (w, h) = (f.gbuffer.width.div_ceil(PER_THREAD), f.gbuffer.height.div_ceil(PER_THREAD));
-        gpu.dispatch_2d(enc, "sdsm.bounds", &self.pipeline, &[&group], w, h);
+        self.reduce.record(gpu, enc, "sdsm.bounds", f, &self.uniform, &depth.result, &self.out);
     }
 
     /// The report's SDSM counters: where the boxes came from, and per cascade the samples,

@@ -10,6 +10,7 @@ use shadowlab_core::techniques::iasm::{self as core, Anchor, Placement, THESIS_R
 
 use super::atlas::{make_atlas, Atlas};
 use super::chunks::chunk_bounds;
+use super::fit::ViewFit;
 use super::plan::{Plan, TileStats};
 use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, RENDER_WGSL};
 use crate::record::{DelayedRead, Recorder};
@@ -38,6 +39,8 @@ pub struct Iasm {
     pub placement: Placement,
     pub plan: Plan,
     pub atlas: Option<Atlas>,
+    /// `fit=view`: the square from the view samples' bounds (None: the thesis's fixed rule).
+    pub(super) fit: Option<ViewFit>,
     /// Delayed: the analysis of the previous frame is in `stats_buf`, made over `analysed`.
     pending: bool,
     analysed: Placement,
@@ -147,6 +150,9 @@ impl Iasm {
             placement: basis,
             plan: Plan::default(),
             atlas,
+            fit: (p.choice("fit") == "view").then(|| {
+                ViewFit::new(gpu, direction, p.get("margin") as f32, 1e-3 * size, p.get_bool("snap"), p.get_bool("delayed"))
+            }),
             pending: false,
             analysed: basis,
             current: basis,
@@ -196,8 +202,13 @@ impl Iasm {
         }
     }
 
-    /// Places the square for the camera of `f`.
-    fn place(&mut self, f: &FrameInputs) {
+    /// Places the square for the camera of `f`: fitted to the view samples (`fit=view`, when
+    /// any was evaluated) or by the thesis's rule.
+    fn place(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        if let Some(p) = self.fit.as_mut().and_then(|v| v.place(gpu, f, rec)) {
+            self.placement = p;
+            return;
+        }
         let cam = &f.camera;
         let forward = (cam.target - cam.position).normalize_or_zero();
         let min_res = *THESIS_RESOLUTIONS.iter().min().unwrap_or(&16) as f32;
@@ -280,7 +291,7 @@ impl Iasm {
 
 impl Technique for Iasm {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.place(f);
+        self.place(gpu, f, rec);
         self.current = self.placement;
         if self.delayed && self.pending {
             // the previous frame's analysis belongs to the previous frame's square: keep both
@@ -351,6 +362,9 @@ impl Technique for Iasm {
             self.delayed_read.record(rec, &self.stats_buf);
             self.analysed = self.current;
             self.pending = true;
+            if let Some(v) = self.fit.as_mut() {
+                v.record_for_next(gpu, f, rec);
+            }
         }
         Ok(())
     }

@@ -27,6 +27,18 @@ pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
     // resolution, offset and the two planes per tile (the uniform), not counted above
     c.insert("tile_metadata_bytes".into(), std::mem::size_of::<super::IasmParams>() as f64);
     c.insert("square_side".into(), t.placement.size as f64);
+    c.insert("square_x0".into(), t.placement.origin.x as f64);
+    c.insert("square_y0".into(), t.placement.origin.y as f64);
+    if let Some(f) = &t.fit {
+        c.insert("fit_source".into(), f.source as u32 as f64);
+        c.insert("fit_bytes".into(), super::FIT_BYTES as f64);
+        if let Some(b) = f.bounds {
+            c.insert("fit_samples".into(), b.samples as f64);
+            for (k, v) in [("x0", b.lo.x), ("y0", b.lo.y), ("x1", b.hi.x), ("y1", b.hi.y)] {
+                c.insert(format!("fit_bounds_{k}"), v as f64);
+            }
+        }
+    }
     c.insert("empty_tiles".into(), plan.empty.iter().filter(|e| **e).count() as f64);
     let mut draws = 0;
     let mut tris = 0u64;

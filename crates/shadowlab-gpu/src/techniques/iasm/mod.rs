@@ -13,6 +13,7 @@
 
 mod atlas;
 mod chunks;
+mod fit;
 mod gpu;
 mod images;
 pub(crate) mod plan;
@@ -24,6 +25,7 @@ use shadowlab_core::params::ParamDef;
 use crate::shaders::{compose, compose_depth};
 use crate::technique::{compose_view, TechniqueInfo};
 
+pub use fit::{FitSource, FIT_BYTES};
 pub use gpu::Iasm;
 
 const PARAMS_WGSL: &str = include_str!("params.wgsl");
@@ -87,6 +89,19 @@ pub const DEFAULT_STORE: f64 = 1.0;
 /// Triangles per culling chunk (vertex order). Small: many draw calls and CPU culling work;
 /// large: loose bounds that pass every tile (the thesis's village worst case).
 pub const DEFAULT_CHUNK: f64 = 256.0;
+/// How the square is placed: 0 = fixed (the thesis's rule: ahead of the camera, side `size`),
+/// 1 = view (fitted to the light-space bounds of the evaluated samples, thesis 3.2 / ch. 5's
+/// suggestion; `size` and `anchor` unused). View is the default: chosen on courtyard and
+/// city_corner (0.20 / 0.12 % wrong against fixed's 0.35 / 1.74 at 1024x1024) and better than
+/// fixed on all four held-out views (city, sponza, warp-courtyard, foliage; BENCHMARKS.md
+/// "Issue 18: iasm fitted to the view").
+pub const DEFAULT_FIT: usize = 1;
+/// `fit=view`: fraction of the samples' larger light-space extent added on each side of the
+/// square (the side always holds two extra coarsest texels for snapping and the normal offset).
+/// Low: a sample the camera moves out of a delayed fit is lit; high: coarser tiles. 0.05 was
+/// the best of 0, 0.01, 0.02, 0.05, 0.1, 0.2 on courtyard + city_corner (mean 0.163 % wrong);
+/// the wrong % is not monotonic in it (where the tile borders fall moves with the side).
+pub const DEFAULT_MARGIN: f64 = 0.05;
 
 pub const PARAMS: &[ParamDef] = &[
     ParamDef::number("m", DEFAULT_M, 0.0, 1000.0, "importance weight of near samples, p = 1 + m clamp(1 - w/k, 0, 1)", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
@@ -98,19 +113,21 @@ pub const PARAMS: &[ParamDef] = &[
     ParamDef::flag("snap", true, "move the square in steps of the coarsest texel (tile/16) so texel grids do not shimmer", "shadowlab addition (not in seed 001)"),
     ParamDef::choice("anchor", &["circle", "tile"], 0, "circle: camera on the inscribed circle (Fig. 3.1); tile: then shifted so the camera sits at a tile centre (no four-tile corner at the camera)", "seed 001 3.2 / ch. 5 suggested fix"),
     ParamDef::choice("store", &["buffer", "atlas"], DEFAULT_STORE as usize, "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)", "seed 001 3.2/3.5; default = the faster on lavapipe (docs/bench/iasm.md)"),
+    ParamDef::choice("fit", &["fixed", "view"], DEFAULT_FIT, "fixed: the thesis's square of side `size` ahead of the camera (Fig. 3.1); view: centred on and sized to the light-space bounds of the evaluated view samples (one more reduction and 320-byte readback; `size`, `anchor` unused)", "seed 001 3.2 / ch. 5 (suggested: fit the frustum to the view); reduction from sdsm (Lauritzen et al. 2011)"),
+    ParamDef::number("margin", DEFAULT_MARGIN, 0.0, 1.0, "fit=view: fraction of the samples' extent added on each side of the square", "shadowlab choice (BENCHMARKS.md, issue 18)"),
     ParamDef::integer("chunk", DEFAULT_CHUNK, 1.0, 1e7, "triangles per culling chunk (vertex order)", "shadowlab choice; seed 001 4.3: culling decides the cost"),
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "iasm",
     summary:
-        "Irregular Adaptive Shadow Maps: 4x4 tiles ahead of the camera, resolutions 1x1024..4x16 by importance rank, in a depth atlas (default) or the thesis's linear buffer",
+        "Irregular Adaptive Shadow Maps: 4x4 tiles on the square fitted to the view samples (or the thesis's fixed one ahead of the camera), resolutions 1x1024..4x16 by importance rank, in a depth atlas (default) or the thesis's linear buffer",
     cost: "importance pass + 512-byte readback, up to 16 culled tile passes (atlas: depth test; buffer: atomic max), 1 fetch per pixel",
     quality: "resolution follows the camera; tile seams where neighbours differ (four-tile corners, thesis Fig. 4.4)",
     source: "seed 001 (IASM thesis) chapter 3",
     lights: &["directional"],
     params: PARAMS,
-    stalls: "iasm.readback: the tile statistics are read back for the plan; delayed=true plans with the previous frame's, read back without a stall (a sync only on the first frame, or when the previous frame has not finished)",
+    stalls: "iasm.readback: the tile statistics are read back for the plan; fit=view adds iasm.fit.readback before it (the samples' bounds for the square); delayed=true plans with the previous frame's, read back without a stall, and with fit=view the previous frame's bounds (a sync only on the first frame, or when the previous frame has not finished)",
     needs: "",
     compare: &[""],
     shaders,
