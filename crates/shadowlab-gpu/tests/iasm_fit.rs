@@ -49,7 +49,10 @@ fn fitted_square_contains_every_evaluated_sample_and_is_smaller() {
         let got_lo = Vec2::new(c["fit_bounds_x0"] as f32, c["fit_bounds_y0"] as f32);
         let got_hi = Vec2::new(c["fit_bounds_x1"] as f32, c["fit_bounds_y1"] as f32);
         let tol = 1e-4 * p.size;
-        assert!((got_lo - lo).abs().max_element() <= tol && (got_hi - hi).abs().max_element() <= tol, "{name}: {got_lo} {got_hi} vs {lo} {hi}");
+        assert!(
+            (got_lo - lo).abs().max_element() <= tol && (got_hi - hi).abs().max_element() <= tol,
+            "{name}: {got_lo} {got_hi} vs {lo} {hi}"
+        );
         // tight: at most the extent, its margin, two steps and one size step larger
         let margin = fit.params.get("margin") as f32;
         let need = (hi - lo).max_element() * (1.0 + 2.0 * margin) / (1.0 - 2.0 / 64.0);

@@ -102,7 +102,12 @@ fn spot_marking_equals_the_cpu_computation() {
             possible.extend(x);
         }
     }
-    eprintln!("{} pages certain, {} possible, {} on the GPU, levels {levels:?}, {ambiguous} ambiguous samples", certain.len(), possible.len(), gpu_set.len());
+    eprintln!(
+        "{} pages certain, {} possible, {} on the GPU, levels {levels:?}, {ambiguous} ambiguous samples",
+        certain.len(),
+        possible.len(),
+        gpu_set.len()
+    );
     assert!(certain.len() > 10, "a real set of pages: {}", certain.len());
     assert!(levels.len() >= 3, "the view spans mip levels: {levels:?}");
     assert!(ambiguous * 100 < v.mask.iter().filter(|m| **m != 0).count(), "few ambiguous samples: {ambiguous}");

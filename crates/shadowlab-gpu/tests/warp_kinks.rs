@@ -34,7 +34,10 @@ fn the_kinks_fix_removes_false_shadow_specks_on_a_low_sun_city() {
     let inverse = errors("notw:bias_mode=2,exact_inverse=true");
     let both = errors("notw:bias_mode=4,exact_inverse=true");
     for (name, e) in [("before", &before), ("secant", &secant), ("inverse", &inverse), ("both", &both)] {
-        eprintln!("city low sun 512, {name}: {:.3} % wrong ({:.3} false lit / {:.3} false shadow)", e.wrong_pct, e.false_lit_pct, e.false_shadow_pct);
+        eprintln!(
+            "city low sun 512, {name}: {:.3} % wrong ({:.3} false lit / {:.3} false shadow)",
+            e.wrong_pct, e.false_lit_pct, e.false_shadow_pct
+        );
     }
     assert!(secant.false_shadow_pct < 0.95 * before.false_shadow_pct, "{secant:?} vs {before:?}");
     assert!(inverse.false_shadow_pct < 0.95 * before.false_shadow_pct, "{inverse:?} vs {before:?}");

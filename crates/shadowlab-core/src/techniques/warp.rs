@@ -171,7 +171,11 @@ impl Warp2D {
         let res = self.res;
         let edge = |o: &dyn Fn(f32) -> f32, k: usize| {
             let x = k as f32 / res as f32;
-            if k >= res { 1.0 } else { x + o(x) }
+            if k >= res {
+                1.0
+            } else {
+                x + o(x)
+            }
         };
         let (a, b, t) = neighbours(xw, res, self.interp);
         let (ca, cb) = (self.column(a), self.column(b));

@@ -1,7 +1,7 @@
 //! The NoTW kinks (issue 18): a flat ground seen by a street-level camera under a low sun,
 //! warped by `notw`, and what the bias footprint misses where the warp's Jacobian changes.
-use super::*;
 use super::tests::lcg;
+use super::*;
 use glam::Vec3;
 
 /// Ground points (y = 0) seen by a camera at `eye` looking along -z (60 degree fov, `n x n`
@@ -30,9 +30,9 @@ pub(super) fn ground_view(n: usize, dir: Vec3, far: f32) -> (Vec<[f32; 2]>, [f32
             pts.push([p.dot(e1), p.dot(e2)]);
         }
     }
-    let (lo, hi) = pts.iter().fold(([f32::MAX; 2], [f32::MIN; 2]), |(lo, hi), p| {
-        ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])])
-    });
+    let (lo, hi) = pts
+        .iter()
+        .fold(([f32::MAX; 2], [f32::MIN; 2]), |(lo, hi), p| ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]));
     let ext = [hi[0] - lo[0], hi[1] - lo[1]];
     let pts = pts.iter().map(|p| [(p[0] - lo[0]) / ext[0], (p[1] - lo[1]) / ext[1]]).collect();
     // depth = dot(p, l) on the ground: p = a e1 + b e2 + s l with p.y = 0
@@ -143,15 +143,27 @@ fn stats(name: &str, v: &[f32]) {
     let over = |t: f32| 100.0 * v.iter().filter(|&&r| r > t).count() as f32 / v.len() as f32;
     println!(
         "  {name}: p50 {:.3} p99 {:.3} p99.9 {:.3} max {:.3}; >0.75 {:.3} % >1 {:.3} % >1.5 {:.3} %",
-        quantile(v, 0.5), quantile(v, 0.99), quantile(v, 0.999), quantile(v, 1.0), over(0.75), over(1.0), over(1.5)
+        quantile(v, 0.5),
+        quantile(v, 0.99),
+        quantile(v, 0.999),
+        quantile(v, 1.0),
+        over(0.75),
+        over(1.0),
+        over(1.5)
     );
 }
 
 /// The CPU experiment of docs/bench/warp_kinks.md (`--ignored --nocapture`, release).
 #[test]
-#[ignore]
+#[ignore = "a measurement that prints the table of docs/bench/warp_kinks.md (asserts nothing; the kinks tests above check the outcome): run with --release -- --ignored --nocapture"]
 fn experiment_kinks() {
-    for (view, res, el, az, blur, mix) in [(512, 512, 12f32, 60f32, 8, 2.0), (512, 512, 15.0, 150.0, 8, 2.0), (512, 512, 15.0, 150.0, 0, 2.0), (256, 256, 15.0, 150.0, 8, 2.0), (256, 256, 12.0, 60.0, 8, 2.0)] {
+    for (view, res, el, az, blur, mix) in [
+        (512, 512, 12f32, 60f32, 8, 2.0),
+        (512, 512, 15.0, 150.0, 8, 2.0),
+        (512, 512, 15.0, 150.0, 0, 2.0),
+        (256, 256, 15.0, 150.0, 8, 2.0),
+        (256, 256, 12.0, 60.0, 8, 2.0),
+    ] {
         let r = need_over_footprint(view, res, sun(el, az), blur, mix);
         println!("view {view}, map {res}, sun {el} az {az}, blur {blur} mix {mix}: {} samples, need / footprint", r[0].len());
         for (name, v) in ["mode 2 (central J at sample)", "mode 3 (max over +-1 texel)", "mode 4 (read texel's secant J)"].iter().zip(&r) {

@@ -36,7 +36,15 @@ pub fn snap_divisions() -> f32 {
 /// the side is `sdsm`'s [`held_extent`] of the needed side against `prev` (the side this
 /// returned last frame) and the origin sits on whole steps. Returns the placement and the
 /// side to pass as `prev` next frame.
-pub fn fit_square(light_dir: glam::Vec3, lo: Vec2, hi: Vec2, margin: f32, min_side: f32, snap: bool, prev: Option<f32>) -> (Placement, f32) {
+pub fn fit_square(
+    light_dir: glam::Vec3,
+    lo: Vec2,
+    hi: Vec2,
+    margin: f32,
+    min_side: f32,
+    snap: bool,
+    prev: Option<f32>,
+) -> (Placement, f32) {
     let (right, up, dir) = light_basis(light_dir);
     let div = snap_divisions();
     let extent = (hi - lo).max_element().max(0.0);

@@ -257,6 +257,6 @@ pub fn pixel_angle(fov_y_deg: f32, height: u32) -> f32 {
 }
 
 #[cfg(test)]
-mod tests;
-#[cfg(test)]
 mod spot_tests;
+#[cfg(test)]
+mod tests;

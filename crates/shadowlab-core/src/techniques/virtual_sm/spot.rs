@@ -35,7 +35,15 @@ pub fn spot_levels(levels: u32, virtual_res: u32, page_res: u32) -> u32 {
 
 impl Clipmap {
     /// The clipmap (directional) or mip chain (spot) of `light`; None for point lights.
-    pub fn for_light(light: &Light, bounds: &Bounds, eye: Vec3, levels: u32, virtual_res: u32, page_res: u32, extent0: f32) -> Option<Clipmap> {
+    pub fn for_light(
+        light: &Light,
+        bounds: &Bounds,
+        eye: Vec3,
+        levels: u32,
+        virtual_res: u32,
+        page_res: u32,
+        extent0: f32,
+    ) -> Option<Clipmap> {
         match *light {
             Light::Directional { direction } => Some(Clipmap::new(direction, bounds, eye, levels, virtual_res, page_res, extent0)),
             Light::Spot { position, direction, cone_deg } => {

@@ -23,8 +23,8 @@ use shadowlab_core::params::ParamValues;
 use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 
 pub use params::*;
-pub use sdsm::{SdsmReduce, OUT_BYTES as SDSM_BOUNDS_BYTES, SDSM_INFO, SDSM_PARAMS};
 pub(crate) use sdsm::{decode_bounds, BoundsReduce, OUT_WORDS as SDSM_OUT_WORDS};
+pub use sdsm::{SdsmReduce, OUT_BYTES as SDSM_BOUNDS_BYTES, SDSM_INFO, SDSM_PARAMS};
 
 use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, MinMax};

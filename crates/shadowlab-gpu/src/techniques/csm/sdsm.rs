@@ -169,7 +169,16 @@ impl BoundsReduce {
 
     /// Clears `out` (OUT_BYTES) and reduces the evaluated samples of `f` into it with the
     /// parameters in `uniform` (`SdsmReduce`) and the [min, max] view depth in `depth_mm`.
-    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str, f: &FrameInputs, uniform: &wgpu::Buffer, depth_mm: &wgpu::Buffer, out: &wgpu::Buffer) {
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        label: &str,
+        f: &FrameInputs,
+        uniform: &wgpu::Buffer,
+        depth_mm: &wgpu::Buffer,
+        out: &wgpu::Buffer,
+    ) {
         let view = f.gbuffer.position.create_view(&Default::default());
         let group = binding::group(
             &gpu.device,
@@ -304,7 +313,9 @@ pub(super) fn prepare(t: &mut Cascaded, gpu: &Gpu, f: &FrameInputs, rec: &mut Re
             let aspect = f.gbuffer.width as f32 / f.gbuffer.height.max(1) as f32;
             let motion = read_camera.map(|c| CameraMotion::between(&c, &f.camera, aspect)).filter(|_| s.reach > 0.0);
             let lv = light_view(t.dir);
-            s.swept = (0..count).map(|i| motion.map_or(Vec3::ZERO, |m| lv.transform_vector3(m.displacement(r.splits[i + 1])) * s.reach)).collect();
+            s.swept = (0..count)
+                .map(|i| motion.map_or(Vec3::ZERO, |m| lv.transform_vector3(m.displacement(r.splits[i + 1])) * s.reach))
+                .collect();
             let bounds = r.bounds.iter().zip(&s.swept).map(|(b, &d)| b.map(|b| b.swept(d, 0.0))).collect();
             (r.splits, bounds, source)
         }

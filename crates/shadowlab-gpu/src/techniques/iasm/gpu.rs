@@ -150,9 +150,8 @@ impl Iasm {
             placement: basis,
             plan: Plan::default(),
             atlas,
-            fit: (p.choice("fit") == "view").then(|| {
-                ViewFit::new(gpu, direction, p.get("margin") as f32, 1e-3 * size, p.get_bool("snap"), p.get_bool("delayed"))
-            }),
+            fit: (p.choice("fit") == "view")
+                .then(|| ViewFit::new(gpu, direction, p.get("margin") as f32, 1e-3 * size, p.get_bool("snap"), p.get_bool("delayed"))),
             pending: false,
             analysed: basis,
             current: basis,

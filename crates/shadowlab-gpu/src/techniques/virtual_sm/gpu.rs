@@ -208,7 +208,6 @@ impl VirtualShadows {
         let keys: Vec<PageKey> = (0..self.levels).flat_map(|k| c.pages_touching(k, b)).collect();
         self.cache.invalidate(&keys)
     }
-
 }
 
 impl VirtualParams {
@@ -229,8 +228,9 @@ impl VirtualParams {
 impl Technique for VirtualShadows {
     /// Marking on the GPU, one readback, the allocation and page table on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let c = Clipmap::for_light(&self.light, &f.scene.bounds, f.camera.position, self.levels, self.virtual_res, self.page_res, self.extent0)
-            .expect("a light kind checked at creation");
+        let c =
+            Clipmap::for_light(&self.light, &f.scene.bounds, f.camera.position, self.levels, self.virtual_res, self.page_res, self.extent0)
+                .expect("a light kind checked at creation");
         let v = &mut self.params;
         v.right = c.right.extend(c.texel0_scale()).into();
         v.up = c.up.extend(c.inv_texel(0)).into();
