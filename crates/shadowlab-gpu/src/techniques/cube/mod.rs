@@ -151,6 +151,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     w::FOOTPRINT_CAP,
     w::DEPTH_CLAMP,
     w::EXACT_INVERSE,
+    w::CULL_HIDDEN,
 ];
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {

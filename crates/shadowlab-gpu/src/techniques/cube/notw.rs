@@ -237,7 +237,11 @@ impl Technique for CubeNotw {
                 if k == "fetches_per_pixel" {
                     r.counters.insert(k, v);
                 } else if k.starts_with("subdiv_") {
-                    // pieces drawn, dropped (holes: subdivision capacity) and queue-full finishes
+                    // pieces drawn, dropped (holes: subdivision capacity) and queue-full finishes;
+                    // the pieces per face too (where the cost goes)
+                    if k == "subdiv_triangles_drawn" {
+                        r.counters.insert(format!("subdiv_pieces_face_{name}"), v);
+                    }
                     *r.counters.entry(k).or_default() += v;
                 } else if k.ends_with("fraction") || k.ends_with("warp") {
                     r.counters.insert(format!("{k}_face_{name}"), v);

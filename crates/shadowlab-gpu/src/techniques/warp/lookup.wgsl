@@ -132,13 +132,22 @@ fn unwarp_exact(t: vec2<f32>) -> vec2<f32> {
 // Clip position of a world point in the warped map (Algorithm 1 of seed 000): crop to the DV,
 // warp, back to clip space. Behind a spot light only the (affine) crop applies.
 fn warped_clip(p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
+    return dv_clip(p, r, true);
+}
+
+// The clip position of p in the DV-cropped map, `warped` or not (the occluder pass of
+// occluders.wgsl draws the unwarped crop).
+fn dv_clip(p: vec3<f32>, r: vec4<f32>, warped: bool) -> vec4<f32> {
     let a = base_clip(wp, p);
     if a.w <= 1e-7 {
         let m = vec2<f32>(a.x * 0.5 + 0.5 * a.w, 0.5 * a.w - a.y * 0.5);
         let u = (m - r.xy * a.w) / (r.zw - r.xy);
         return vec4<f32>(u.x * 2.0 - a.w, a.w - 2.0 * u.y, a.z, a.w);
     }
-    let u = warp(to_dv(clip_to_map(a).xy, r));
+    var u = to_dv(clip_to_map(a).xy, r);
+    if warped {
+        u = warp(u);
+    }
     return vec4<f32>((u.x * 2.0 - 1.0) * a.w, (1.0 - 2.0 * u.y) * a.w, a.z, a.w);
 }
 

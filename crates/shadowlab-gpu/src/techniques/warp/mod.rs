@@ -21,6 +21,7 @@
 //! maps (`dpsm`, `dpsm-notw` in techniques/dpsm): the same passes over the view samples of that
 //! hemisphere, the paraboloid mapping in `base_clip` (params.wgsl).
 
+mod occluders;
 mod params;
 mod run;
 
@@ -68,6 +69,8 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("warp/depth.wgsl", depth_src(false)),
         ("warp/depth_exact.wgsl", depth_src(true)),
         ("warp/subdiv.wgsl", subdiv_src()),
+        ("warp/occluders.wgsl", occluders::occluders_src()),
+        ("warp/hzb.wgsl", occluders::hzb_src()),
         ("warp/eval.wgsl", eval_src()),
     ]
 }
@@ -187,7 +190,8 @@ pub struct WarpParams {
     pub min_piece: f32,
     /// 1 = exact inversion in the exact depth pass (`exact_inverse`)
     pub exact_inverse: f32,
-    pub pad1: f32,
+    /// 1 = subdivision leaves edges hidden behind nearer geometry unsplit (`cull_hidden`)
+    pub cull_hidden: f32,
     pub pad2: f32,
 }
 
@@ -222,6 +226,8 @@ pub struct Warped {
     analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
     lookup_layout: wgpu::BindGroupLayout,
     depth_pipeline: wgpu::RenderPipeline,
+    /// `cull_hidden`: the occluder pass and its pyramid; else none (a one-word stand-in is bound).
+    occluders: Option<occluders::Occluders>,
     split_layout: wgpu::BindGroupLayout,
     /// split_root, split_args, split_level, draw_args.
     split: [wgpu::ComputePipeline; 4],
@@ -314,11 +320,12 @@ impl Warped {
         }
     }
 
-    /// Bytes of scratch this map allocated (work buffers, counts, and the subdivision buffers
-    /// unless borrowed).
+    /// Bytes of scratch this map allocated (work buffers, counts, the occluder map and pyramid,
+    /// and the subdivision buffers unless borrowed).
     pub fn scratch_bytes(&self) -> u64 {
         let subdiv = if self.owns_subdiv { self.pieces.size() + 2 * self.queues[0].size() } else { 0 };
-        self.work.size() + self.fwork.size() + self.counts.size() + subdiv
+        let occ = self.occluders.as_ref().map_or(0, |o| o.bytes());
+        self.work.size() + self.fwork.size() + self.counts.size() + subdiv + occ
     }
 
     /// A warped map over `proj`, labelled `name` (wgpu labels, stage names `{name}.<stage>`);
@@ -397,7 +404,7 @@ impl Warped {
             depth_clamp: k.depth_clamp as f32,
             min_piece: k.min_piece,
             exact_inverse: if k.exact_inverse { 1.0 } else { 0.0 },
-            pad1: 0.0,
+            cull_hidden: if k.cull_hidden { 1.0 } else { 0.0 },
             pad2: 0.0,
         };
         let d = &gpu.device;
@@ -460,11 +467,12 @@ impl Warped {
             layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX_FRAGMENT, &[look[0], look[1], look[2], look[3], (10, ro)]);
         let depth_pipeline =
             raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(k.exact_depth), &[&lookup_layout, &scene.layout], &[]);
+        let occluders = k.cull_hidden.then(|| occluders::Occluders::new(gpu, name, res, &lookup_layout, scene));
         let split_layout = layout_at(
             gpu,
             &format!("{name}.subdivide"),
             wgpu::ShaderStages::COMPUTE,
-            &[look[0], look[1], look[2], look[3], (10, rw), (11, rw), (12, rw), (13, rw), (14, binding::uniform())],
+            &[look[0], look[1], look[2], look[3], (10, rw), (11, rw), (12, rw), (13, rw), (14, binding::uniform()), (15, ro)],
         );
         let ssrc = subdiv_src();
         let split = ["split_root", "split_args", "split_level", "draw_args"]
@@ -514,6 +522,7 @@ impl Warped {
             analyze,
             lookup_layout,
             depth_pipeline,
+            occluders,
             split_layout,
             split,
             eval_layout,

@@ -216,6 +216,18 @@ pub const EXACT_INVERSE: ParamDef = ParamDef::flag(
     "shadowlab (NoTW kinks, issue 18; docs/bench/warp_kinks.md)",
 );
 
+/// Subdivision leaves an edge unsplit when an unwarped occluder map (the scene drawn into the
+/// DV-cropped map, res x res, then a pyramid of maxima) is nearer than the edge all around it:
+/// the bend of a hidden edge cannot show. Planar maps (`notw`, `cube-notw`'s faces); see
+/// warp/occluders.rs and BENCHMARKS.md (bounded cost, issue 18).
+pub const DEFAULT_CULL_HIDDEN: f64 = 1.0;
+pub const CULL_HIDDEN: ParamDef = ParamDef::flag(
+    "cull_hidden",
+    DEFAULT_CULL_HIDDEN != 0.0,
+    "do not split edges that lie behind nearer geometry (an unwarped occluder map and its pyramid of maxima, drawn first): fewer pieces on layered scenes; an edge judged hidden is drawn unsplit, never dropped",
+    "shadowlab measurement (bounded cost, issue 18; BENCHMARKS.md)",
+);
+
 /// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
 const NOTW_SHARED: [ParamDef; 17] = [
     RES,
@@ -250,9 +262,10 @@ const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A]
     out
 }
 
-/// notw's own list: `NOTW_PARAMS` plus the warp strength and the bias footprint parameters.
+/// notw's own list: `NOTW_PARAMS` plus the warp strength, the bias footprint parameters, the
+/// exact depth's clamp and inversion, and hidden-edge culling.
 pub const NOTW_OWN_PARAMS: &[ParamDef] =
-    &concat::<17, 5, 22>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE]);
+    &concat::<17, 6, 23>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE, CULL_HIDDEN]);
 
 /// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
 /// run with; the gradient footprint (2) was measured for `notw` only.
@@ -313,6 +326,8 @@ pub(super) struct Knobs {
     pub depth_clamp: u32,
     /// Exact inversion in the exact depth pass (the NoTW variants: notw, cube-notw, dpsm-notw).
     pub exact_inverse: bool,
+    /// Leave hidden edges unsplit (`cull_hidden`; planar projections only).
+    pub cull_hidden: bool,
 }
 
 impl Knobs {
@@ -339,6 +354,7 @@ impl Knobs {
             footprint_cap: p.get("footprint_cap") as f32,
             depth_clamp: p.get_u32("depth_clamp"),
             exact_inverse: notw && p.get_bool("exact_inverse"),
+            cull_hidden: notw && !paraboloid && subdiv > 0.0 && p.get_bool("cull_hidden"),
         }
     }
 }

@@ -62,7 +62,8 @@ struct WarpParams {
     min_piece: f32,
     // 1 = exact depth inverts the warp exactly (unwarp_exact), 0 = Newton steps (unwarp)
     exact_inverse: f32,
-    pad1: f32,
+    // 1: subdivision does not split edges hidden behind nearer geometry (occluders.wgsl)
+    cull_hidden: f32,
     pad2: f32,
 }
 
@@ -157,4 +158,20 @@ fn neighbours(v: f32, res: u32, interp: bool) -> vec3<f32> {
     let s = clamp(v * f32(res) - 0.5, 0.0, f32(res - 1u));
     let i0 = floor(s);
     return vec3<f32>(i0, min(i0 + 1.0, f32(res - 1u)), s - i0);
+}
+
+// The hidden-edge pyramid (occluders.wgsl, hzb.wgsl): level 0 is the unwarped DV-cropped depth
+// map (res x res texels), level l (side ceil(res / 2^l)) the maximum over 2x2 texels of level
+// l - 1, all levels one after another in one array.
+fn hzb_side(res: u32, l: u32) -> u32 {
+    return max((res + (1u << l) - 1u) >> l, 1u);
+}
+
+fn hzb_offset(res: u32, l: u32) -> u32 {
+    var o = 0u;
+    for (var k = 0u; k < l; k++) {
+        let s = hzb_side(res, k);
+        o += s * s;
+    }
+    return o;
 }

@@ -68,6 +68,13 @@ impl Warped {
         gpu.read_buffer_as(&self.work, 2 * n)[..n].to_vec()
     }
 
+    /// `cull_hidden`: the last frame's occluder map (res x res) and its pyramid of maxima (all
+    /// levels, level 0 first).
+    pub fn read_occluders(&self, gpu: &Gpu) -> Option<(Vec<f32>, Vec<f32>)> {
+        let o = self.occluders.as_ref()?;
+        Some((bytemuck::pod_collect_to_vec(&gpu.read_texture(o.depth(), 4)), gpu.read_buffer_as(&o.hzb, (o.hzb.size() / 4) as usize)))
+    }
+
     /// The view samples per texel of the final (warped) map, counted by the last evaluation.
     pub fn read_counts_final(&self, gpu: &Gpu) -> Vec<u32> {
         gpu.read_buffer_as(&self.counts, (self.res * self.res) as usize)
@@ -186,9 +193,14 @@ impl Technique for Warped {
                     e.push(wgpu::BindGroupEntry { binding: 13, resource: self.queues[1 - qi].as_entire_binding() });
                     let u = &self.level_uniforms[l.saturating_sub(1)];
                     e.push(wgpu::BindGroupEntry { binding: 14, resource: u.as_entire_binding() });
+                    let hzb = self.occluders.as_ref().map_or(&self.dv, |o| &o.hzb);
+                    e.push(wgpu::BindGroupEntry { binding: 15, resource: hzb.as_entire_binding() });
                     gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &e })
                 })
                 .collect();
+            if let Some(o) = &self.occluders {
+                rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, &depth_group, f.scene));
+            }
             let tris = self.params.triangles;
             let n = tris.div_ceil(64);
             rec.stage(&format!("{name}.subdivide"), |enc| {
@@ -265,6 +277,9 @@ impl Technique for Warped {
             c.insert("subdiv_queue_full_finishes".into(), a[2] as f64);
             c.insert("subdiv_cut_level".into(), a[19] as f64);
             c.insert("subdiv_pieces_unsplit".into(), a[20] as f64);
+            if self.occluders.is_some() {
+                c.insert("subdiv_hidden_edge_tests".into(), a[21] as f64);
+            }
             if a[19] > 0 {
                 r.degraded.push(format!(
                     "subdivision level {} of {}: the pieces did not fit the piece capacity ({}); {} pieces were drawn unsplit (bent edges)",

@@ -20,7 +20,8 @@
 // counters: [appended, dropped (never: kept for the report), queue-full finishes (never), -,
 // draw args (4), queue 0: count, groups x, y, z, queue 1: count, groups x, y, z, -, -, split
 // limit of the running level (pieces of triangles below it split), first level cut (0: none),
-// pieces finished unsplit, -, -, -], then per queue BUCKETS children and BUCKETS pieces by
+// pieces finished unsplit, bent edges left unsplit as hidden (per test: an edge counts once
+// per piece on it), -, -], then per queue BUCKETS children and BUCKETS pieces by
 // bucket of triangle index.
 
 struct Level {
@@ -33,6 +34,8 @@ struct Level {
 @group(0) @binding(12) var<storage, read_write> q_in: array<vec4<u32>>;
 @group(0) @binding(13) var<storage, read_write> q_out: array<vec4<u32>>;
 @group(0) @binding(14) var<uniform> lv: Level;
+// `cull_hidden`: the pyramid of occluder depth maxima (hzb.wgsl); one word when off
+@group(0) @binding(15) var<storage, read> hzb: array<f32>;
 
 fn corner(c: u32) -> vec2<u32> {
     return vec2<u32>(c & 0xffffu, c >> 16u);
@@ -98,8 +101,53 @@ fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
     if is_paraboloid(wp) {
         return paraboloid_edge_error(pa, pb, warp(ua), warp(ub), r) > wp.subdiv;
     }
-    return edge_error(ua, ub, warp(ua), warp(ub)) > wp.subdiv;
+    let wa = warp(ua);
+    let wb = warp(ub);
+    let e = edge_error(ua, ub, wa, wb);
+    if e <= wp.subdiv {
+        return false;
+    }
+    // hidden: the unsplit edge's chord strays up to e warped texels from the curve, which is
+    // about e * (base length / warped length) cropped texels; twice that plus HIDDEN_MARGIN
+    let rho = length(ub - ua) / max(length(wb - wa), 1e-12);
+    let m = (HIDDEN_MARGIN + 2.0 * e * rho) / wp.res;
+    if hidden(min(ua, ub) - m, max(ua, ub) + m, min(clip_to_map(a).z, clip_to_map(b).z)) {
+        atomicAdd(&counters[21], 1u);
+        return false;
+    }
+    return true;
 }
+
+// Whether every point of the DV-cropped rectangle [lo, hi] holds an occluder nearer than z (the
+// pyramid's maximum over the texels it touches, at the level where they are at most 2x2).
+// Outside the crop: unknown, not hidden. Point-sampled maps can miss gaps below a texel; an
+// edge judged hidden there is only drawn coarser (unsplit), never dropped.
+fn hidden(lo: vec2<f32>, hi: vec2<f32>, z: f32) -> bool {
+    if wp.cull_hidden < 0.5 {
+        return false;
+    }
+    let res = u32(wp.res);
+    let a = floor(lo * wp.res);
+    let b = floor(hi * wp.res);
+    if any(a < vec2<f32>(0.0)) || any(b > vec2<f32>(wp.res - 1.0)) {
+        return false;
+    }
+    let ia = vec2<u32>(a);
+    let ib = vec2<u32>(b);
+    // 2^l > the extent in texels: the rectangle touches at most 2x2 texels of level l
+    let l = 32u - countLeadingZeros(max(ib.x - ia.x, ib.y - ia.y));
+    let side = hzb_side(res, l);
+    let o = hzb_offset(res, l);
+    let pa = min(ia >> vec2<u32>(l), vec2<u32>(side - 1u));
+    let pb = min(ib >> vec2<u32>(l), vec2<u32>(side - 1u));
+    let m = max(max(hzb[o + pa.y * side + pa.x], hzb[o + pa.y * side + pb.x]), max(hzb[o + pb.y * side + pa.x], hzb[o + pb.y * side + pb.x]));
+    return z > m + HIDDEN_EPS;
+}
+
+// Cropped texels added around a hidden-edge test (the point-sampled occluders' reach).
+const HIDDEN_MARGIN: f32 = 2.0;
+// Depth step (post-projective) an edge must lie behind its occluders by.
+const HIDDEN_EPS: f32 = 1e-6;
 
 // The paraboloid mapping bends straight world edges (seed 002 section 3.3.2: "the rendered scene
 // needs to be finely tessellated"): distance (warped texels) of the images of the world points
@@ -158,7 +206,8 @@ fn interior_needs_split(p: vec4<u32>) -> bool {
         return false;
     }
     if max(hi.x - lo.x, hi.y - lo.y) > BIG_PIECE {
-        return true;
+        let m = HIDDEN_MARGIN / wp.res;
+        return is_paraboloid(wp) || !hidden(lo - m, hi + m, min(min(clip_to_map(a).z, clip_to_map(b).z), clip_to_map(c).z));
     }
     return false;
 }

@@ -1,0 +1,125 @@
+//! `cull_hidden` (planar warped maps): before subdivision, the scene is drawn into the
+//! DV-cropped map without the warp (occluders.wgsl, a plain shadow map, res x res), and its
+//! depths reduced to a pyramid of 2x2 maxima (hzb.wgsl). subdiv.wgsl then leaves an edge unsplit
+//! when everything around it is nearer to the light than the edge: its bend cannot show. The
+//! decision is a function of the edge (both pieces on it agree: no cracks) and of the map (the
+//! same on every run), and an unsplit edge is still drawn, coarser, never dropped.
+
+use super::{compose, layout_at, LOOKUP_WGSL, PARAMS_WGSL};
+use crate::scene_gpu::GpuScene;
+use crate::{binding, raster, Gpu};
+
+const OCCLUDERS_WGSL: &str = include_str!("occluders.wgsl");
+const HZB_WGSL: &str = include_str!("hzb.wgsl");
+
+pub(super) fn occluders_src() -> String {
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{OCCLUDERS_WGSL}"), true)
+}
+
+pub(super) fn hzb_src() -> String {
+    compose(&format!("{PARAMS_WGSL}{HZB_WGSL}"), false)
+}
+
+pub(super) struct Occluders {
+    res: u32,
+    depth: wgpu::Texture,
+    /// The pyramid, level 0 (res x res) first (params.wgsl `hzb_offset`).
+    pub hzb: wgpu::Buffer,
+    raster: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    base: wgpu::ComputePipeline,
+    reduce: wgpu::ComputePipeline,
+    /// One uniform per level: (res, level).
+    levels: Vec<wgpu::Buffer>,
+}
+
+/// Levels above 0 until the side is 1.
+fn top_level(res: u32) -> u32 {
+    32 - (res.max(1) - 1).leading_zeros()
+}
+
+/// Side of level `l`: ceil(res / 2^l) (params.wgsl `hzb_side`).
+fn side(res: u32, l: u32) -> u32 {
+    res.div_ceil(1 << l).max(1)
+}
+
+/// Floats of the whole pyramid.
+pub fn pyramid_len(res: u32) -> u64 {
+    (0..=top_level(res)).map(|l| (side(res, l) as u64).pow(2)).sum()
+}
+
+impl Occluders {
+    pub fn new(gpu: &Gpu, name: &str, res: u32, lookup: &wgpu::BindGroupLayout, scene: &GpuScene) -> Occluders {
+        let label = format!("{name}.occluders");
+        let raster = raster::depth_pipeline(gpu, &label, &occluders_src(), &[lookup, &scene.layout], scene.has_cutouts);
+        let depth = raster::depth_target(gpu, &label, res, res, 1, wgpu::TextureUsages::empty());
+        let layout = layout_at(
+            gpu,
+            &format!("{name}.hzb"),
+            wgpu::ShaderStages::COMPUTE,
+            &[(0, binding::texture_depth()), (1, binding::storage(false)), (2, binding::uniform())],
+        );
+        let src = hzb_src();
+        Occluders {
+            res,
+            hzb: gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4),
+            base: gpu.compute_pipeline(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout]),
+            reduce: gpu.compute_pipeline(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout]),
+            levels: (0..=top_level(res)).map(|l| gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0])).collect(),
+            depth,
+            raster,
+            layout,
+        }
+    }
+
+    pub fn depth(&self) -> &wgpu::Texture {
+        &self.depth
+    }
+
+    /// Bytes of the occluder map and its pyramid.
+    pub fn bytes(&self) -> u64 {
+        4 * self.res as u64 * self.res as u64 + self.hzb.size()
+    }
+
+    /// The occluder pass and the pyramid; `lookup` is the depth pass's group (the DV rectangle).
+    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, lookup: &wgpu::BindGroup, scene: &GpuScene) {
+        let view = self.depth.create_view(&Default::default());
+        {
+            let mut pass = raster::begin_pass(enc, "occluders", &[], &view);
+            pass.set_pipeline(&self.raster);
+            pass.set_bind_group(0, lookup, &[]);
+            pass.set_bind_group(1, &scene.group, &[]);
+            pass.draw(0..scene.triangle_count * 3, 0..1);
+        }
+        for (l, u) in self.levels.iter().enumerate() {
+            let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("hzb"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
+                    wgpu::BindGroupEntry { binding: 1, resource: self.hzb.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: u.as_entire_binding() },
+                ],
+            });
+            let side = side(self.res, l as u32);
+            let pipeline = if l == 0 { &self.base } else { &self.reduce };
+            gpu.dispatch_2d(enc, "hzb", pipeline, &[&group], side, side);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pyramid_ends_in_one_texel_and_holds_every_level() {
+        assert_eq!(top_level(512), 9);
+        assert_eq!(top_level(1), 0);
+        assert_eq!(top_level(600), 10);
+        assert_eq!(pyramid_len(4), 16 + 4 + 1);
+        assert_eq!(pyramid_len(5), 25 + 9 + 4 + 1);
+        // the subdivision's widest rectangle (res - 1 texels) asks for level top_level
+        assert_eq!(32 - (599u32).leading_zeros(), top_level(600));
+    }
+}

@@ -1,0 +1,91 @@
+//! GPU tests of hidden-edge culling in the warped maps' subdivision (`cull_hidden`,
+//! warp/occluders.rs): the occluder pyramid is the maximum it claims to be, and leaving hidden
+//! edges unsplit draws fewer pieces without losing agreement with `rt`.
+
+use shadowlab_core::builtin::builtin;
+use shadowlab_core::params::TechniqueSpec;
+use shadowlab_gpu::lab::{Lab, View};
+use shadowlab_gpu::registry;
+use shadowlab_gpu::technique;
+use shadowlab_gpu::techniques::warp::{Variant, Warped};
+
+mod common;
+use common::*;
+
+fn run_direct(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str) -> Warped {
+    let resolved = registry::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
+    let mut t = Warped::new(gpu, &lab.gscene, &resolved.values, &v.light, Variant::Notw).unwrap();
+    technique::submit_frame(&mut t, gpu, &v.inputs(&lab.gscene)).unwrap();
+    gpu.take_error().unwrap();
+    t
+}
+
+/// The pyramid, level by level, against the CPU: level 0 is the occluder map, each level above
+/// the maximum of the 2x2 texels below it (ceil(side / 2) a side; an odd side's last texel
+/// stands alone). Res 100 makes every level odd-sided somewhere.
+#[test]
+fn the_occluder_pyramid_holds_the_maxima_of_the_occluder_map() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("city").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 128);
+    let t = run_direct(&gpu, &lab, &v, "notw:res=100,window=16");
+    let (depth, hzb) = t.read_occluders(&gpu).expect("notw culls hidden edges by default");
+    let res = 100usize;
+    let drawn = depth.iter().filter(|d| **d < 1.0).count();
+    let mut distinct: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert!(drawn > res * res / 2 && distinct.len() > res, "{drawn} texels drawn, {} depths: the city's ground and blocks expected", distinct.len());
+    assert_eq!(&hzb[..res * res], &depth[..], "level 0 is the occluder map");
+    let (mut side, mut at) = (res, 0usize);
+    let mut levels = 0;
+    while side > 1 {
+        let up = side.div_ceil(2);
+        for y in 0..up {
+            for x in 0..up {
+                let mut m = f32::MIN;
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let (sx, sy) = ((2 * x + dx).min(side - 1), (2 * y + dy).min(side - 1));
+                    m = m.max(hzb[at + sy * side + sx]);
+                }
+                assert_eq!(hzb[at + side * side + y * up + x], m, "level {} texel ({x}, {y})", levels + 1);
+            }
+        }
+        at += side * side;
+        side = up;
+        levels += 1;
+    }
+    assert_eq!(levels, 7, "100 -> 50 -> 25 -> 13 -> 7 -> 4 -> 2 -> 1");
+    assert_eq!(hzb.len(), at + 1);
+}
+
+/// `cube-notw` on the room's point light (furniture, walls and the ceiling seen from inside:
+/// several layers on every face): culling hidden edges leaves some bent edges unsplit, draws
+/// fewer pieces, and agrees with `rt` as well as splitting everything does.
+#[test]
+fn culling_hidden_edges_draws_fewer_pieces_at_the_same_quality() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 1, 192);
+    let rt = lab.reference(&v, 1).unwrap();
+    let run = |s: &str| lab.run(&v, &TechniqueSpec::parse(s).unwrap(), 1).unwrap();
+    let on = run("cube-notw:res=128,window=64");
+    let off = run("cube-notw:res=128,window=64,cull_hidden=false");
+    let pieces = |r: &shadowlab_gpu::lab::Run| r.report.counters["subdiv_triangles_drawn"];
+    let wrong = |r: &shadowlab_gpu::lab::Run| 100.0 - agreement(&r.visibility, &rt.visibility, &v.mask);
+    eprintln!(
+        "room point 192, cube-notw res 128: culled {} pieces, {:.3} % wrong ({} hidden edge tests); all split {} pieces, {:.3} %",
+        pieces(&on),
+        wrong(&on),
+        on.report.counters["subdiv_hidden_edge_tests"],
+        pieces(&off),
+        wrong(&off)
+    );
+    assert!(on.report.counters["subdiv_hidden_edge_tests"] > 0.0);
+    assert!(!off.report.counters.contains_key("subdiv_hidden_edge_tests"));
+    assert!(pieces(&on) < pieces(&off), "{} pieces culled vs {} all split", pieces(&on), pieces(&off));
+    assert!(wrong(&on) <= wrong(&off) + 0.05, "{:.3} % wrong culled vs {:.3} % all split", wrong(&on), wrong(&off));
+    assert!(on.report.degraded.is_empty() && off.report.degraded.is_empty());
+}
