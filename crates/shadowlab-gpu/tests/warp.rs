@@ -139,6 +139,13 @@ fn gpu_warps_equal_the_cpu_warps_on_the_same_samples() {
     assert!(max_diff(&g.ox, &cpu.warp.ox) < 2e-3, "blurred row warps differ by {}", max_diff(&g.ox, &cpu.warp.ox));
     assert!(max_diff(&g.oy, &cpu.warp.oy) < 5e-3, "blurred column warps differ by {}", max_diff(&g.oy, &cpu.warp.oy));
 
+    // with the tent-weighted smoothing across functions (`window_tent`)
+    let t = run_direct(&gpu, &lab, &v, "notw:res=64,window=8,blur=3,mix=0.5,window_tent=true", Variant::Notw);
+    let cpu = warp::notw_shaped(&pts, res, 8, true, true, 3, 0.5 * base.len() as f32 / pts.len() as f32);
+    let g = t.read_warp(&gpu);
+    assert!(max_diff(&g.ox, &cpu.warp.ox) < 2e-3, "tent row warps differ by {}", max_diff(&g.ox, &cpu.warp.ox));
+    assert!(max_diff(&g.oy, &cpu.warp.oy) < 5e-3, "tent column warps differ by {}", max_diff(&g.oy, &cpu.warp.oy));
+
     // RTW: importance map (DV + distance to eye, max per texel), collapse, blur, 1D warps
     let t = run_direct(&gpu, &lab, &v, "rtw:res=64,blur=8,w_dv=1,w_eye=1", Variant::Rtw);
     let maxd = dist.iter().copied().fold(0.0, f32::max);

@@ -29,14 +29,18 @@ fn the_occluder_pyramid_holds_the_maxima_of_the_occluder_map() {
     let scene = builtin("city").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 128);
-    let t = run_direct(&gpu, &lab, &v, "notw:res=100,window=16");
-    let (depth, hzb) = t.read_occluders(&gpu).expect("notw culls hidden edges by default");
+    let t = run_direct(&gpu, &lab, &v, "notw:res=100,window=16,cull_hidden=true");
+    let (depth, hzb) = t.read_occluders(&gpu).expect("cull_hidden=true builds the occluder pyramid");
     let res = 100usize;
     let drawn = depth.iter().filter(|d| **d < 1.0).count();
     let mut distinct: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
     distinct.sort_unstable();
     distinct.dedup();
-    assert!(drawn > res * res / 2 && distinct.len() > res, "{drawn} texels drawn, {} depths: the city's ground and blocks expected", distinct.len());
+    assert!(
+        drawn > res * res / 2 && distinct.len() > res,
+        "{drawn} texels drawn, {} depths: the city's ground and blocks expected",
+        distinct.len()
+    );
     assert_eq!(&hzb[..res * res], &depth[..], "level 0 is the occluder map");
     let (mut side, mut at) = (res, 0usize);
     let mut levels = 0;
@@ -71,8 +75,8 @@ fn culling_hidden_edges_draws_fewer_pieces_at_the_same_quality() {
     let v = view(&lab, &scene, 1, 192);
     let rt = lab.reference(&v, 1).unwrap();
     let run = |s: &str| lab.run(&v, &TechniqueSpec::parse(s).unwrap(), 1).unwrap();
-    let on = run("cube-notw:res=128,window=64");
-    let off = run("cube-notw:res=128,window=64,cull_hidden=false");
+    let on = run("cube-notw:res=128,window=64,cull_hidden=true");
+    let off = run("cube-notw:res=128,window=64");
     let pieces = |r: &shadowlab_gpu::lab::Run| r.report.counters["subdiv_triangles_drawn"];
     let wrong = |r: &shadowlab_gpu::lab::Run| 100.0 - agreement(&r.visibility, &rt.visibility, &v.mask);
     eprintln!(

@@ -47,18 +47,23 @@ pub fn eval_offset(o: &[f32], x: f32) -> f32 {
 /// Weighted average of neighbouring functions (seed 000 section 3.1, Figure 4): function i
 /// becomes the average of functions j in [i - window/2, i + window/2], weighted by their sample
 /// totals. A convex combination of monotonic warps is monotonic. `window` 0: unchanged.
-pub fn smooth(offsets: &[f32], totals: &[f32], len: usize, window: usize) -> Vec<f32> {
+/// `tent`: each function's weight also falls off linearly with |i - j| (window/2 + 1 - |i - j|),
+/// so a function with many samples enters the average gradually instead of at once: with the
+/// box (the seeds'), neighbouring functions differ by a step wherever a heavy function enters
+/// or leaves the window, which sparse samples make large.
+pub fn smooth(offsets: &[f32], totals: &[f32], len: usize, window: usize, tent: bool) -> Vec<f32> {
     let rows = totals.len();
     let half = window / 2;
     let mut out = vec![0.0; rows * len];
     for i in 0..rows {
         let (a, b) = (i.saturating_sub(half), (i + half).min(rows - 1));
-        let wsum: f32 = totals[a..=b].iter().sum();
+        let weight = |j: usize| if tent { (half + 1 - i.abs_diff(j)) as f32 * totals[j] } else { totals[j] };
+        let wsum: f32 = (a..=b).map(weight).sum();
         if wsum <= 0.0 {
             continue;
         }
         for k in 0..len {
-            let s: f32 = (a..=b).map(|j| totals[j] * offsets[j * len + k]).sum();
+            let s: f32 = (a..=b).map(|j| weight(j) * offsets[j * len + k]).sum();
             out[i * len + k] = s / wsum;
         }
     }
@@ -67,11 +72,11 @@ pub fn smooth(offsets: &[f32], totals: &[f32], len: usize, window: usize) -> Vec
 
 /// Per-row warping functions of a `res x res` count map (row-major), smoothed over `window`.
 /// Returns the `res x res` offsets (row i, edge k at i*res+k) and the row totals.
-pub fn row_warps(counts: &[f32], res: usize, window: usize) -> Vec<f32> {
+pub fn row_warps(counts: &[f32], res: usize, window: usize, tent: bool) -> Vec<f32> {
     let prefix = row_prefix(counts, res, res);
     let totals: Vec<f32> = (0..res).map(|r| prefix[r * res + res - 1]).collect();
     let raw: Vec<f32> = (0..res).flat_map(|r| offsets_from_prefix(&prefix[r * res..(r + 1) * res])).collect();
-    smooth(&raw, &totals, res, window)
+    smooth(&raw, &totals, res, window, tent)
 }
 
 fn texel(v: f32, res: usize) -> usize {
@@ -222,16 +227,21 @@ pub struct Notw {
 /// neighbouring functions). `blur` > 0 box-blurs the counts along each row (column) first;
 /// `mix` adds a uniform floor of `mix` x the mean count per texel (points / res^2) to each.
 pub fn notw(points: &[[f32; 2]], res: usize, window: usize, interp: bool, blur_radius: usize, mix: f32) -> Notw {
+    notw_shaped(points, res, window, false, interp, blur_radius, mix)
+}
+
+/// [`notw`] with the smoothing window's shape: `tent` or the seeds' box (see [`smooth`]).
+pub fn notw_shaped(points: &[[f32; 2]], res: usize, window: usize, tent: bool, interp: bool, blur_radius: usize, mix: f32) -> Notw {
     let floor = mix * points.len() as f32 / (res * res) as f32;
     let blur_rows = |v: Vec<f32>| -> Vec<f32> { v.chunks(res).flat_map(|r| blur(r, blur_radius)).map(|c| c + floor).collect() };
     let counts = count_map(points, res, None);
     let cf = blur_rows(counts.iter().map(|&c| c as f32).collect());
-    let ox = row_warps(&cf, res, window);
+    let ox = row_warps(&cf, res, window, tent);
     let rows_only = Warp2D { res, rows_x: res, cols_y: 1, ox, oy: vec![0.0; res], interp };
     let counts_rows = count_map(points, res, Some((&rows_only, false)));
     // columns: transpose, warp as rows, transpose back into the image layout
     let t = blur_rows((0..res * res).map(|idx| counts_rows[(idx % res) * res + idx / res] as f32).collect());
-    let oy_t = row_warps(&t, res, window);
+    let oy_t = row_warps(&t, res, window, tent);
     let oy: Vec<f32> = (0..res * res).map(|idx| oy_t[(idx % res) * res + idx / res]).collect();
     Notw { counts, counts_rows, warp: Warp2D { res, rows_x: res, cols_y: res, ox: rows_only.ox, oy, interp } }
 }

@@ -52,7 +52,7 @@ fn a_row_with_all_samples_in_one_half_maps_that_half_to_the_whole_row() {
     for k in 0..res / 2 {
         c[5 * res + k] = 3.0;
     }
-    let o = row_warps(&c, res, 0);
+    let o = row_warps(&c, res, 0, false);
     let row = &o[5 * res..6 * res];
     for s in 0..=50 {
         let x = 0.5 * s as f32 / 50.0;
@@ -119,11 +119,30 @@ fn random_warps_are_monotonic_and_onto() {
 fn smoothing_is_a_weighted_average_over_the_window() {
     // three rows of two edges: totals 1, 0, 3; window 2 (rows i-1..i+1)
     let offs = [0.4, 0.0, 9.0, 0.0, -0.2, 0.0];
-    let s = smooth(&offs, &[1.0, 0.0, 3.0], 2, 2);
+    let s = smooth(&offs, &[1.0, 0.0, 3.0], 2, 2, false);
     assert!((s[0] - 0.4).abs() < 1e-6); // rows 0,1: only row 0 weighs
     assert!((s[2] - (0.4 - 0.6) / 4.0).abs() < 1e-6); // rows 0..2: (1*0.4 + 3*-0.2) / 4
     assert!((s[4] - (-0.2)).abs() < 1e-6);
-    assert_eq!(smooth(&offs, &[1.0, 0.0, 3.0], 2, 0)[2], 0.0, "window 0 keeps row 1 (0 samples): 0 weight -> 0");
+    assert_eq!(smooth(&offs, &[1.0, 0.0, 3.0], 2, 0, false)[2], 0.0, "window 0 keeps row 1 (0 samples): 0 weight -> 0");
+}
+
+#[test]
+fn the_tent_window_weighs_functions_by_distance_and_steps_less_between_neighbours() {
+    // three rows as above, window 2 (half 1): weight 2 at distance 0, 1 at distance 1
+    let offs = [0.4, 0.0, 9.0, 0.0, -0.2, 0.0];
+    let s = smooth(&offs, &[1.0, 0.0, 3.0], 2, 2, true);
+    assert!((s[0] - 0.4).abs() < 1e-6, "rows 0, 1: only row 0 weighs");
+    assert!((s[2] - (0.4 - 0.6) / 4.0).abs() < 1e-6, "row 1: rows 0 and 2 both at distance 1");
+    // sparse functions (every third row has samples, 1-5 of them) with scattered offsets,
+    // window 16: the box's neighbours differ by a step wherever a function enters or leaves;
+    // the tent's steps are about half as large (0.143 vs 0.072 here)
+    let rows = 64;
+    let offs: Vec<f32> = (0..rows).map(|r| ((r * 5) % 7) as f32 / 7.0).collect();
+    let totals: Vec<f32> = (0..rows).map(|r| if r % 3 == 0 { (1 + (r * 3) % 5) as f32 } else { 0.0 }).collect();
+    let steps = |v: &[f32]| v[8..rows - 8].windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0f32, f32::max);
+    let (boxed, tent) = (smooth(&offs, &totals, 1, 16, false), smooth(&offs, &totals, 1, 16, true));
+    assert!((steps(&boxed) - 1.0 / 7.0).abs() < 1e-5, "box steps: {boxed:?}");
+    assert!(steps(&tent) < 0.55 * steps(&boxed), "tent steps {} vs box {}", steps(&tent), steps(&boxed));
 }
 
 #[test]

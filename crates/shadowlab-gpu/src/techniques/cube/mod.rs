@@ -152,6 +152,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     w::DEPTH_CLAMP,
     w::EXACT_INVERSE,
     w::CULL_HIDDEN,
+    w::WINDOW_TENT,
 ];
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {

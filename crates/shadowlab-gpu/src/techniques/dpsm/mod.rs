@@ -146,6 +146,7 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     warp::FOOTPRINT_CAP,
     warp::DEPTH_CLAMP,
     warp::EXACT_INVERSE,
+    warp::WINDOW_TENT,
 ];
 
 pub const INFO: TechniqueInfo = TechniqueInfo {

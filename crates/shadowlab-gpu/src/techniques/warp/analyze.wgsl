@@ -169,6 +169,8 @@ fn offsets_cols(@builtin(global_invocation_id) id: vec3<u32>) {
 // window / SMOOTH_BLOCK + 2 reads instead of window + 1 (cube-notw's window 128 made this
 // the largest stage of its frame). The totals are whole sample counts, exact in f32 below
 // 2^24 samples, so only the weighted sum drifts, by rounding over at most SMOOTH_BLOCK slides.
+// `window_tent`: the weights also fall off as half + 1 - |r - j| (core warp::smooth); the sum
+// slides by the two half-window sums, which slide like the box's.
 // Set by the pipeline (warp::SMOOTH_BLOCK, which also sizes the dispatch).
 override SMOOTH_BLOCK: u32;
 
@@ -185,12 +187,39 @@ fn smooth_block(axis: u32, k: u32, block: u32) {
     if k >= w || r0 >= w {
         return;
     }
+    let tent = wp.tent > 0.5;
     var acc = vec2<f32>(0.0);
-    for (var j = max(i32(r0) - half, 0); j <= min(i32(r0) + half, i32(w) - 1); j++) {
-        acc += weighted(axis, u32(j), k);
+    // tent: the sums of the functions just above r (r + 1 ..= r + half + 1) and at or below it
+    // (r - half ..= r), which move the tent's weighted sum by one step
+    var above = vec2<f32>(0.0);
+    var below = vec2<f32>(0.0);
+    for (var j = max(i32(r0) - half, 0); j <= min(i32(r0) + half + 1, i32(w) - 1); j++) {
+        let x = weighted(axis, u32(j), k);
+        let d = abs(j - i32(r0));
+        if d <= half {
+            acc += select(x, x * f32(half + 1 - d), tent);
+        }
+        if j > i32(r0) {
+            above += x;
+        } else {
+            below += x;
+        }
     }
     for (var r = r0; r < min(r0 + SMOOTH_BLOCK, w); r++) {
-        if r > r0 {
+        if r > r0 && tent {
+            // from r - 1 to r: sum + above - below; then the two halves move up by one
+            acc += above - below;
+            let p = i32(r) - 1;
+            let mid = weighted(axis, u32(r), k);
+            above -= mid;
+            below += mid;
+            if p + half + 2 < i32(w) {
+                above += weighted(axis, u32(p + half + 2), k);
+            }
+            if p - half >= 0 {
+                below -= weighted(axis, u32(p - half), k);
+            }
+        } else if r > r0 {
             let enter = i32(r) + half;
             let leave = i32(r) - half - 1;
             if enter < i32(w) {

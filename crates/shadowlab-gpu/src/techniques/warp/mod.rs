@@ -192,7 +192,8 @@ pub struct WarpParams {
     pub exact_inverse: f32,
     /// 1 = subdivision leaves edges hidden behind nearer geometry unsplit (`cull_hidden`)
     pub cull_hidden: f32,
-    pub pad2: f32,
+    /// 1 = tent-weighted smoothing across functions (`window_tent`)
+    pub tent: f32,
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -405,7 +406,7 @@ impl Warped {
             min_piece: k.min_piece,
             exact_inverse: if k.exact_inverse { 1.0 } else { 0.0 },
             cull_hidden: if k.cull_hidden { 1.0 } else { 0.0 },
-            pad2: 0.0,
+            tent: if k.tent { 1.0 } else { 0.0 },
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;

@@ -219,13 +219,32 @@ pub const EXACT_INVERSE: ParamDef = ParamDef::flag(
 /// Subdivision leaves an edge unsplit when an unwarped occluder map (the scene drawn into the
 /// DV-cropped map, res x res, then a pyramid of maxima) is nearer than the edge all around it:
 /// the bend of a hidden edge cannot show. Planar maps (`notw`, `cube-notw`'s faces); see
-/// warp/occluders.rs and BENCHMARKS.md (bounded cost, issue 18).
-pub const DEFAULT_CULL_HIDDEN: f64 = 1.0;
+/// warp/occluders.rs and BENCHMARKS.md (bounded cost, issue 18). Off: the occluder map is
+/// point-sampled at res, and where the warp magnifies a grazing wall that is a sliver of base
+/// texels its edges look hidden: `notw` on the built-in city went 1.138 -> 2.251 % wrong (false
+/// shadows on lit walls); cube-notw kept its quality on five point-light views (38-40 % fewer
+/// pieces on room and the lantern).
+pub const DEFAULT_CULL_HIDDEN: f64 = 0.0;
 pub const CULL_HIDDEN: ParamDef = ParamDef::flag(
     "cull_hidden",
     DEFAULT_CULL_HIDDEN != 0.0,
     "do not split edges that lie behind nearer geometry (an unwarped occluder map and its pyramid of maxima, drawn first): fewer pieces on layered scenes; an edge judged hidden is drawn unsplit, never dropped",
     "shadowlab measurement (bounded cost, issue 18; BENCHMARKS.md)",
+);
+
+/// Smoothing across functions with a tent instead of the seeds' box: each function's weight
+/// also falls off linearly with its distance, so one with many samples enters the average
+/// gradually. With the box, sparse samples (far fewer than texels: a cube face few view samples
+/// fall on) leave steps between neighbouring functions, edges crossing them bend by the step
+/// however short they are, and subdivision splits them to its last level. See BENCHMARKS.md
+/// (bounded cost, issue 18). Off: the seeds' box. Opt-in: measured on the sibenik stress view
+/// only (cube-notw 4.13 M -> 0.92 M pieces, 0.977 -> 0.886 % wrong), not yet on held-out views.
+pub const DEFAULT_WINDOW_TENT: f64 = 0.0;
+pub const WINDOW_TENT: ParamDef = ParamDef::flag(
+    "window_tent",
+    DEFAULT_WINDOW_TENT != 0.0,
+    "smooth across functions with tent weights (window/2 + 1 - distance) x samples instead of the seeds' box: no steps between neighbouring functions where a function with many samples enters the window",
+    "seed 000 section 3.1 (the box); tent: shadowlab (bounded cost, issue 18; BENCHMARKS.md)",
 );
 
 /// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
@@ -263,9 +282,9 @@ const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A]
 }
 
 /// notw's own list: `NOTW_PARAMS` plus the warp strength, the bias footprint parameters, the
-/// exact depth's clamp and inversion, and hidden-edge culling.
+/// exact depth's clamp and inversion, hidden-edge culling and the smoothing's tent.
 pub const NOTW_OWN_PARAMS: &[ParamDef] =
-    &concat::<17, 6, 23>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE, CULL_HIDDEN]);
+    &concat::<17, 7, 24>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE, CULL_HIDDEN, WINDOW_TENT]);
 
 /// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
 /// run with; the gradient footprint (2) was measured for `notw` only.
@@ -328,6 +347,8 @@ pub(super) struct Knobs {
     pub exact_inverse: bool,
     /// Leave hidden edges unsplit (`cull_hidden`; planar projections only).
     pub cull_hidden: bool,
+    /// Tent-weighted smoothing across functions (`window_tent`, NoTW).
+    pub tent: bool,
 }
 
 impl Knobs {
@@ -355,6 +376,7 @@ impl Knobs {
             depth_clamp: p.get_u32("depth_clamp"),
             exact_inverse: notw && p.get_bool("exact_inverse"),
             cull_hidden: notw && !paraboloid && subdiv > 0.0 && p.get_bool("cull_hidden"),
+            tent: notw && p.get_bool("window_tent"),
         }
     }
 }

@@ -64,7 +64,8 @@ struct WarpParams {
     exact_inverse: f32,
     // 1: subdivision does not split edges hidden behind nearer geometry (occluders.wgsl)
     cull_hidden: f32,
-    pad2: f32,
+    // 1: the smoothing across functions weighs them with a tent (analyze.wgsl smooth_block)
+    tent: f32,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.

@@ -206,8 +206,7 @@ fn interior_needs_split(p: vec4<u32>) -> bool {
         return false;
     }
     if max(hi.x - lo.x, hi.y - lo.y) > BIG_PIECE {
-        let m = HIDDEN_MARGIN / wp.res;
-        return is_paraboloid(wp) || !hidden(lo - m, hi + m, min(min(clip_to_map(a).z, clip_to_map(b).z), clip_to_map(c).z));
+        return true;
     }
     return false;
 }
