@@ -164,7 +164,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     lights: &["point"],
     params: NOTW_PARAMS,
     stalls: "cube-notw.face_samples: the samples per face are read back to skip empty faces",
-    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision",
+    needs: "12 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
