@@ -26,11 +26,11 @@ pub(super) struct Occluders {
     /// The pyramid, level 0 (res x res) first (params.wgsl `hzb_offset`).
     pub hzb: wgpu::Buffer,
     raster: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
     base: wgpu::ComputePipeline,
     reduce: wgpu::ComputePipeline,
-    /// One uniform per level: (res, level).
-    levels: Vec<wgpu::Buffer>,
+    /// One bind group per level (the occluder map, the pyramid, the level's uniform (res, level)),
+    /// made once: nothing in them changes between frames.
+    groups: Vec<wgpu::BindGroup>,
 }
 
 /// Levels above 0 until the side is 1.
@@ -60,15 +60,30 @@ impl Occluders {
             &[(0, binding::texture_depth()), (1, binding::storage(false)), (2, binding::uniform())],
         );
         let src = hzb_src();
+        let hzb = gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4);
+        let view = depth.create_view(&Default::default());
+        let groups = (0..=top_level(res))
+            .map(|l| {
+                let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);
+                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("hzb"),
+                    layout: &layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
+                        wgpu::BindGroupEntry { binding: 1, resource: hzb.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: u.as_entire_binding() },
+                    ],
+                })
+            })
+            .collect();
         Occluders {
             res,
-            hzb: gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4),
+            hzb,
             base: gpu.compute_pipeline(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout]),
             reduce: gpu.compute_pipeline(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout]),
-            levels: (0..=top_level(res)).map(|l| gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0])).collect(),
+            groups,
             depth,
             raster,
-            layout,
         }
     }
 
@@ -91,19 +106,10 @@ impl Occluders {
             pass.set_bind_group(1, &scene.group, &[]);
             pass.draw(0..scene.triangle_count * 3, 0..1);
         }
-        for (l, u) in self.levels.iter().enumerate() {
-            let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("hzb"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                    wgpu::BindGroupEntry { binding: 1, resource: self.hzb.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: u.as_entire_binding() },
-                ],
-            });
+        for (l, group) in self.groups.iter().enumerate() {
             let side = side(self.res, l as u32);
             let pipeline = if l == 0 { &self.base } else { &self.reduce };
-            gpu.dispatch_2d(enc, "hzb", pipeline, &[&group], side, side);
+            gpu.dispatch_2d(enc, "hzb", pipeline, &[group], side, side);
         }
     }
 }
