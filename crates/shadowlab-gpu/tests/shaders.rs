@@ -408,7 +408,7 @@ fn virtual_params_layout_matches_rust() {
     use shadowlab_gpu::techniques::virtual_sm::VirtualParams;
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
-    let f = fields!(VirtualParams; right, up, dir, view, dims, bias, pcf, spot, origins);
+    let f = fields!(VirtualParams; right, up, dir, view, dims, bias, pcf, spot, face_axes, origins);
     check_all(&get("virtual_sm/mark.wgsl"), "VirtualParams", size_of::<VirtualParams>(), f);
     check_all(&get("virtual_sm/eval.wgsl"), "VirtualParams", size_of::<VirtualParams>(), f);
 }

@@ -40,10 +40,11 @@ impl Ord for PageKey {
 
 /// The requested pages plus the fallback pages a full pool needs: while the first `slots`
 /// pages in priority order leave some requested pages out, each left-out page of level k adds
-/// the `candidates` of level k + 1 within one page of its parent (the pages its samples would
-/// read one level coarser: mark.wgsl flags them as candidates), until nothing more is added.
-/// Without a full pool this is `requested`. Sorted, without duplicates.
-pub fn with_fallbacks(requested: &[PageKey], candidates: &[PageKey], slots: usize) -> Vec<PageKey> {
+/// the `candidates` of level k + `step` (one level coarser: `Clipmap::faces()`, 1 unless a
+/// cube) within one page of its parent (the pages its samples would read one level coarser:
+/// mark.wgsl flags them as candidates), until nothing more is added. Without a full pool this
+/// is `requested`. Sorted, without duplicates.
+pub fn with_fallbacks(requested: &[PageKey], candidates: &[PageKey], slots: usize, step: u32) -> Vec<PageKey> {
     let mut req: Vec<PageKey> = requested.to_vec();
     req.sort();
     req.dedup();
@@ -58,7 +59,7 @@ pub fn with_fallbacks(requested: &[PageKey], candidates: &[PageKey], slots: usiz
             .iter()
             .flat_map(|f| {
                 let (px, py) = (f.x.div_euclid(2), f.y.div_euclid(2));
-                (-1..=1).flat_map(move |dy| (-1..=1).map(move |dx| (f.level + 1, px + dx, py + dy)))
+                (-1..=1).flat_map(move |dy| (-1..=1).map(move |dx| (f.level + step, px + dx, py + dy)))
             })
             .collect();
         let add: Vec<PageKey> = pending.iter().filter(|c| wanted.contains(&(c.level, c.x, c.y))).copied().collect();

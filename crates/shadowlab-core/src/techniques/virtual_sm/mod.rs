@@ -2,7 +2,8 @@
 //! lights: clipmap levels around the camera, each a virtual map of `virtual_res` texels a side
 //! in pages of `page_res` texels; level k covers 2^k times level 0's extent. Spot lights: one
 //! perspective virtual map of the cone with a mip chain (level k: `virtual_res / 2^k` texels a
-//! side, the same pages), see `spot.rs`; the rest of this file serves both.
+//! side, the same pages), see `spot.rs`. Point lights: six such maps, one per cube face, their
+//! mip chains numbered as one list of levels (`cube.rs`); the rest of this file serves all three.
 //!
 //! Light space (`iasm::light_basis`): `x` = right, `y` = up, depth = distance along the
 //! direction the light travels. Global texel coordinates of level k: `gx = x / t_k`,
@@ -15,8 +16,10 @@
 //! Stored depth: orthographic, linear, 0 = near the light (spot: post-projective, 0 = near).
 
 mod alloc;
+mod cube;
 mod spot;
 pub use alloc::{with_fallbacks, Allocation, PageCache, PageKey};
+pub use cube::{cube_face, CUBE_DIRS};
 pub use spot::{spot_levels, Projection};
 
 use glam::{IVec2, Mat4, Vec2, Vec3, Vec4};
@@ -24,7 +27,8 @@ use glam::{IVec2, Mat4, Vec2, Vec3, Vec4};
 use super::iasm::light_basis;
 use crate::scene::Bounds;
 
-/// The clipmap of one directional light (or the mip chain of one spot light) for one view.
+/// The clipmap of one directional light (or the mip chain of one spot light, or the six faces'
+/// mip chains of one point light) for one view.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clipmap {
     /// Orthographic (directional) or the spot's perspective.
@@ -32,7 +36,10 @@ pub struct Clipmap {
     pub right: Vec3,
     pub up: Vec3,
     pub dir: Vec3,
+    /// Level indices in all: `faces() * mips`.
     pub levels: u32,
+    /// Levels per face (clipmap levels or mip levels; `levels` unless a cube).
+    pub mips: u32,
     pub virtual_res: u32,
     pub page_res: u32,
     /// World side of level 0 (spot: 2, the NDC side of the map).
@@ -60,6 +67,7 @@ impl Clipmap {
             up,
             dir,
             levels,
+            mips: levels,
             virtual_res,
             page_res,
             extent0,
@@ -81,24 +89,24 @@ impl Clipmap {
         (self.levels * self.pages_per_side() * self.pages_per_side()) as usize
     }
 
-    /// World size of one texel of level k.
+    /// World size of one texel of level k (of its mip: a cube's faces repeat the chain).
     pub fn texel(&self, k: u32) -> f32 {
-        self.extent0 * (1u64 << k) as f32 / self.virtual_res as f32
+        self.extent0 * (1u64 << self.mip(k)) as f32 / self.virtual_res as f32
     }
 
-    /// Texels per world unit at level k: `(virtual_res / extent0) 2^-k` (halving is exact, so
+    /// Texels per world unit at level k: `(virtual_res / extent0) 2^-mip` (halving is exact, so
     /// the GPU, given level 0's value, computes the same number).
     pub fn inv_texel(&self, k: u32) -> f32 {
         let mut s = self.virtual_res as f32 / self.extent0;
-        for _ in 0..k {
+        for _ in 0..self.mip(k) {
             s *= 0.5;
         }
         s
     }
 
-    /// Global texel coordinates of world point p at level k (continuous).
+    /// Global texel coordinates of world point p at level k (continuous), on level k's face.
     pub fn texel_coords(&self, k: u32, p: Vec3) -> Vec2 {
-        self.light_coords(p) * self.inv_texel(k)
+        self.light_coords_face(self.face(k), p) * self.inv_texel(k)
     }
 
     /// The window origin (in pages) of level k centred on `eye`: the eye's page minus N/2.
@@ -142,23 +150,25 @@ impl Clipmap {
     /// (`level_for`), or the first coarser one whose window holds them, the pages under the
     /// corners of the square of `reach` texels around p (the PCF taps after the normal offset);
     /// and the same corners' pages of the coarsest level, so that a sample whose pages fall back
-    /// always finds a mapped coarser page. Empty where no window holds p.
+    /// always finds a mapped coarser page. A cube's sample marks only its own face's levels.
+    /// Empty where no window holds p.
     pub fn sample_pages(&self, p: Vec3, footprint: f32, scale: f32, reach: f32) -> Vec<PageKey> {
         let corners = |k: u32| {
             let g = self.texel_coords(k, p);
             [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)].map(|(sx, sy)| self.page_at(k, g + Vec2::new(sx, sy) * reach))
         };
         let mut out = Vec::new();
-        let mut k = level_for(footprint, self.texel0_at(p), scale, self.levels);
-        while k < self.levels {
+        let face = self.face_of(p);
+        let (top, step) = (self.level_index(face, self.mips - 1), self.faces());
+        let mut k = self.level_index(face, level_for(footprint, self.texel0_at(p), scale, self.mips));
+        while k <= top {
             let c = corners(k);
             if c.iter().all(|pg| self.in_window(k, *pg)) {
                 out.extend(c.iter().map(|pg| PageKey { level: k, x: pg.x, y: pg.y }));
                 break;
             }
-            k += 1;
+            k += step;
         }
-        let top = self.levels - 1;
         if k < top {
             out.extend(corners(top).iter().filter(|pg| self.in_window(top, **pg)).map(|pg| PageKey { level: top, x: pg.x, y: pg.y }));
         }
@@ -170,7 +180,7 @@ impl Clipmap {
     /// The orthographic view-projection of one page: its light-space square to NDC x/y in
     /// [-1, 1] (NDC y = +1 at the page's top row), depth to [0, 1] as [`depth`](Self::depth).
     pub fn page_view_proj(&self, key: PageKey) -> Mat4 {
-        if let Projection::Persp { .. } = self.projection {
+        if self.persp().is_some() {
             return self.spot_page_view_proj(key);
         }
         let s = self.texel(key.level) * self.page_res as f32;
@@ -212,19 +222,20 @@ impl Clipmap {
     }
 
     /// The texel rectangle of level k covered by world box b (its corners' light coordinates),
-    /// None where it spans the whole map (a corner behind a spot light).
+    /// None where it spans the whole map (a corner behind a perspective map's plane).
     pub fn texel_rect(&self, k: u32, b: &Bounds) -> Option<(Vec2, Vec2)> {
-        let (lo, hi) = self.light_rect(b)?;
+        let (lo, hi) = self.light_rect(self.face(k), b)?;
         let s = self.inv_texel(k);
         Some((lo * s, hi * s))
     }
 
-    /// The light-coordinate rectangle of world box b (see [`light_coords`](Self::light_coords)),
-    /// None where it spans the whole map (a corner at or behind a spot light's plane).
-    pub fn light_rect(&self, b: &Bounds) -> Option<(Vec2, Vec2)> {
+    /// The light-coordinate rectangle of world box b on face f (see
+    /// [`light_coords_face`](Self::light_coords_face)), None where it spans the whole map (a
+    /// corner at or behind a perspective map's plane).
+    pub fn light_rect(&self, f: u32, b: &Bounds) -> Option<(Vec2, Vec2)> {
         let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
         for c in b.corners() {
-            let g = self.light_coords_in_front(c)?;
+            let g = self.light_coords_in_front(f, c)?;
             lo = lo.min(g);
             hi = hi.max(g);
         }
@@ -256,6 +267,8 @@ pub fn pixel_angle(fov_y_deg: f32, height: u32) -> f32 {
     2.0 * (fov_y_deg.to_radians() * 0.5).tan() / height as f32
 }
 
+#[cfg(test)]
+mod cube_tests;
 #[cfg(test)]
 mod spot_tests;
 #[cfg(test)]

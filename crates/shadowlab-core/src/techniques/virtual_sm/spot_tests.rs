@@ -38,7 +38,7 @@ fn the_cone_fills_the_map_and_its_axis_is_the_centre() {
     assert!((g.x - 2.0).abs() < 1e-5 && (g.y - 1.0).abs() < 1e-5, "{g}");
     // up in light space is the top row (smaller w)
     assert!(c.light_coords(position + (c.dir + c.up * 0.3) * 2.0).y < 1.0);
-    assert!(c.light_coords_in_front(position - c.dir).is_none());
+    assert!(c.light_coords_in_front(0, position - c.dir).is_none());
 }
 
 #[test]

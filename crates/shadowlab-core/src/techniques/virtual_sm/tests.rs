@@ -190,12 +190,12 @@ fn left_out_pages_bring_their_coarser_candidates() {
     let req = [key(0, 0, 0), key(0, 1, 0), key(0, 2, 0), key(0, 3, 0), key(0, 8, 8)];
     let cand = [key(1, 1, 0), key(1, 0, 0), key(1, 4, 4), key(1, 20, 20), key(2, 0, 0)];
     // room for everything: nothing added
-    assert_eq!(with_fallbacks(&req, &cand, 5), {
+    assert_eq!(with_fallbacks(&req, &cand, 5, 1), {
         let mut r = req.to_vec();
         r.sort();
         r
     });
-    let out = with_fallbacks(&req, &cand, 3);
+    let out = with_fallbacks(&req, &cand, 3, 1);
     // the two level-1 candidates near parents (0,0)/(1,0) come first; then (1,4,4) for (0,8,8)
     // once it is left out; (1,20,20) is near nothing, (2,0,0) is two levels up
     assert_eq!(&out[..3], &[key(1, 0, 0), key(1, 1, 0), key(1, 4, 4)]);

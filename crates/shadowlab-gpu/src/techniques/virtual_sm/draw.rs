@@ -7,19 +7,19 @@ use shadowlab_core::techniques::virtual_sm::{Clipmap, PageKey};
 
 use crate::{raster, Gpu};
 
-/// A chunk: triangle range and its rectangle in level-0 light coordinates
-/// (`Clipmap::light_rect`; unbounded where it spans the whole map).
+/// A chunk: triangle range and its rectangle in level-0 light coordinates per face
+/// (`Clipmap::light_rect`; unbounded where it spans the whole map; one face unless a cube).
 pub(super) struct Chunk {
     pub first: u32,
     pub end: u32,
-    lo: Vec2,
-    hi: Vec2,
+    rects: Vec<(Vec2, Vec2)>,
 }
 
 impl Chunk {
     pub fn new(first: u32, end: u32, world: &Bounds, c: &Clipmap) -> Chunk {
-        let (lo, hi) = c.light_rect(world).unwrap_or((Vec2::splat(f32::NEG_INFINITY), Vec2::splat(f32::INFINITY)));
-        Chunk { first, end, lo, hi }
+        let all = (Vec2::splat(f32::NEG_INFINITY), Vec2::splat(f32::INFINITY));
+        let rects = (0..c.faces()).map(|f| c.light_rect(f, world).unwrap_or(all)).collect();
+        Chunk { first, end, rects }
     }
 }
 
@@ -32,9 +32,11 @@ fn page_rect(c: &Clipmap, k: &PageKey) -> (Vec2, Vec2) {
 /// Triangle ranges of the chunks overlapping page `k` (adjacent chunks merged).
 pub(super) fn page_draws(chunks: &[Chunk], c: &Clipmap, k: &PageKey) -> Vec<(u32, u32)> {
     let (lo, hi) = page_rect(c, k);
+    let f = c.face(k.level) as usize;
     let mut out: Vec<(u32, u32)> = Vec::new();
     for ch in chunks {
-        if ch.hi.x < lo.x || ch.lo.x > hi.x || ch.hi.y < lo.y || ch.lo.y > hi.y {
+        let (clo, chi) = ch.rects[f];
+        if chi.x < lo.x || clo.x > hi.x || chi.y < lo.y || clo.y > hi.y {
             continue;
         }
         match out.last_mut() {

@@ -2,7 +2,8 @@
 // in texels of that level (a spot's texel at the sample's light depth), then each of the NxN PCF taps looked up through the page table
 // (a tap across a page border reads the neighbouring page: no guard band needed) and compared
 // with its atlas texel (lit where depth <= stored, as the comparison sampler of `sm`). Where a
-// tap's page is not mapped (fallen back) the whole kernel moves to the next coarser level.
+// tap's page is not mapped (fallen back) the whole kernel moves to the next coarser level
+// (of the sample's face, for a cube).
 // No mapped level: lit (the allocation counts those pages; the report says so). With
 // COUNT_SAMPLES the samples are counted per level used (lab only).
 
@@ -17,7 +18,7 @@ fn lookup(k: u32, p: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     let half = f32(kw - 1) * 0.5;
     let q = biased_point(p, n, l, texel_world(k, p), vp.bias, half);
     let g = texel_coords(k, q);
-    let z = light_depth(q);
+    let z = light_depth(k, q);
     if z > 1.0 {
         return 1.0;
     }
@@ -55,12 +56,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let l = to_light(light, s.p);
     var v = 1.0;
-    var used = vp.dims.x;
-    for (var k = choose_level(s.p); k < vp.dims.x; k++) {
+    // counts: per mip; the last entry (24) for samples without a mapped level
+    var used = 24u;
+    let k0 = choose_level(s.p);
+    let top = top_level(k0);
+    for (var k = k0; k <= top; k += faces()) {
         let r = lookup(k, s.p, s.n, l);
         if r >= 0.0 {
             v = r;
-            used = k;
+            used = mip_of(k);
             break;
         }
     }

@@ -22,7 +22,13 @@ pub const CHUNK_TRIANGLES: u32 = 1024;
 
 pub struct VirtualShadows {
     pub(super) light: Light,
+    /// The `levels` parameter (the clipmap's levels, or a perspective map's mips at most).
+    levels_param: u32,
+    /// Level indices of the page table (a cube's: 6 x its mips).
     pub(super) levels: u32,
+    /// Levels per face, and faces (6 for a point light).
+    pub(super) mips: u32,
+    pub(super) faces: u32,
     pub(super) virtual_res: u32,
     pub(super) page_res: u32,
     pub(super) extent0: f32,
@@ -75,8 +81,8 @@ impl VirtualShadows {
         }
         let extent0 = p.get("level0_extent") as f32;
         // the light's projection at creation (the light never moves): chunk rectangles, levels
-        let proto = Clipmap::for_light(light, &scene.bounds, scene.bounds.center(), levels, virtual_res, page_res, extent0)
-            .ok_or_else(|| GpuError::Invalid(format!("virtual supports directional and spot lights (got a {} light)", light.kind())))?;
+        let proto = Clipmap::for_light(light, &scene.bounds, scene.bounds.center(), levels, virtual_res, page_res, extent0);
+        let levels_param = levels;
         let levels = proto.levels;
         let max = gpu.limits.max_texture_dimension_2d;
         let slots = (p.get("pool_mib") * 1048576.0 / (page_res as f64 * page_res as f64 * 4.0)).floor() as u32;
@@ -136,7 +142,10 @@ impl VirtualShadows {
         let kernel_half = (p.get_u32("pcf") as f32 - 1.0) * 0.5;
         Ok(VirtualShadows {
             light: *light,
+            levels_param,
             levels,
+            mips: proto.mips,
+            faces: proto.faces(),
             virtual_res,
             page_res,
             extent0,
@@ -216,10 +225,16 @@ impl VirtualParams {
         let mut v: VirtualParams = bytemuck::Zeroable::zeroed();
         v.dims = [levels, n, page_res, cols];
         v.bias = [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32];
-        v.pcf = [p.get_u32("pcf"), 0, 0, 0];
-        if let Projection::Persp { position, tan_half } = proto.projection {
-            v.pcf[1] = 1;
+        v.pcf = [p.get_u32("pcf"), 0, proto.mips, proto.faces()];
+        if let Some((position, tan_half)) = proto.persp() {
+            v.pcf[1] = if matches!(proto.projection, Projection::Cube { .. }) { 2 } else { 1 };
             v.spot = position.extend(tan_half).into();
+        }
+        for f in 0..proto.faces() {
+            let (r, u, d) = proto.axes(f);
+            for (i, a) in [r, u, d].iter().enumerate() {
+                v.face_axes[3 * f as usize + i] = a.extend(0.0).into();
+            }
         }
         v
     }
@@ -228,15 +243,22 @@ impl VirtualParams {
 impl Technique for VirtualShadows {
     /// Marking on the GPU, one readback, the allocation and page table on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let c =
-            Clipmap::for_light(&self.light, &f.scene.bounds, f.camera.position, self.levels, self.virtual_res, self.page_res, self.extent0)
-                .expect("a light kind checked at creation");
+        let c = Clipmap::for_light(
+            &self.light,
+            &f.scene.bounds,
+            f.camera.position,
+            self.levels_param,
+            self.virtual_res,
+            self.page_res,
+            self.extent0,
+        );
         let v = &mut self.params;
         v.right = c.right.extend(c.texel0_scale()).into();
         v.up = c.up.extend(c.inv_texel(0)).into();
         v.dir = c.dir.extend(c.z_near).into();
         v.view = [c.z_far, pixel_angle(f.camera.fov_y_deg, f.gbuffer.height), self.bias_scale, self.reach];
-        for (k, o) in c.origins.iter().enumerate() {
+        // (a perspective map's origins are all 0: WGSL reads only the clipmap's, at most 24)
+        for (k, o) in c.origins.iter().take(MAX_LEVELS).enumerate() {
             v.origins[k] = [o.x, o.y, 0, 0];
         }
         rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.params));
@@ -280,7 +302,7 @@ impl Technique for VirtualShadows {
         let mut req: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f & 1 != 0).map(|(i, _)| c.key_of_index(i)).collect();
         req.sort();
         let cand: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f == 2).map(|(i, _)| c.key_of_index(i)).collect();
-        let all = with_fallbacks(&req, &cand, self.cache.slots() as usize);
+        let all = with_fallbacks(&req, &cand, self.cache.slots() as usize, self.faces);
         self.fallback_added = all.len() - req.len();
         self.alloc = self.cache.allocate(&all);
         self.requested = req;

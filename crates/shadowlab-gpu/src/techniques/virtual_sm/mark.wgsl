@@ -1,4 +1,5 @@
-// Page marking: every evaluated view sample flags the pages it will read (Clipmap::sample_pages):
+// Page marking: every evaluated view sample flags the pages it will read (Clipmap::sample_pages;
+// a cube's sample, on its own face's levels only):
 // at its level (or the first coarser one whose window holds them) the pages under the corners
 // of the square of `reach` texels around it, and the same corners' pages of the coarsest level
 // (the fallback of last resort), flag 1; the corners' pages one level coarser, flag 2: the
@@ -36,16 +37,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    let top = vp.dims.x - 1u;
     var k = choose_level(s.p);
+    let top = top_level(k);
+    let step = faces();
     while k <= top {
         if mark_level(k, texel_coords(k, s.p), true, 1u) {
             if k < top {
-                mark_level(k + 1u, texel_coords(k + 1u, s.p), false, 2u);
+                mark_level(k + step, texel_coords(k + step, s.p), false, 2u);
             }
             break;
         }
-        k++;
+        k += step;
     }
     if k < top {
         mark_level(top, texel_coords(top, s.p), false, 1u);

@@ -1,7 +1,9 @@
-//! `virtual`: virtual (page-based) shadow maps for directional and spot lights, after UE5's
-//! design. Directional: clipmap levels around the camera, each a virtual map of `virtual_res`
-//! texels a side in pages of `page_res`. Spot: one perspective virtual map of the cone with a
-//! mip chain (level k: `virtual_res / 2^k` texels a side) in the same pages. Only the pages
+//! `virtual`: virtual (page-based) shadow maps for directional, spot and point lights, after
+//! UE5's design. Directional: clipmap levels around the camera, each a virtual map of
+//! `virtual_res` texels a side in pages of `page_res`. Spot: one perspective virtual map of the
+//! cone with a mip chain (level k: `virtual_res / 2^k` texels a side) in the same pages. Point:
+//! six such maps, one per cube face (90 degrees each), sharing the page table's list of levels
+//! and the pool; a PCF kernel clamps at its face's edge (no lookup across faces). Only the pages
 //! view samples need are rendered, into slots of one Depth32Float atlas (the physical pool,
 //! `pool_mib`), and kept across frames while nothing moved over them. The CPU half (level
 //! geometry, projections, page math, the pool) is `shadowlab_core::techniques::virtual_sm`.
@@ -53,11 +55,11 @@ fn page_source() -> String {
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "virtual",
-    summary: "virtual shadow maps: clipmap levels (spot: one map's mip chain) of 16K virtual texels in 128^2 pages; only the pages view samples need are rendered, cached across frames",
+    summary: "virtual shadow maps: clipmap levels (spot: one map's mip chain; point: six faces' chains) of 16K virtual texels in 128^2 pages; only the pages view samples need are rendered, cached across frames",
     cost: "a marking pass, one readback (a sync), per new page one atlas viewport with culled chunks; N^2 page-table lookups per pixel",
     quality: "about one texel per pixel everywhere (resolution_bias); a full pool makes fine pages fall back to coarser ones (reported)",
     source: "Epic Games, Unreal Engine 5 virtual shadow maps (2021); clipmaps: Tanner, Migdal, Jones 1998",
-    lights: &["directional", "spot"],
+    lights: &["directional", "spot", "point"],
     params: PARAMS,
     stalls: "virtual.readback: the page requests read back for the CPU allocation (every frame)",
     needs: "",
@@ -82,10 +84,12 @@ pub struct VirtualParams {
     pub dims: [u32; 4],
     /// bias, slope_bias, normal_offset, max_slope.
     pub bias: [f32; 4],
-    /// x: PCF width, y: projection (0 orthographic, 1 spot).
+    /// x: PCF width, y: projection (0 orthographic, 1 spot, 2 cube), z: mips per face, w: faces.
     pub pcf: [u32; 4],
-    /// Spot: xyz position, w tan(cone half-angle).
+    /// Spot, cube: xyz position, w tan(half-angle) (1 for a cube face).
     pub spot: [f32; 4],
+    /// Cube: each face's right, up and travel direction (`Clipmap::axes`), 3 per face.
+    pub face_axes: [[f32; 4]; 18],
     /// xy: window origins per level (pages).
     pub origins: [[i32; 4]; MAX_LEVELS],
 }

@@ -35,17 +35,29 @@ pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
     c.insert("request_bytes".into(), table_bytes as f64);
     let counts: Vec<u32> = gpu.read_buffer_as(&t.counts, MAX_LEVELS + 1);
     let total: u64 = counts.iter().map(|&x| x as u64).sum();
+    // per level index (a cube's: mip x 6 + face); the samples per mip (all faces)
     for k in 0..t.levels as usize {
         let marked = t.requested.iter().filter(|p| p.level == k as u32).count();
-        if marked > 0 || counts[k] > 0 {
+        if marked > 0 {
             c.insert(format!("pages_marked_level_{k}"), marked as f64);
-            c.insert(format!("pixels_in_level_{k}"), counts[k] as f64 / total.max(1) as f64);
         }
     }
-    let unresolved = counts[t.levels as usize];
+    for m in 0..t.mips as usize {
+        if counts[m] > 0 {
+            c.insert(format!("pixels_in_level_{m}"), counts[m] as f64 / total.max(1) as f64);
+        }
+    }
+    if t.faces > 1 {
+        c.insert("faces".into(), t.faces as f64);
+        for f in 0..t.faces {
+            let marked = t.requested.iter().filter(|p| p.level % t.faces == f).count();
+            c.insert(format!("pages_marked_face_{f}"), marked as f64);
+        }
+    }
+    let unresolved = counts[MAX_LEVELS];
     c.insert("pixels_unresolved".into(), unresolved as f64);
     if !a.fallen_back.is_empty() {
-        let finest = a.fallen_back.iter().map(|p| p.level).min().unwrap_or(0);
+        let finest = a.fallen_back.iter().map(|p| p.level / t.faces).min().unwrap_or(0);
         r.degraded.push(format!(
             "virtual: page pool full ({slots} pages): {} pages fell back to coarser levels (finest level {finest}; {} fallback pages added)",
             a.fallen_back.len(),
@@ -60,7 +72,8 @@ pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
 }
 
 /// The marked pages of each level that has any, as an N x N grid of the level's window,
-/// side by side, each marked page in its level's colour (fallen-back pages dimmed).
+/// side by side, each marked page in its level's colour (a cube: its mip's; fallen-back pages
+/// dimmed).
 fn marked_picture(t: &VirtualShadows) -> NamedImage {
     let n = (t.virtual_res / t.page_res) as usize;
     let levels: Vec<u32> = (0..t.levels).filter(|k| t.requested.iter().any(|p| p.level == *k)).collect();
@@ -76,7 +89,7 @@ fn marked_picture(t: &VirtualShadows) -> NamedImage {
             let o = c.origins[k as usize];
             for p in t.requested.iter().filter(|p| p.level == k) {
                 let (x, y) = ((p.x - o.x) as usize, (p.y - o.y) as usize);
-                let col = LEVEL_COLOURS[k as usize % LEVEL_COLOURS.len()];
+                let col = LEVEL_COLOURS[(k / t.faces) as usize % LEVEL_COLOURS.len()];
                 let dim = if fallen.contains(p) { 3 } else { 1 };
                 let at = ((y + 1) * w + i * (n + 2) + x + 1) * 4;
                 rgba[at..at + 4].copy_from_slice(&[col[0] / dim, col[1] / dim, col[2] / dim, 255]);

@@ -1,6 +1,7 @@
-//! GPU tests of `virtual` on spot lights (one perspective virtual map with a mip chain): against
-//! `rt` on the built-in room's spot, marking against the CPU, the page cache on a still camera,
-//! and determinism.
+//! GPU tests of `virtual` on local lights: spot lights (one perspective virtual map with a mip
+//! chain) and point lights (six, one per cube face), on the built-in room's spot (light 0) and
+//! point light (light 1): against `rt`, marking against the CPU, the page cache on a still
+//! camera, and determinism.
 
 use std::collections::BTreeSet;
 
@@ -29,47 +30,65 @@ fn frame(lab: &Lab, t: &mut VirtualShadows, v: &View) -> Vec<f32> {
     lab.gpu.read_buffer_as(&v.visibility, v.gbuffer.pixels())
 }
 
-/// The room's spot light (light 0).
-fn room() -> (shadowlab_core::scene::Scene, usize) {
+/// The room with its spot light (light 0) and its point light (light 1).
+const LIGHTS: [usize; 2] = [0, 1];
+
+fn room() -> shadowlab_core::scene::Scene {
     let scene = builtin("room").unwrap();
     assert!(matches!(scene.lights[0], Light::Spot { .. }));
-    (scene, 0)
+    assert!(matches!(scene.lights[1], Light::Point { .. }));
+    scene
 }
 
 #[test]
-fn virtual_spot_matches_rt_on_room() {
+fn virtual_local_lights_match_rt_on_room() {
     let Some(gpu) = gpu() else { return };
-    let (scene, light) = room();
+    let scene = room();
     let lab = Lab::new(&gpu, &scene).unwrap();
-    let v = view(&lab, &scene, light, 256);
-    let rt = lab.reference(&v, 1).unwrap();
-    for s in ["virtual:resolution_bias=-1,pool_mib=64", "virtual:resolution_bias=-1,pool_mib=64,pcf=3"] {
-        let run = lab.run(&v, &TechniqueSpec::parse(s).unwrap(), 1).unwrap();
-        let a = agreement(&run.visibility, &rt.visibility, &v.mask);
-        eprintln!("{s}: {a:.3}% agreement, counters {:?}", run.report.counters);
-        assert!(run.report.degraded.is_empty(), "{s}: {:?}", run.report.degraded);
-        assert!(run.report.counters["pages_marked"] > 8.0, "a real page set: {:?}", run.report.counters);
-        if a < 99.0 {
-            panic!("{s} agrees with rt on {a:.3}%; {}", save_images("virtual-spot-room", &v, &run, &rt));
+    for light in LIGHTS {
+        let v = view(&lab, &scene, light, 256);
+        let rt = lab.reference(&v, 1).unwrap();
+        for s in ["virtual:resolution_bias=-1,pool_mib=64", "virtual:resolution_bias=-1,pool_mib=64,pcf=3"] {
+            let run = lab.run(&v, &TechniqueSpec::parse(s).unwrap(), 1).unwrap();
+            let a = agreement(&run.visibility, &rt.visibility, &v.mask);
+            eprintln!("light {light}, {s}: {a:.3}% agreement, counters {:?}", run.report.counters);
+            assert!(run.report.degraded.is_empty(), "{s}: {:?}", run.report.degraded);
+            assert!(run.report.counters["pages_marked"] > 8.0, "a real page set: {:?}", run.report.counters);
+            if light == 1 {
+                let faces = (0..6).filter(|f| run.report.counters[&format!("pages_marked_face_{f}")] > 0.0).count();
+                assert!(faces >= 4, "the room's walls around the point light use most faces: {faces}");
+            }
+            if a < 99.0 {
+                panic!("light {light}, {s} agrees with rt on {a:.3}%; {}", save_images("virtual-local-room", &v, &run, &rt));
+            }
+            assert_eq!(run.stalls, vec!["virtual.readback".to_string()]);
         }
-        assert_eq!(run.stalls, vec!["virtual.readback".to_string()]);
     }
 }
 
 /// The GPU's marks equal `Clipmap::sample_pages` over the read-back G-buffer, as the directional
 /// test (virtual.rs) does: samples whose answer changes under a small nudge may go either way.
 #[test]
-fn spot_marking_equals_the_cpu_computation() {
+fn local_light_marking_equals_the_cpu_computation() {
     let Some(gpu) = gpu() else { return };
-    let (scene, light) = room();
+    let scene = room();
     let lab = Lab::new(&gpu, &scene).unwrap();
-    let v = view(&lab, &scene, light, 192);
+    for light in LIGHTS {
+        local_marking(&lab, &scene, light);
+    }
+}
+
+fn local_marking(lab: &Lab, scene: &shadowlab_core::scene::Scene, light: usize) {
+    let v = view(lab, scene, light, 192);
     // two levels finer than the footprint: a page set large enough to compare
-    let mut t = make(&lab, &v, "virtual:pcf=3,resolution_bias=-2");
-    frame(&lab, &mut t, &v);
+    let mut t = make(lab, &v, "virtual:pcf=3,resolution_bias=-2");
+    frame(lab, &mut t, &v);
     let gpu_set: BTreeSet<PageKey> = t.requested().iter().copied().collect();
     let c = t.clipmap().unwrap().clone();
-    assert!(matches!(c.projection, Projection::Persp { .. }));
+    match light {
+        0 => assert!(matches!(c.projection, Projection::Persp { .. })),
+        _ => assert!(matches!(c.projection, Projection::Cube { .. }) && c.faces() == 6),
+    }
     let pa = pixel_angle(scene.camera.fov_y_deg, v.height);
     let scale = bias_scale(-2.0);
     let reach = 1.0 + 0.5 + 1.0; // pcf 3: half 1, normal offset 0.5, one texel
@@ -96,14 +115,14 @@ fn spot_marking_equals_the_cpu_computation() {
         } else {
             ambiguous += 1;
         }
-        levels.extend(base.iter().map(|k| k.level));
+        levels.extend(base.iter().map(|k| c.mip(k.level)));
         possible.extend(base);
         for x in variants {
             possible.extend(x);
         }
     }
     eprintln!(
-        "{} pages certain, {} possible, {} on the GPU, levels {levels:?}, {ambiguous} ambiguous samples",
+        "light {light}: {} pages certain, {} possible, {} on the GPU, levels {levels:?}, {ambiguous} ambiguous samples",
         certain.len(),
         possible.len(),
         gpu_set.len()
@@ -114,22 +133,31 @@ fn spot_marking_equals_the_cpu_computation() {
     let missing: Vec<_> = certain.difference(&gpu_set).collect();
     let extra: Vec<_> = gpu_set.difference(&possible).collect();
     assert!(missing.is_empty() && extra.is_empty(), "missing {missing:?}, extra {extra:?}");
-    // the coarsest level is one page, the fallback of every sample
-    assert!(gpu_set.contains(&PageKey { level: c.levels - 1, x: 0, y: 0 }));
+    // the coarsest level of each face used is one page, the fallback of its samples
+    for k in &gpu_set {
+        let top = c.level_index(c.face(k.level), c.mips - 1);
+        assert!(gpu_set.contains(&PageKey { level: top, x: 0, y: 0 }), "{k:?}: no top page {top}");
+    }
     assert!(gpu_set.iter().all(|k| k.x >= 0 && k.y >= 0 && k.x < c.side(k.level) && k.y < c.side(k.level)));
 }
 
 #[test]
-fn a_still_camera_renders_no_spot_page_on_its_second_frame() {
+fn a_still_camera_renders_no_local_light_page_on_its_second_frame() {
     let Some(gpu) = gpu() else { return };
-    let (scene, light) = room();
+    let scene = room();
     let lab = Lab::new(&gpu, &scene).unwrap();
-    let v = view(&lab, &scene, light, 128);
-    let mut t = make(&lab, &v, "virtual");
-    let first = frame(&lab, &mut t, &v);
+    for light in LIGHTS {
+        still_camera(&lab, &scene, light);
+    }
+}
+
+fn still_camera(lab: &Lab, scene: &shadowlab_core::scene::Scene, light: usize) {
+    let v = view(lab, scene, light, 128);
+    let mut t = make(lab, &v, "virtual");
+    let first = frame(lab, &mut t, &v);
     let a = t.allocation().clone();
     assert!(!a.render.is_empty() && a.render.len() == t.requested().len() && a.cached == 0);
-    let second = frame(&lab, &mut t, &v);
+    let second = frame(lab, &mut t, &v);
     let b = t.allocation();
     assert!(b.render.is_empty(), "second frame rendered {} pages", b.render.len());
     assert_eq!(b.cached, t.requested().len());
@@ -138,22 +166,25 @@ fn a_still_camera_renders_no_spot_page_on_its_second_frame() {
 }
 
 #[test]
-fn virtual_spot_is_deterministic() {
+fn virtual_local_lights_are_deterministic() {
     let Some(gpu) = gpu() else { return };
-    let (scene, light) = room();
+    let scene = room();
     let lab = Lab::new(&gpu, &scene).unwrap();
-    let v = view(&lab, &scene, light, 128);
-    // also with a pool too small for the view: the fallback is deterministic too
-    for s in ["virtual:pcf=3", "virtual:pool_mib=0.25,resolution_bias=-2"] {
-        let spec = TechniqueSpec::parse(s).unwrap();
-        let runs: Vec<_> = (0..2).map(|_| lab.run(&v, &spec, 1).unwrap()).collect();
-        assert!(runs[0].visibility.iter().zip(&runs[1].visibility).all(|(x, y)| x.to_bits() == y.to_bits()), "{s}");
-        assert_eq!(runs[0].report.counters, runs[1].report.counters, "{s}");
-        if s.contains("pool_mib=0.25") {
-            let c = &runs[0].report.counters;
-            assert_eq!(c["pool_pages"], 4.0);
-            assert!(c["pages_fallen_back"] > 0.0, "{c:?}");
-            assert!(!runs[0].report.degraded.is_empty());
+    for light in LIGHTS {
+        let v = view(&lab, &scene, light, 128);
+        // also with a pool too small for the view: the fallback is deterministic too
+        for s in ["virtual:pcf=3", "virtual:pool_mib=0.25,resolution_bias=-2"] {
+            let spec = TechniqueSpec::parse(s).unwrap();
+            let runs: Vec<_> = (0..2).map(|_| lab.run(&v, &spec, 1).unwrap()).collect();
+            let same = runs[0].visibility.iter().zip(&runs[1].visibility).all(|(x, y)| x.to_bits() == y.to_bits());
+            assert!(same, "light {light}, {s}");
+            assert_eq!(runs[0].report.counters, runs[1].report.counters, "light {light}, {s}");
+            if s.contains("pool_mib=0.25") {
+                let c = &runs[0].report.counters;
+                assert_eq!(c["pool_pages"], 4.0);
+                assert!(c["pages_fallen_back"] > 0.0, "{c:?}");
+                assert!(!runs[0].report.degraded.is_empty());
+            }
         }
     }
 }
