@@ -11,7 +11,7 @@ use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, PageKey};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::{submit_frame, Technique};
-use shadowlab_gpu::techniques::virtual_sm::{VirtualShadows, CHUNK_TRIANGLES};
+use shadowlab_gpu::techniques::virtual_sm::{VirtualShadows, DYNAMIC_CHUNK_TRIANGLES};
 
 mod common;
 use common::*;
@@ -204,7 +204,7 @@ fn pcf_across_page_borders_equals_an_unpaged_map() {
 fn dynamic_chunk_boxes(scene: &shadowlab_core::scene::Scene, t: f32) -> Vec<Bounds> {
     let verts = scene.animated_vertices(t);
     verts
-        .chunks(3 * CHUNK_TRIANGLES as usize)
+        .chunks(3 * DYNAMIC_CHUNK_TRIANGLES as usize)
         .map(|c| {
             let mut b = Bounds::EMPTY;
             for v in c {

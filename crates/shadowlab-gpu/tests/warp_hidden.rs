@@ -93,3 +93,39 @@ fn culling_hidden_edges_draws_fewer_pieces_at_the_same_quality() {
     assert!(wrong(&on) <= wrong(&off) + 0.05, "{:.3} % wrong culled vs {:.3} % all split", wrong(&on), wrong(&off));
     assert!(on.report.degraded.is_empty() && off.report.degraded.is_empty());
 }
+
+/// `edge_importance` on the city under its sun: a view sample on a shadow edge of the occluder
+/// map counts 1 + k, any other 1. So the count map with k = 4 minus the one without is 4 x the
+/// edge samples per texel: divisible by 4, present, a minority of the sampled texels, and only
+/// where the occluder map's 3x3 texels around the texel hold different depths.
+#[test]
+fn edge_importance_counts_shadow_edge_samples_more() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("city").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 128);
+    let spec = "notw:res=100,window=16";
+    let plain = run_direct(&gpu, &lab, &v, spec);
+    let edged = run_direct(&gpu, &lab, &v, &format!("{spec},edge_importance=4"));
+    assert!(plain.read_occluders(&gpu).is_none(), "no occluder pass without cull_hidden or edge_importance");
+    let (depth, _) = edged.read_occluders(&gpu).expect("edge_importance draws the occluder map");
+    let (a, b) = (plain.read_counts_before(&gpu), edged.read_counts_before(&gpu));
+    let res = 100usize;
+    let (mut edge_texels, mut sampled) = (0, 0);
+    for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+        assert!(y >= x && (y - x) % 4 == 0, "texel {i}: {x} -> {y}");
+        sampled += (*x > 0) as usize;
+        if y > x {
+            edge_texels += 1;
+            let (tx, ty) = ((i % res) as i64, (i / res) as i64);
+            let around: Vec<f32> = (-1..=1)
+                .flat_map(|dy| (-1..=1).map(move |dx| ((tx + dx).clamp(0, 99), (ty + dy).clamp(0, 99))))
+                .map(|(x, y)| depth[y as usize * res + x as usize])
+                .collect();
+            let (lo, hi) = around.iter().fold((f32::MAX, f32::MIN), |(l, h), d| (l.min(*d), h.max(*d)));
+            assert!(hi > lo, "texel ({tx}, {ty}) counted as a shadow edge over a flat occluder map");
+        }
+    }
+    eprintln!("{edge_texels} of {sampled} sampled texels hold shadow-edge samples");
+    assert!(edge_texels > 20 && edge_texels * 2 < sampled, "{edge_texels} of {sampled}");
+}

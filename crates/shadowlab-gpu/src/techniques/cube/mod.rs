@@ -122,12 +122,31 @@ pub const DEFAULT_NOTW_MIX: f64 = 1.0;
 /// is steep, so the bias tuned with mode 0 no longer covers the depth slope there.
 pub const DEFAULT_NOTW_BIAS_MODE: f64 = 0.0;
 
+/// cube-notw smooths across functions with tent weights (`window_tent`, warp::WINDOW_TENT),
+/// not the seeds' box. Chosen on the sibenik stress view (4.13 M -> 0.92 M pieces, 0.977 ->
+/// 0.886 % wrong); checked on four views not used to choose it (512x512, default parameters
+/// otherwise; wrong % box -> tent, pieces): room light 1 0.247 -> 0.223, 895 k -> 427 k;
+/// courtyard lantern 0.171 -> 0.161, 4.33 M -> 1.29 M; conference light 1 0.252 -> 0.240,
+/// 2.32 M -> 1.00 M; eaves light 0 0.334 -> 0.312, 8.61 M -> 5.98 M (BENCHMARKS.md, issue 18).
+pub const DEFAULT_NOTW_WINDOW_TENT: f64 = 1.0;
+
+/// cube-notw's shadow-edge importance (`edge_importance`, warp::EDGE_IMPORTANCE): a view
+/// sample on a shadow edge of the unwarped occluder map counts 9 instead of 1, so the faces'
+/// warps give edges more texels. Chosen on room light 1 and the sibenik stress view (512x512,
+/// wrong % for k = 0 / 2 / 4 / 8 / 16 / 32 / 64: room 0.223 / 0.193 / 0.176 / 0.163 / 0.146 /
+/// 0.150 / 0.155; sibenik 0.886 / 0.834 / 0.817 / 0.781 / 0.793 / - / -; pieces grow with k,
+/// sibenik 1.92 M at 0 to 2.79 M at 8 and 3.49 M at 16, so 8 rather than 16). Checked on three
+/// views not used to choose it, k = 0 -> 8: conference light 1 0.240 -> 0.181, courtyard lantern
+/// 0.161 -> 0.138, eaves light 0 0.312 -> 0.179 (eaves then fills the piece capacity on two
+/// faces: flagged degraded, deterministic) (BENCHMARKS.md, issue 18).
+pub const DEFAULT_NOTW_EDGE_IMPORTANCE: f64 = 8.0;
+
 const THREE_SETUPS: &str =
     "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md, point_quality.md)";
 
 /// notw's parameters (same keys, order, ranges and docs), with the window, blur, mix, subdivision,
-/// normal offset and bias footprint defaults measured for cube faces (tests/cube.rs checks the
-/// keys against notw's).
+/// normal offset, bias footprint, smoothing tent and edge importance defaults measured for cube
+/// faces (tests/cube.rs checks the keys against notw's).
 pub const NOTW_PARAMS: &[ParamDef] = &[
     w::RES,
     w::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"),
@@ -152,7 +171,14 @@ pub const NOTW_PARAMS: &[ParamDef] = &[
     w::DEPTH_CLAMP,
     w::EXACT_INVERSE,
     w::CULL_HIDDEN,
-    w::WINDOW_TENT,
+    w::WINDOW_TENT.with_default(
+        DEFAULT_NOTW_WINDOW_TENT,
+        "shadowlab: chosen on sibenik, checked on room, courtyard lantern, conference and eaves point lights (BENCHMARKS.md, issue 18)",
+    ),
+    w::EDGE_IMPORTANCE.with_default(
+        DEFAULT_NOTW_EDGE_IMPORTANCE,
+        "shadowlab: chosen on room and sibenik, checked on conference, courtyard lantern and eaves point lights (BENCHMARKS.md, issue 18)",
+    ),
 ];
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {

@@ -20,6 +20,11 @@ use crate::{binding, raster, Gpu, GpuError};
 /// rectangle overlaps it. Smaller: tighter culling, more draws per page.
 pub const CHUNK_TRIANGLES: u32 = 1024;
 
+/// Triangles per chunk of moving geometry: its swept boxes invalidate the pages under them
+/// every frame, so they are kept small (a long swaying cable in 1024-triangle chunks is one
+/// box over its whole length). Smaller: tighter invalidation, more boxes read back per frame.
+pub const DYNAMIC_CHUNK_TRIANGLES: u32 = 64;
+
 pub struct VirtualShadows {
     pub(super) light: Light,
     /// The `levels` parameter (the clipmap's levels, or a perspective map's mips at most).
@@ -131,11 +136,11 @@ impl VirtualShadows {
         }
         let dynamic_chunk0 = chunks.len();
         let dynamic = (split < scene.triangle_count)
-            .then(|| ChunkBounds::new(gpu, scene, "virtual.dynamic_bounds", split, scene.triangle_count, CHUNK_TRIANGLES));
+            .then(|| ChunkBounds::new(gpu, scene, "virtual.dynamic_bounds", split, scene.triangle_count, DYNAMIC_CHUNK_TRIANGLES));
         if let Some(b) = &dynamic {
             for i in 0..b.count {
-                let first = split + i * CHUNK_TRIANGLES;
-                chunks.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(scene.triangle_count), &scene.bounds, &proto));
+                let first = split + i * DYNAMIC_CHUNK_TRIANGLES;
+                chunks.push(Chunk::new(first, (first + DYNAMIC_CHUNK_TRIANGLES).min(scene.triangle_count), &scene.bounds, &proto));
             }
         }
         let probe = gpu.storage("virtual.probe", table_len * 4 + dynamic.as_ref().map_or(0, |b| b.count as u64 * 24));

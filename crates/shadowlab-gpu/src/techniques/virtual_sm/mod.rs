@@ -23,7 +23,7 @@ mod params;
 mod report;
 
 use bytemuck::{Pod, Zeroable};
-pub use gpu::{VirtualShadows, CHUNK_TRIANGLES};
+pub use gpu::{VirtualShadows, CHUNK_TRIANGLES, DYNAMIC_CHUNK_TRIANGLES};
 pub use params::*;
 
 use crate::shaders::compose_depth;

@@ -15,6 +15,8 @@
 @group(0) @binding(9) var<storage, read_write> fwork: array<f32>;
 @group(0) @binding(10) var warp_x_out: texture_storage_2d<r32float, write>;
 @group(0) @binding(11) var warp_y_out: texture_storage_2d<r32float, write>;
+// the occluder map's pyramid (level 0 first: the unwarped DV-cropped depth), `edge_importance`
+@group(0) @binding(12) var<storage, read> occ: array<f32>;
 
 var<workgroup> wg_bounds: array<atomic<u32>, 6>;
 
@@ -70,7 +72,46 @@ fn inside(u: vec2<f32>) -> bool {
     return all(u >= vec2<f32>(0.0)) && all(u < vec2<f32>(1.0));
 }
 
-// Count map (NoTW importance) by atomic adds; RTW: importance map, maximum per texel.
+// Whether occluder depth o is clearly nearer the light than depth z: by 2 % of the distance
+// (perspective: 1 - depth grows about as 1 / distance) or 0.5 % of the depth range.
+fn clearly_nearer(o: f32, z: f32) -> bool {
+    if wp.perspective > 0.5 {
+        return 1.0 - o > (1.0 - z) * 1.02;
+    }
+    return o < z - 0.005;
+}
+
+// Whether the sample at DV texel t (depth z) lies on a shadow edge of the occluder map: among
+// its 3x3 texels, one clearly nearer (an occluder) and one not (its own surface, or lit).
+fn on_shadow_edge(tx: u32, ty: u32, z: f32) -> bool {
+    let w = res_u();
+    var near = false;
+    var open = false;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let x = u32(clamp(i32(tx) + dx, 0, i32(w) - 1));
+            let y = u32(clamp(i32(ty) + dy, 0, i32(w) - 1));
+            if clearly_nearer(occ[y * w + x], z) {
+                near = true;
+            } else {
+                open = true;
+            }
+        }
+    }
+    return near && open;
+}
+
+// A sample's count at DV coordinates u: 1, or 1 + edge_importance on a shadow edge.
+fn sample_weight(p: vec3<f32>, u: vec2<f32>) -> u32 {
+    let w = res_u();
+    if wp.edge_importance > 0u && on_shadow_edge(texel_of(u.x, w), texel_of(u.y, w), clip_to_map(base_clip(wp, p)).z) {
+        return 1u + wp.edge_importance;
+    }
+    return 1u;
+}
+
+// Count map (NoTW importance) by atomic adds (a shadow-edge sample counts 1 + edge_importance);
+// RTW: importance map, maximum per texel.
 @compute @workgroup_size(8, 8)
 fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     var s: Sample;
@@ -83,7 +124,7 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let w = res_u();
     let t = texel_of(u.y, w) * w + texel_of(u.x, w);
-    atomicAdd(&work[t], 1u);
+    atomicAdd(&work[t], sample_weight(s.p, u));
     if wp.rtw_importance != 0u {
         let maxd = bitcast<f32>(atomicLoad(&dv[4]));
         let d = distance(s.p, frame.camera_pos.xyz);
@@ -267,7 +308,7 @@ fn row_offset(i: u32, x: f32) -> f32 {
     return edge_lerp(left, fwork[row + k], sx, k);
 }
 
-// The count map rebuilt through the smoothed row warps (step 6).
+// The count map rebuilt through the smoothed row warps (step 6), each sample with its count.
 @compute @workgroup_size(8, 8)
 fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
     var s: Sample;
@@ -283,7 +324,7 @@ fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
     let a = neighbours(u.y, w, wp.interp != 0u);
     let xw = u.x + mix(row_offset(u32(a.x), u.x), row_offset(u32(a.y), u.x), a.z);
     if xw >= 0.0 && xw < 1.0 {
-        atomicAdd(&work[w * w + i * w + texel_of(xw, w)], 1u);
+        atomicAdd(&work[w * w + i * w + texel_of(xw, w)], sample_weight(s.p, u));
     }
 }
 

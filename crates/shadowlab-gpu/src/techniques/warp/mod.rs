@@ -194,6 +194,11 @@ pub struct WarpParams {
     pub cull_hidden: f32,
     /// 1 = tent-weighted smoothing across functions (`window_tent`)
     pub tent: f32,
+    /// Extra count of a view sample on a shadow edge of the occluder map (`edge_importance`)
+    pub edge_importance: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -227,7 +232,8 @@ pub struct Warped {
     analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
     lookup_layout: wgpu::BindGroupLayout,
     depth_pipeline: wgpu::RenderPipeline,
-    /// `cull_hidden`: the occluder pass and its pyramid; else none (a one-word stand-in is bound).
+    /// `cull_hidden`, `edge_importance`: the occluder pass and its pyramid; else none (a
+    /// stand-in is bound).
     occluders: Option<occluders::Occluders>,
     split_layout: wgpu::BindGroupLayout,
     /// split_root, split_args, split_level, draw_args.
@@ -407,6 +413,10 @@ impl Warped {
             exact_inverse: if k.exact_inverse { 1.0 } else { 0.0 },
             cull_hidden: if k.cull_hidden { 1.0 } else { 0.0 },
             tent: if k.tent { 1.0 } else { 0.0 },
+            edge_importance: k.edge_importance,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         let d = &gpu.device;
         let n = res as u64 * res as u64;
@@ -449,7 +459,7 @@ impl Warped {
             format: wgpu::TextureFormat::R32Float,
             view_dimension: wgpu::TextureViewDimension::D2,
         };
-        let analyze_layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store]);
+        let analyze_layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store, ro]);
         let src = analyze_src();
         let entries: &[&str] = match variant {
             Variant::Notw => {
@@ -468,7 +478,7 @@ impl Warped {
             layout_at(gpu, &format!("{name}.depth"), wgpu::ShaderStages::VERTEX_FRAGMENT, &[look[0], look[1], look[2], look[3], (10, ro)]);
         let depth_pipeline =
             raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &depth_src(k.exact_depth), &[&lookup_layout, &scene.layout], &[]);
-        let occluders = k.cull_hidden.then(|| occluders::Occluders::new(gpu, name, res, &lookup_layout, scene));
+        let occluders = (k.cull_hidden || k.edge_importance > 0).then(|| occluders::Occluders::new(gpu, name, res, &lookup_layout, scene));
         let split_layout = layout_at(
             gpu,
             &format!("{name}.subdivide"),

@@ -237,14 +237,39 @@ pub const CULL_HIDDEN: ParamDef = ParamDef::flag(
 /// gradually. With the box, sparse samples (far fewer than texels: a cube face few view samples
 /// fall on) leave steps between neighbouring functions, edges crossing them bend by the step
 /// however short they are, and subdivision splits them to its last level. See BENCHMARKS.md
-/// (bounded cost, issue 18). Off: the seeds' box. Opt-in: measured on the sibenik stress view
-/// only (cube-notw 4.13 M -> 0.92 M pieces, 0.977 -> 0.886 % wrong), not yet on held-out views.
+/// (bounded cost, issue 18). Off here (`notw`, `dpsm-notw`): the seeds' box; `cube-notw` turns
+/// it on (cube::DEFAULT_NOTW_WINDOW_TENT: better and 1.3-3.4x fewer pieces on all five point
+/// views). Held-out views at 512x512, wrong % box -> tent: `notw` warp-courtyard 0.785 -> 0.950,
+/// warp-sponza 1.266 -> 1.262, warp-conference 0.559 -> 0.526, city 1.089 -> 0.961, eaves sun
+/// 1.174 -> 1.232 (mixed: kept off); `dpsm-notw` room 0.376 -> 0.355, lantern 0.302 -> 0.275,
+/// conference 0.474 -> 0.501, eaves 0.654 -> 0.598 (three of four: kept off).
 pub const DEFAULT_WINDOW_TENT: f64 = 0.0;
 pub const WINDOW_TENT: ParamDef = ParamDef::flag(
     "window_tent",
     DEFAULT_WINDOW_TENT != 0.0,
     "smooth across functions with tent weights (window/2 + 1 - distance) x samples instead of the seeds' box: no steps between neighbouring functions where a function with many samples enters the window",
     "seed 000 section 3.1 (the box); tent: shadowlab (bounded cost, issue 18; BENCHMARKS.md)",
+);
+
+/// Importance that follows shadow edges: a view sample whose 3x3 texels of the unwarped
+/// occluder map (`cull_hidden`'s pass, drawn before the count map when this is on) hold both an
+/// occluder clearly nearer than the sample and none (its own surface) lies on a shadow edge,
+/// and counts `1 + edge_importance` in the count map instead of 1, so the warp gives edges
+/// more texels (RTW's edge term, after Rosen 2012, on NoTW's count map). Planar maps (`notw`,
+/// `cube-notw`'s faces). 0 here: the seeds' count of samples only; `cube-notw` uses 8
+/// (cube::DEFAULT_NOTW_EDGE_IMPORTANCE: 0.57-0.86x its wrong pixels on five point views). Under
+/// a sun it is worse (512x512, k = 0 / 8 / 16: city 1.089 / 1.973 / 2.348, warp-courtyard
+/// 0.785 / 2.056 / 4.915): the orthographic test's fixed gap (0.5 % of the depth range) flags
+/// ground seen at a low sun, whose depth steps more than that per texel, as edges everywhere;
+/// a gap from the receiver's slope is the next step.
+pub const DEFAULT_EDGE_IMPORTANCE: f64 = 0.0;
+pub const EDGE_IMPORTANCE: ParamDef = ParamDef::integer(
+    "edge_importance",
+    DEFAULT_EDGE_IMPORTANCE,
+    0.0,
+    256.0,
+    "extra count of a view sample on a shadow edge of the unwarped occluder map (0 = samples only): more texels for shadow edges",
+    "shadowlab (point-light importance, issue 18); edge term: Rosen 2012 (RTW)",
 );
 
 /// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
@@ -283,8 +308,10 @@ const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A]
 
 /// notw's own list: `NOTW_PARAMS` plus the warp strength, the bias footprint parameters, the
 /// exact depth's clamp and inversion, hidden-edge culling and the smoothing's tent.
-pub const NOTW_OWN_PARAMS: &[ParamDef] =
-    &concat::<17, 7, 24>(NOTW_SHARED, [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE, CULL_HIDDEN, WINDOW_TENT]);
+pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<17, 8, 25>(
+    NOTW_SHARED,
+    [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE, CULL_HIDDEN, WINDOW_TENT, EDGE_IMPORTANCE],
+);
 
 /// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
 /// run with; the gradient footprint (2) was measured for `notw` only.
@@ -349,6 +376,8 @@ pub(super) struct Knobs {
     pub cull_hidden: bool,
     /// Tent-weighted smoothing across functions (`window_tent`, NoTW).
     pub tent: bool,
+    /// Extra count of a shadow-edge sample (`edge_importance`; planar NoTW only).
+    pub edge_importance: u32,
 }
 
 impl Knobs {
@@ -377,6 +406,7 @@ impl Knobs {
             exact_inverse: notw && p.get_bool("exact_inverse"),
             cull_hidden: notw && !paraboloid && subdiv > 0.0 && p.get_bool("cull_hidden"),
             tent: notw && p.get_bool("window_tent"),
+            edge_importance: if notw && !paraboloid { p.get_u32("edge_importance") } else { 0 },
         }
     }
 }

@@ -66,6 +66,11 @@ struct WarpParams {
     cull_hidden: f32,
     // 1: the smoothing across functions weighs them with a tent (analyze.wgsl smooth_block)
     tent: f32,
+    // extra count of a view sample on a shadow edge of the occluder map (analyze.wgsl count)
+    edge_importance: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // Fixed-point scale of DV coordinates for the atomic min/max.

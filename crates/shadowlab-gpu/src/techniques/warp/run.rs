@@ -37,6 +37,25 @@ impl Warped {
         &self.analyze.iter().find(|(e, _)| *e == entry).expect("entry point created for this variant").1
     }
 
+    /// The depth pass's bindings: the lookup resources and the pieces (binding 10).
+    fn depth_entries<'a>(&'a self, xv: &'a wgpu::TextureView, yv: &'a wgpu::TextureView) -> Vec<wgpu::BindGroupEntry<'a>> {
+        let pieces = if self.params.subdiv > 0.0 { &self.pieces } else { &self.counters };
+        let look = self.lookup_resources(xv, yv);
+        let mut entries: Vec<wgpu::BindGroupEntry> =
+            look.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: 6 + i as u32, resource: r.clone() }).collect();
+        entries.push(wgpu::BindGroupEntry { binding: 10, resource: pieces.as_entire_binding() });
+        entries
+    }
+
+    fn depth_group(&self, gpu: &Gpu, xv: &wgpu::TextureView, yv: &wgpu::TextureView) -> wgpu::BindGroup {
+        let entries = self.depth_entries(xv, yv);
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.name()),
+            layout: &self.lookup_layout,
+            entries: &entries,
+        })
+    }
+
     fn lookup_resources<'a>(&'a self, xv: &'a wgpu::TextureView, yv: &'a wgpu::TextureView) -> [wgpu::BindingResource<'a>; 4] {
         [
             self.uniform.as_entire_binding(),
@@ -125,6 +144,8 @@ impl Technique for Warped {
                 self.fwork.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&xv),
                 wgpu::BindingResource::TextureView(&yv),
+                // the occluder pyramid (`edge_importance`), or a stand-in never read
+                self.occluders.as_ref().map_or(&self.counts, |o| &o.hzb).as_entire_binding(),
             ],
         );
         rec.write_buffer(&self.dv, 0, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
@@ -133,6 +154,12 @@ impl Technique for Warped {
         });
         if self.variant == Variant::Dv {
             return Ok(());
+        }
+        // `edge_importance`: the occluder map of this frame's DV crop before the count map
+        // (render then reuses it for `cull_hidden`)
+        if let (Some(o), true) = (&self.occluders, self.params.edge_importance > 0) {
+            let depth_group = self.depth_group(gpu, &xv, &yv);
+            rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, &depth_group, f.scene));
         }
         let res = self.res;
         let n = res * res;
@@ -175,11 +202,7 @@ impl Technique for Warped {
         let name = self.name();
         let (xv, yv) = (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()));
         let subdiv = self.params.subdiv > 0.0;
-        let pieces = if subdiv { &self.pieces } else { &self.counters };
-        let look = self.lookup_resources(&xv, &yv);
-        let mut entries: Vec<wgpu::BindGroupEntry> =
-            look.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: 6 + i as u32, resource: r.clone() }).collect();
-        entries.push(wgpu::BindGroupEntry { binding: 10, resource: pieces.as_entire_binding() });
+        let mut entries = self.depth_entries(&xv, &yv);
         let depth_group =
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.lookup_layout, entries: &entries });
         if subdiv {
@@ -198,7 +221,7 @@ impl Technique for Warped {
                     gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &e })
                 })
                 .collect();
-            if let Some(o) = &self.occluders {
+            if let (Some(o), true) = (&self.occluders, self.params.edge_importance == 0) {
                 rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, &depth_group, f.scene));
             }
             let tris = self.params.triangles;
@@ -277,7 +300,7 @@ impl Technique for Warped {
             c.insert("subdiv_queue_full_finishes".into(), a[2] as f64);
             c.insert("subdiv_cut_level".into(), a[19] as f64);
             c.insert("subdiv_pieces_unsplit".into(), a[20] as f64);
-            if self.occluders.is_some() {
+            if self.params.cull_hidden > 0.5 {
                 c.insert("subdiv_hidden_edge_tests".into(), a[21] as f64);
             }
             if a[19] > 0 {
