@@ -4,6 +4,7 @@
 use glam::{IVec2, Vec2, Vec3};
 
 use super::*;
+use crate::techniques::cube::{face_of, FACES};
 
 fn room() -> Bounds {
     Bounds { min: Vec3::new(-10.0, 0.0, -10.0), max: Vec3::new(10.0, 5.0, 10.0) }
@@ -35,7 +36,8 @@ fn six_faces_of_mip_chains_make_one_list_of_levels() {
 #[test]
 fn each_direction_lands_on_its_major_axis_face_inside_the_map() {
     let (c, at) = point();
-    for (f, d) in CUBE_DIRS.iter().enumerate() {
+    for (f, face) in FACES.iter().enumerate() {
+        let d = &face.n;
         let p = at + *d * 2.0;
         assert_eq!(c.face_of(p), f as u32);
         let (_, _, dir) = c.axes(f as u32);
@@ -43,8 +45,8 @@ fn each_direction_lands_on_its_major_axis_face_inside_the_map() {
         assert!((c.light_coords(p) - Vec2::ONE).abs().max_element() < 1e-6, "face {f}: the axis is the centre");
     }
     // ties go to the lower axis; every direction's coordinates on its face lie in [0, 2]
-    assert_eq!(cube_face(Vec3::new(1.0, 1.0, 1.0)), 0);
-    assert_eq!(cube_face(Vec3::new(0.0, -1.0, 1.0)), 3);
+    assert_eq!(face_of(Vec3::new(1.0, 1.0, 1.0)), 0);
+    assert_eq!(face_of(Vec3::new(0.0, -1.0, 1.0)), 3);
     let mut seen = [0; 6];
     for i in 0..2000 {
         let t = i as f32 * 0.618;

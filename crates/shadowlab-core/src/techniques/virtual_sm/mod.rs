@@ -19,7 +19,6 @@ mod alloc;
 mod cube;
 mod spot;
 pub use alloc::{with_fallbacks, Allocation, PageCache, PageKey};
-pub use cube::{cube_face, CUBE_DIRS};
 pub use spot::{spot_levels, Projection};
 
 use glam::{IVec2, Mat4, Vec2, Vec3, Vec4};

@@ -30,7 +30,8 @@ use crate::techniques::sm::BIAS_WGSL;
 use crate::{binding, raster, Gpu, GpuError};
 use shadowlab_core::params::family::{BIAS, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
 
-const FACES_WGSL: &str = include_str!("faces.wgsl");
+/// The face rules (`shadowlab_core::techniques::cube`), also composed into `virtual`'s shaders.
+pub(crate) const FACES_WGSL: &str = include_str!("faces.wgsl");
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 const SPLIT_WGSL: &str = include_str!("split.wgsl");
@@ -123,8 +124,8 @@ pub const DEFAULT_NOTW_MIX: f64 = 1.0;
 pub const DEFAULT_NOTW_BIAS_MODE: f64 = 0.0;
 
 /// cube-notw smooths across functions with tent weights (`window_tent`, warp::WINDOW_TENT),
-/// not the seeds' box. Chosen on the sibenik stress view (4.13 M -> 0.92 M pieces, 0.977 ->
-/// 0.886 % wrong); checked on four views not used to choose it (512x512, default parameters
+/// not the seeds' box. Chosen on the sibenik stress view (0.977 -> 0.886 % wrong; 1.92 M pieces
+/// with the tent in a later run, against 4.13 M recorded for the box); checked on four views not used to choose it (512x512, default parameters
 /// otherwise; wrong % box -> tent, pieces): room light 1 0.247 -> 0.223, 895 k -> 427 k;
 /// courtyard lantern 0.171 -> 0.161, 4.33 M -> 1.29 M; conference light 1 0.252 -> 0.240,
 /// 2.32 M -> 1.00 M; eaves light 0 0.334 -> 0.312, 8.61 M -> 5.98 M (BENCHMARKS.md, issue 18).

@@ -28,6 +28,7 @@ pub use params::*;
 
 use crate::shaders::compose_depth;
 use crate::technique::{compose_view, TechniqueInfo};
+use crate::techniques::cube::FACES_WGSL;
 
 const PAGES_WGSL: &str = include_str!("pages.wgsl");
 const MARK_WGSL: &str = include_str!("mark.wgsl");
@@ -42,11 +43,11 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 }
 
 fn mark_source() -> String {
-    compose_view(&format!("{PAGES_WGSL}{MARK_WGSL}"), false)
+    compose_view(&format!("{FACES_WGSL}{PAGES_WGSL}{MARK_WGSL}"), false)
 }
 
 fn eval_source() -> String {
-    compose_view(&format!("{PAGES_WGSL}{}{EVAL_WGSL}", crate::techniques::sm::BIAS_WGSL), false)
+    compose_view(&format!("{FACES_WGSL}{PAGES_WGSL}{}{EVAL_WGSL}", crate::techniques::sm::BIAS_WGSL), false)
 }
 
 fn page_source() -> String {

@@ -53,20 +53,12 @@ fn face_of_level(k: u32) -> u32 {
     return k % faces();
 }
 
-// The face whose map holds p: its major axis from the light, ties to x then y (cube_face).
+// The face whose map holds p: `cube`'s face of its direction from the light (faces.wgsl).
 fn face_of(p: vec3<f32>) -> u32 {
     if !is_cube() {
         return 0u;
     }
-    let v = p - vp.spot.xyz;
-    let a = abs(v);
-    if a.x >= a.y && a.x >= a.z {
-        return select(1u, 0u, v.x >= 0.0);
-    }
-    if a.y >= a.z {
-        return select(3u, 2u, v.y >= 0.0);
-    }
-    return select(5u, 4u, v.z >= 0.0);
+    return cube_face(p - vp.spot.xyz);
 }
 
 // Right, up and travel direction of face f (Clipmap::axes).

@@ -238,8 +238,8 @@ pub const CULL_HIDDEN: ParamDef = ParamDef::flag(
 /// fall on) leave steps between neighbouring functions, edges crossing them bend by the step
 /// however short they are, and subdivision splits them to its last level. See BENCHMARKS.md
 /// (bounded cost, issue 18). Off here (`notw`, `dpsm-notw`): the seeds' box; `cube-notw` turns
-/// it on (cube::DEFAULT_NOTW_WINDOW_TENT: better and 1.3-3.4x fewer pieces on all five point
-/// views). Held-out views at 512x512, wrong % box -> tent: `notw` warp-courtyard 0.785 -> 0.950,
+/// it on (cube::DEFAULT_NOTW_WINDOW_TENT: better and 1.4-3.4x fewer pieces on the four held-out
+/// point views at 512x512). Held-out views at 512x512, wrong % box -> tent: `notw` warp-courtyard 0.785 -> 0.950,
 /// warp-sponza 1.266 -> 1.262, warp-conference 0.559 -> 0.526, city 1.089 -> 0.961, eaves sun
 /// 1.174 -> 1.232 (mixed: kept off); `dpsm-notw` room 0.376 -> 0.355, lantern 0.302 -> 0.275,
 /// conference 0.474 -> 0.501, eaves 0.654 -> 0.598 (three of four: kept off).
