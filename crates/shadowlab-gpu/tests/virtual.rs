@@ -7,7 +7,7 @@ use glam::Vec3;
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::Bounds;
-use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, PageKey};
+use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, Build, PageKey};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::{submit_frame, Technique};
@@ -228,6 +228,7 @@ fn moving_objects_invalidate_exactly_their_pages() {
     let v0 = lab.view(&scene.camera, &scene.camera, &light, 128, 128).unwrap();
     let mut t = make(&lab, &v0, "virtual:pool_mib=64");
     let mut cached_after_first = 0;
+    let mut from_copy = 0;
     for f in 0..5 {
         let (time, prev) = (f as f32 * 2.0, (f as f32 - 1.0).max(0.0) * 2.0);
         lab.set_time(time, prev).unwrap();
@@ -257,12 +258,21 @@ fn moving_objects_invalidate_exactly_their_pages() {
         if f > 0 {
             cached_after_first += t.allocation().cached;
         }
+        // pages under the moving objects keep a static copy and are rebuilt from it
+        from_copy += t.builds().iter().filter(|b| matches!(b, Build::Copy(_))).count();
     }
     assert!(cached_after_first > 0, "pages stayed cached while objects moved");
+    assert!(from_copy > 0, "invalidated pages were rebuilt from their static copies");
     // and the result is the fresh one: a new instance at the last time agrees bit for bit
     let v = lab.view(&scene.camera, &scene.camera, &light, 128, 128).unwrap();
     let live = frame(&lab, &mut t, &v);
     let mut fresh = make(&lab, &v, "virtual:pool_mib=64");
     let new = frame(&lab, &mut fresh, &v);
     assert!(live.iter().zip(&new).all(|(a, b)| a.to_bits() == b.to_bits()), "cached pages equal freshly rendered ones");
+    // and a page rebuilt from its static copy equals one drawn whole
+    let mut whole = make(&lab, &v, "virtual:pool_mib=64,static_share=0");
+    let w = frame(&lab, &mut whole, &v);
+    assert_eq!(whole.statics().slots(), 0);
+    assert!(whole.builds().iter().all(|b| *b == Build::Full));
+    assert!(live.iter().zip(&w).all(|(a, b)| a.to_bits() == b.to_bits()), "pages from static copies equal pages drawn whole");
 }

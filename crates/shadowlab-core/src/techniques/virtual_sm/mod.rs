@@ -18,8 +18,10 @@
 mod alloc;
 mod cube;
 mod spot;
+mod statics;
 pub use alloc::{with_fallbacks, Allocation, PageCache, PageKey};
 pub use spot::{spot_levels, Projection};
+pub use statics::{Build, StaticCopies};
 
 use glam::{IVec2, Mat4, Vec2, Vec3, Vec4};
 

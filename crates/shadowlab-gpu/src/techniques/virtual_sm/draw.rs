@@ -1,11 +1,12 @@
 //! Page drawing helpers of `virtual`: the culling chunks (triangle ranges with their
-//! light-coordinate rectangles), the chunks a page draws, and the slot-clear pipeline.
+//! light-coordinate rectangles), the chunks a page draws, the slot-clear pipeline and the
+//! static/dynamic split's copy pipeline.
 
 use glam::Vec2;
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::virtual_sm::{Clipmap, PageKey};
 
-use crate::{raster, Gpu};
+use crate::{binding, raster, Gpu};
 
 /// A chunk: triangle range and its rectangle in level-0 light coordinates per face
 /// (`Clipmap::light_rect`; unbounded where it spans the whole map; one face unless a cube).
@@ -68,4 +69,41 @@ pub(super) fn clear_pipeline(gpu: &Gpu, source: &str, layouts: &[&wgpu::BindGrou
         multiview_mask: None,
         cache: None,
     })
+}
+
+/// Whether a moving chunk (`chunks[moving0..]`) lies over page `k` now.
+pub(super) fn moving_over(chunks: &[Chunk], moving0: usize, c: &Clipmap, k: &PageKey) -> bool {
+    !page_draws(&chunks[moving0..], c, k).is_empty()
+}
+
+/// The static/dynamic split's copy (copy.wgsl): its bind group layout (the static pool, the
+/// per-page offsets) and pipeline (depth test Always, `frag_depth` from the static copy).
+pub(super) fn copy_pipeline(gpu: &Gpu) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
+    let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    let layout = binding::layout(&gpu.device, "virtual.copy", stages, &[binding::texture_depth(), binding::storage(true)]);
+    let module = gpu.shader("virtual.copy", super::COPY_WGSL);
+    let pl = gpu.pipeline_layout("virtual.copy", &[&layout]);
+    let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("virtual.copy"),
+        layout: Some(&pl),
+        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_copy"), compilation_options: Default::default(), buffers: &[] },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: raster::DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_copy"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    (layout, pipeline)
 }

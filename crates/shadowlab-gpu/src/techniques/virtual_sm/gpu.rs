@@ -5,11 +5,11 @@ use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::virtual_sm::{
-    bias_scale, pixel_angle, with_fallbacks, Allocation, Clipmap, PageCache, PageKey, Projection,
+    bias_scale, pixel_angle, with_fallbacks, Allocation, Build, Clipmap, PageCache, PageKey, Projection, StaticCopies,
 };
 
 use super::bounds::ChunkBounds;
-use super::draw::{clear_pipeline, page_draws, Chunk};
+use super::draw::{clear_pipeline, copy_pipeline, moving_over, Chunk};
 use super::{eval_source, mark_source, page_source, VirtualParams, MAX_LEVELS};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -49,13 +49,25 @@ pub struct VirtualShadows {
     pub(super) rendered_total: u64,
     pub(super) cols: u32,
     pub(super) rows: u32,
-    chunks: Vec<Chunk>,
+    /// The static copies (UE5's static/dynamic split) and how each rendered page of the last
+    /// frame was built (`alloc.render`'s order).
+    pub(super) statics: StaticCopies,
+    pub(super) builds: Vec<Build>,
+    pub(super) static_cols: u32,
+    pub(super) static_atlas: wgpu::Texture,
+    /// Per rendered page: its static slot's origin minus its atlas slot's origin (texels).
+    pub(super) copy_offsets: wgpu::Buffer,
+    pub(super) copy_group: wgpu::BindGroup,
+    pub(super) copy_pipeline: wgpu::RenderPipeline,
+    /// Triangles the last frame drew into pages (static pool and atlas).
+    pub(super) triangles_drawn: u64,
+    pub(super) chunks: Vec<Chunk>,
     /// The chunks of moving triangles (`dynamic_first..`), bounded every frame; the last
     /// frame's boxes (None before the first).
     dynamic: Option<ChunkBounds>,
     dynamic_boxes: Option<Vec<Bounds>>,
     /// Index of the first dynamic chunk in `chunks`.
-    dynamic_chunk0: usize,
+    pub(super) dynamic_chunk0: usize,
     pub(super) invalidated: usize,
     /// Fallback pages (one level coarser) the last frame added for pages a full pool left out.
     pub(super) fallback_added: usize,
@@ -71,9 +83,9 @@ pub struct VirtualShadows {
     mark: wgpu::ComputePipeline,
     eval_layout: wgpu::BindGroupLayout,
     eval: EvalPipelines,
-    page_group: wgpu::BindGroup,
-    page_pipeline: wgpu::RenderPipeline,
-    clear_pipeline: wgpu::RenderPipeline,
+    pub(super) page_group: wgpu::BindGroup,
+    pub(super) page_pipeline: wgpu::RenderPipeline,
+    pub(super) clear_pipeline: wgpu::RenderPipeline,
 }
 
 impl VirtualShadows {
@@ -90,15 +102,37 @@ impl VirtualShadows {
         let levels_param = levels;
         let levels = proto.levels;
         let max = gpu.limits.max_texture_dimension_2d;
-        let slots = (p.get("pool_mib") * 1048576.0 / (page_res as f64 * page_res as f64 * 4.0)).floor() as u32;
-        // near-square atlas: a power-of-two column count around sqrt(slots), full rows only
-        let cols = ((slots as f64).sqrt().ceil() as u32).next_power_of_two().min(max / page_res).max(1);
-        let rows = (slots / cols).min(max / page_res);
+        let page_bytes = page_res as f64 * page_res as f64 * 4.0;
+        let pool_mib = p.get("pool_mib");
+        let static_mib = pool_mib * p.get("static_share");
+        // the static copies come out of the pool, and only where something moves
+        let moving = scene.dynamic_first < scene.triangle_count;
+        let static_slots = if moving { atlas_shape((static_mib * 1048576.0 / page_bytes).floor() as u32, page_res, max) } else { (1, 0) };
+        let slots = ((pool_mib * 1048576.0 - (static_slots.0 * static_slots.1) as f64 * page_bytes) / page_bytes).floor() as u32;
+        let (cols, rows) = atlas_shape(slots, page_res, max);
         if rows == 0 {
-            return Err(GpuError::Invalid(format!("virtual: pool_mib {} holds no page of {page_res}^2", p.get("pool_mib"))));
+            return Err(GpuError::Invalid(format!("virtual: pool_mib {pool_mib} holds no page of {page_res}^2 besides its static copies")));
         }
         let d = &gpu.device;
         let atlas = raster::depth_target(gpu, "virtual.atlas", cols * page_res, rows * page_res, 1, wgpu::TextureUsages::empty());
+        let (static_cols, static_rows) = static_slots;
+        let static_atlas = raster::depth_target(
+            gpu,
+            "virtual.static_atlas",
+            static_cols * page_res,
+            static_rows.max(1) * page_res,
+            1,
+            wgpu::TextureUsages::empty(),
+        );
+        let copy_offsets = gpu.storage("virtual.copy_offsets", (cols * rows) as u64 * 16);
+        let (copy_layout, copy_pipeline) = copy_pipeline(gpu);
+        let static_view = static_atlas.create_view(&Default::default());
+        let copy_group = binding::group(
+            d,
+            "virtual.copy",
+            &copy_layout,
+            &[wgpu::BindingResource::TextureView(&static_view), copy_offsets.as_entire_binding()],
+        );
         let pages_per_side = virtual_res / page_res;
         let table_len = (levels * pages_per_side * pages_per_side) as u64;
         let params = VirtualParams::zeroed_for(p, &proto, pages_per_side, page_res, cols);
@@ -166,6 +200,14 @@ impl VirtualShadows {
             rendered_total: 0,
             cols,
             rows,
+            statics: StaticCopies::new(static_cols * static_rows),
+            builds: Vec::new(),
+            static_cols,
+            static_atlas,
+            copy_offsets,
+            copy_group,
+            copy_pipeline,
+            triangles_drawn: 0,
             chunks,
             dynamic,
             dynamic_boxes: None,
@@ -200,6 +242,17 @@ impl VirtualShadows {
         &self.alloc
     }
 
+    /// How each page of the last frame's `allocation().render` was built (drawn whole, or from
+    /// a static copy).
+    pub fn builds(&self) -> &[Build] {
+        &self.builds
+    }
+
+    /// The static copies of pages under moving geometry.
+    pub fn statics(&self) -> &StaticCopies {
+        &self.statics
+    }
+
     /// The page pool and its resident pages.
     pub fn cache(&self) -> &PageCache {
         &self.cache
@@ -222,6 +275,13 @@ impl VirtualShadows {
         let keys: Vec<PageKey> = (0..self.levels).flat_map(|k| c.pages_touching(k, b)).collect();
         self.cache.invalidate(&keys)
     }
+}
+
+/// A near-square atlas of at most `slots` pages: a power-of-two column count around
+/// sqrt(slots), full rows only (columns, rows).
+fn atlas_shape(slots: u32, page_res: u32, max: u32) -> (u32, u32) {
+    let cols = ((slots as f64).sqrt().ceil() as u32).next_power_of_two().min(max / page_res).max(1);
+    (cols, (slots / cols).min(max / page_res))
 }
 
 impl VirtualParams {
@@ -318,6 +378,26 @@ impl Technique for VirtualShadows {
         rec.write_buffer(&self.page_table, 0, bytemuck::cast_slice(&table));
         let mats: Vec<[[f32; 4]; 4]> = self.alloc.render.iter().map(|(k, _)| c.page_view_proj(*k).to_cols_array_2d()).collect();
         rec.write_buffer(&self.page_mats, 0, bytemuck::cast_slice(&mats));
+        let keys: Vec<PageKey> = self.alloc.render.iter().map(|(k, _)| *k).collect();
+        let (chunks, moving0) = (&self.chunks, self.dynamic_chunk0);
+        self.builds = self.statics.assign(&keys, |k| moving_over(chunks, moving0, &c, k));
+        let pr = self.page_res as i32;
+        let offsets: Vec<[i32; 4]> = self
+            .alloc
+            .render
+            .iter()
+            .zip(&self.builds)
+            .map(|((_, slot), b)| match b {
+                Build::Fill(s) | Build::Copy(s) => {
+                    let (sc, c) = (self.static_cols, self.cols);
+                    [((s % sc) as i32 - (slot % c) as i32) * pr, ((s / sc) as i32 - (slot / c) as i32) * pr, 0, 0]
+                }
+                Build::Full => [0; 4],
+            })
+            .collect();
+        if !offsets.is_empty() {
+            rec.write_buffer(&self.copy_offsets, 0, bytemuck::cast_slice(&offsets));
+        }
         self.clipmap = Some(c);
         self.frames += 1;
         self.rendered_total += self.alloc.render.len() as u64;
@@ -325,40 +405,9 @@ impl Technique for VirtualShadows {
         Ok(())
     }
 
-    /// The new pages, each cleared and drawn with its chunks into its slot.
+    /// The new pages (render.rs).
     fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let (Some(c), false) = (&self.clipmap, self.alloc.render.is_empty()) else { return Ok(()) };
-        let view = self.atlas.create_view(&Default::default());
-        let pr = self.page_res;
-        let draws: Vec<Vec<(u32, u32)>> = self.alloc.render.iter().map(|(k, _)| page_draws(&self.chunks, c, k)).collect();
-        rec.stage("virtual.render", |enc| {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("virtual.render"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_bind_group(0, &self.page_group, &[]);
-            pass.set_bind_group(1, &f.scene.group, &[]);
-            for (i, ((_, slot), ranges)) in self.alloc.render.iter().zip(&draws).enumerate() {
-                let (x, y) = ((slot % self.cols) * pr, (slot / self.cols) * pr);
-                pass.set_viewport(x as f32, y as f32, pr as f32, pr as f32, 0.0, 1.0);
-                pass.set_scissor_rect(x, y, pr, pr);
-                pass.set_pipeline(&self.clear_pipeline);
-                pass.draw(0..3, 0..1);
-                pass.set_pipeline(&self.page_pipeline);
-                let inst = i as u32;
-                for &(a, b) in ranges {
-                    pass.draw(a * 3..b * 3, inst..inst + 1);
-                }
-            }
-        });
+        super::render::render(self, f, rec);
         Ok(())
     }
 

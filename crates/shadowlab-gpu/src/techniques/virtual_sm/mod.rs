@@ -15,11 +15,17 @@
 //! (coarse levels first; a full pool makes the finest pages fall back, counted); `render` draws
 //! the new pages, each with its own frustum (orthographic, or the spot's narrowed) into its slot, with the scene's chunks
 //! culled per page; `evaluate` looks every PCF tap up through the page table (eval.wgsl).
+//!
+//! Static/dynamic split (UE5's): in scenes with moving geometry, a page that moving chunks lie
+//! over also keeps a copy of its static geometry alone in a second, smaller atlas (the static
+//! pool, `static_share` of the pool). When the moving geometry sweeps over the page again it
+//! is rebuilt from that copy (copy.wgsl) plus the moving chunks, not from all its geometry.
 
 mod bounds;
 mod draw;
 mod gpu;
 mod params;
+mod render;
 mod report;
 
 use bytemuck::{Pod, Zeroable};
@@ -34,12 +40,18 @@ const PAGES_WGSL: &str = include_str!("pages.wgsl");
 const MARK_WGSL: &str = include_str!("mark.wgsl");
 const EVAL_WGSL: &str = include_str!("eval.wgsl");
 const PAGE_WGSL: &str = include_str!("page.wgsl");
+const COPY_WGSL: &str = include_str!("copy.wgsl");
 
 /// Levels the uniform holds (WGSL `origins`).
 pub const MAX_LEVELS: usize = 24;
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("virtual_sm/mark.wgsl", mark_source()), ("virtual_sm/eval.wgsl", eval_source()), ("virtual_sm/page.wgsl", page_source())]
+    vec![
+        ("virtual_sm/mark.wgsl", mark_source()),
+        ("virtual_sm/eval.wgsl", eval_source()),
+        ("virtual_sm/page.wgsl", page_source()),
+        ("virtual_sm/copy.wgsl", COPY_WGSL.to_string()),
+    ]
 }
 
 fn mark_source() -> String {

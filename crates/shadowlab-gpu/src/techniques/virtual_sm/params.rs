@@ -23,6 +23,12 @@ pub const DEFAULT_RESOLUTION_BIAS: f64 = 0.0;
 /// Physical pool: 12 MiB, the memory of `csm`'s default 3 x 1024^2 maps (issue 17's
 /// equal-memory comparison): 192 pages of 128^2.
 pub const DEFAULT_POOL_MIB: f64 = 12.0;
+/// Share of the pool for the static copies of pages under moving geometry (UE5's
+/// static/dynamic split): such a page is rebuilt from its copy plus the moving chunks instead of
+/// from all its geometry. Only scenes with moving geometry take it from the pool (1/8: 24 of
+/// the default 192 pages). 0: no copies (every invalidated page is drawn whole). Larger: fewer
+/// pages drawn whole on long paths, fewer pages for the view.
+pub const DEFAULT_STATIC_SHARE: f64 = 0.125;
 
 pub const PARAMS: &[ParamDef] = &[
     ParamDef::integer(
@@ -65,6 +71,14 @@ pub const PARAMS: &[ParamDef] = &[
         2048.0,
         "physical page pool (MiB of Depth32Float pages)",
         "csm's 3 x 1024^2 (issue 17)",
+    ),
+    ParamDef::number(
+        "static_share",
+        DEFAULT_STATIC_SHARE,
+        0.0,
+        0.9,
+        "share of pool_mib for static copies of pages under moving geometry (scenes with moving geometry only; 0: none)",
+        "UE5 static/dynamic page split (r.Shadow.Virtual.Cache.StaticSeparate); share: shadowlab",
     ),
     PCF,
     BIAS,

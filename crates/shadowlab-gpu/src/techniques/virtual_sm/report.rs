@@ -1,7 +1,7 @@
 //! `virtual`'s report: pages marked, rendered, cached and fallen back in the last frame, the
 //! pool's and page table's bytes, samples per level, and a picture of the marked pages.
 
-use shadowlab_core::techniques::virtual_sm::PageKey;
+use shadowlab_core::techniques::virtual_sm::{Build, PageKey};
 
 use super::gpu::VirtualShadows;
 use super::MAX_LEVELS;
@@ -15,7 +15,8 @@ const LEVEL_COLOURS: [[u8; 3]; 8] =
 pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
     let a = &t.alloc;
     let slots = t.cols * t.rows;
-    let pool_bytes = slots as u64 * (t.page_res as u64).pow(2) * 4;
+    let static_slots = t.statics.slots();
+    let pool_bytes = (slots + static_slots) as u64 * (t.page_res as u64).pow(2) * 4;
     let n = t.virtual_res / t.page_res;
     let table_bytes = t.levels as u64 * (n as u64).pow(2) * 4;
     let mut r = TechniqueReport { shadow_data_bytes: pool_bytes + table_bytes, ..Default::default() };
@@ -30,6 +31,14 @@ pub(super) fn report(t: &VirtualShadows, gpu: &Gpu) -> TechniqueReport {
     c.insert("pages_fallback_added".into(), t.fallback_added as f64);
     c.insert("pages_invalidated_total".into(), t.invalidated_total as f64);
     c.insert("pool_pages".into(), slots as f64);
+    // the static/dynamic split: how the rendered pages were built, and the triangles drawn
+    let count = |f: fn(&Build) -> bool| t.builds.iter().filter(|b| f(b)).count() as f64;
+    c.insert("pages_drawn_whole".into(), count(|b| *b == Build::Full));
+    c.insert("static_copies_drawn".into(), count(|b| matches!(b, Build::Fill(_))));
+    c.insert("pages_from_static_copy".into(), count(|b| matches!(b, Build::Copy(_))));
+    c.insert("static_pool_pages".into(), static_slots as f64);
+    c.insert("static_copies_resident".into(), t.statics.resident() as f64);
+    c.insert("triangles_drawn".into(), t.triangles_drawn as f64);
     c.insert("pool_bytes".into(), pool_bytes as f64);
     c.insert("page_table_bytes".into(), table_bytes as f64);
     c.insert("request_bytes".into(), table_bytes as f64);
