@@ -57,13 +57,7 @@ pub(super) fn clear_pipeline(gpu: &Gpu, source: &str, layouts: &[&wgpu::BindGrou
         layout: Some(&layout),
         vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_clear"), compilation_options: Default::default(), buffers: &[] },
         primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: raster::DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
+        depth_stencil: Some(depth_always()),
         multisample: Default::default(),
         fragment: None,
         multiview_mask: None,
@@ -88,13 +82,7 @@ pub(super) fn copy_pipeline(gpu: &Gpu) -> (wgpu::BindGroupLayout, wgpu::RenderPi
         layout: Some(&pl),
         vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_copy"), compilation_options: Default::default(), buffers: &[] },
         primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: raster::DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
+        depth_stencil: Some(depth_always()),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &module,
@@ -106,4 +94,15 @@ pub(super) fn copy_pipeline(gpu: &Gpu) -> (wgpu::BindGroupLayout, wgpu::RenderPi
         cache: None,
     });
     (layout, pipeline)
+}
+
+/// Depth written unconditionally (the slot clear and the static copy).
+fn depth_always() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: raster::DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
 }
