@@ -277,11 +277,20 @@ impl VirtualShadows {
     }
 }
 
-/// A near-square atlas of at most `slots` pages: a power-of-two column count around
-/// sqrt(slots), full rows only (columns, rows).
+/// An atlas of at most `slots` pages in full rows (columns, rows), each side within `max`
+/// texels: a power-of-two column count around sqrt(slots) when that holds as many pages as any
+/// shape can, otherwise the squarest shape that holds the most (168 slots: 14 x 12, where 16
+/// columns would hold 160).
 fn atlas_shape(slots: u32, page_res: u32, max: u32) -> (u32, u32) {
-    let cols = ((slots as f64).sqrt().ceil() as u32).next_power_of_two().min(max / page_res).max(1);
-    (cols, (slots / cols).min(max / page_res))
+    let side = (max / page_res).max(1);
+    let fit = |c: u32| (c, (slots / c).min(side));
+    let count = |(c, r): (u32, u32)| c * r;
+    let pow2 = fit(((slots as f64).sqrt().ceil() as u32).next_power_of_two().min(side).max(1));
+    let most = (1..=side).map(|c| count(fit(c))).max().unwrap_or(0);
+    if count(pow2) == most {
+        return pow2;
+    }
+    (1..=side).map(fit).filter(|s| count(*s) == most).min_by_key(|(c, r)| c.abs_diff(*r)).unwrap_or(pow2)
 }
 
 impl VirtualParams {
@@ -442,5 +451,28 @@ impl VirtualShadows {
         );
         let stage = if counting { "virtual.analysis" } else { "virtual.evaluate" };
         self.eval.record(gpu, rec, stage, &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::atlas_shape;
+
+    #[test]
+    fn atlas_shapes_hold_as_many_pages_as_fit() {
+        // the default pool (192 pages) keeps its power-of-two shape
+        assert_eq!(atlas_shape(192, 128, 16384), (16, 12));
+        // the pool less its static copies: 168 pages, all of them (16 columns held 160)
+        let (c, r) = atlas_shape(168, 128, 16384);
+        assert_eq!((c * r, c.abs_diff(r)), (168, 2));
+        assert_eq!(atlas_shape(24, 128, 16384), (8, 3));
+        // a prime count: the most full rows can hold, never more than asked, within the limit
+        for (slots, max) in [(167, 16384), (167, 2048), (5, 256), (1, 128)] {
+            let (c, r) = atlas_shape(slots, 128, max);
+            assert!(c * r <= slots && c * 128 <= max && r * 128 <= max, "{slots} {max}: {c} x {r}");
+            let side = max / 128;
+            let best = (1..=side).map(|c| c * (slots / c).min(side)).max().unwrap();
+            assert_eq!(c * r, best, "{slots} {max}");
+        }
     }
 }
