@@ -154,6 +154,28 @@ fn a_tiny_pool_falls_back_counted_and_deterministic() {
     assert!(a.mapped.iter().all(|(p, _)| p.level >= coarsest_fallen));
 }
 
+/// A pool far too small for the view (16 pages of 128^2, a few times fewer than asked for) falls
+/// back as many levels as it must, one level at a time: every sample finds a mapped level below
+/// the coarsest (whose texels would be far too large for its bias), and the visibility stays
+/// close to a pool that holds everything. Before the candidates were marked at every level,
+/// samples whose one-level-coarser page was left out too walked up to the coarsest level.
+#[test]
+fn a_deep_overcommit_falls_back_level_by_level() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 128);
+    let rt = lab.reference(&v, 1).unwrap();
+    let small = lab.run(&v, &TechniqueSpec::parse("virtual:pool_mib=1,resolution_bias=-3,levels=12").unwrap(), 1).unwrap();
+    let c = &small.report.counters;
+    assert!(c["pages_marked"] > 3.0 * c["pool_pages"], "overcommitted: {c:?}");
+    assert!(!c.contains_key("pixels_in_level_11"), "samples at the coarsest level: {c:?}");
+    let used: f64 = c.iter().filter(|(k, _)| k.starts_with("pixels_in_level_")).map(|(_, v)| v).sum();
+    assert!((used - 1.0).abs() < 1e-9 && c["pixels_unresolved"] == 0.0, "every sample resolved: {c:?}");
+    let a = agreement(&small.visibility, &rt.visibility, &v.mask);
+    assert!(a > 97.0, "4 pages agree with rt on {a:.3}%");
+}
+
 /// PCF taps across page borders read the neighbouring pages: with one level, 64^2 pages give
 /// the same visibility as the same level stored as one 2048^2 page (an unpaged map of the same
 /// texel grid), on pixels whose 5x5 kernel straddles page borders too.

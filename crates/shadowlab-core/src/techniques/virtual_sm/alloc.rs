@@ -3,9 +3,10 @@
 //! when the pool is full. Deterministic: the outcome depends only on the requested set and the
 //! cache's history, never on the order the GPU marked pages in.
 //!
-//! Priority: coarser levels first, then row-major (y, x) page order inside a level; the first
-//! `slots` requested pages in that order get a slot, the rest fall back (their samples use the
-//! nearest coarser level whose pages are mapped). A requested page still resident (rendered in
+//! Priority: coarser levels first; inside a level, the pages more view samples would read first
+//! ([`Demand`]), then row-major (y, x) page order; the first `slots` requested pages in that
+//! order get a slot, the rest fall back (their samples use the nearest coarser level whose pages
+//! are mapped). A requested page still resident (rendered in
 //! an earlier frame and not invalidated since) keeps its slot and is not rendered again. New
 //! pages take free slots in ascending order, then evict the resident pages not requested this
 //! frame, least recently requested first (ties: page order).
@@ -21,7 +22,7 @@ pub struct PageKey {
 }
 
 impl PageKey {
-    /// Sort key of the priority order: coarser level first, then (y, x).
+    /// Page order (the priority order without sample counts): coarser level first, then (y, x).
     fn priority(&self) -> (std::cmp::Reverse<u32>, i32, i32) {
         (std::cmp::Reverse(self.level), self.y, self.x)
     }
@@ -38,16 +39,54 @@ impl Ord for PageKey {
     }
 }
 
+/// View samples per page: how many samples chose each page at their own level (mark.wgsl
+/// counts the page under each sample), added up the chain of coarser levels of the same face,
+/// so that a coarser page counts the samples that read it when their finer pages fall back.
+/// Exact integer sums: the same for any marking order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Demand(BTreeMap<PageKey, u64>);
+
+impl Demand {
+    /// From `(page, samples)` at the samples' own levels; `levels` level indices in all, `step`
+    /// from a level to the next coarser one of its face (`Clipmap::faces()`).
+    pub fn up_the_chain(counts: &[(PageKey, u32)], levels: u32, step: u32) -> Demand {
+        let mut d = BTreeMap::new();
+        for &(k, n) in counts {
+            let mut p = k;
+            loop {
+                *d.entry(p).or_insert(0) += n as u64;
+                if p.level + step >= levels {
+                    break;
+                }
+                p = PageKey { level: p.level + step, x: p.x.div_euclid(2), y: p.y.div_euclid(2) };
+            }
+        }
+        Demand(d)
+    }
+
+    /// Samples that would read page `k` (0 if none counted).
+    pub fn of(&self, k: &PageKey) -> u64 {
+        self.0.get(k).copied().unwrap_or(0)
+    }
+
+    /// Sorts `pages` into priority order: coarser level first, then more samples, then (y, x).
+    /// Without counts this is [`PageKey`]'s order.
+    pub fn sort(&self, pages: &mut [PageKey]) {
+        pages.sort_by_key(|k| (std::cmp::Reverse(k.level), std::cmp::Reverse(self.of(k)), k.y, k.x));
+    }
+}
+
 /// The requested pages plus the fallback pages a full pool needs: while the first `slots`
 /// pages in priority order leave some requested pages out, each left-out page of level k adds
 /// the `candidates` of level k + `step` (one level coarser: `Clipmap::faces()`, 1 unless a
 /// cube) within one page of its parent (the pages its samples would read one level coarser:
 /// mark.wgsl flags them as candidates), until nothing more is added. Without a full pool this
-/// is `requested`. Sorted, without duplicates.
-pub fn with_fallbacks(requested: &[PageKey], candidates: &[PageKey], slots: usize, step: u32) -> Vec<PageKey> {
+/// is `requested`. In `demand`'s priority order, without duplicates.
+pub fn with_fallbacks(requested: &[PageKey], candidates: &[PageKey], slots: usize, step: u32, demand: &Demand) -> Vec<PageKey> {
     let mut req: Vec<PageKey> = requested.to_vec();
     req.sort();
     req.dedup();
+    demand.sort(&mut req);
     let mut pending: std::collections::BTreeSet<PageKey> = candidates.iter().copied().collect();
     for k in &req {
         pending.remove(k);
@@ -70,7 +109,7 @@ pub fn with_fallbacks(requested: &[PageKey], candidates: &[PageKey], slots: usiz
             pending.remove(a);
         }
         req.extend(add);
-        req.sort();
+        demand.sort(&mut req);
         done_from = slots;
     }
     req
@@ -133,17 +172,24 @@ impl PageCache {
         before - self.resident.len()
     }
 
-    /// The resident pages, in priority order.
+    /// The resident pages, in [`PageKey`] order.
     pub fn resident_pages(&self) -> impl Iterator<Item = &PageKey> {
         self.resident.keys()
     }
 
-    /// Assigns slots to `requested` (any order, duplicates allowed) for a new frame.
+    /// Assigns slots to `requested` (any order, duplicates allowed) for a new frame, in
+    /// [`PageKey`] order (no sample counts).
     pub fn allocate(&mut self, requested: &[PageKey]) -> Allocation {
+        self.allocate_by(requested, &Demand::default())
+    }
+
+    /// Assigns slots to `requested` in `demand`'s priority order.
+    pub fn allocate_by(&mut self, requested: &[PageKey], demand: &Demand) -> Allocation {
         self.frame += 1;
         let mut req: Vec<PageKey> = requested.to_vec();
         req.sort();
         req.dedup();
+        demand.sort(&mut req);
         let n = (self.slots as usize).min(req.len());
         let (chosen, rest) = req.split_at(n);
         let chosen_set: std::collections::BTreeSet<PageKey> = chosen.iter().copied().collect();

@@ -19,7 +19,7 @@ mod alloc;
 mod cube;
 mod spot;
 mod statics;
-pub use alloc::{with_fallbacks, Allocation, PageCache, PageKey};
+pub use alloc::{with_fallbacks, Allocation, Demand, PageCache, PageKey};
 pub use spot::{spot_levels, Projection};
 pub use statics::{Build, StaticCopies};
 

@@ -190,12 +190,12 @@ fn left_out_pages_bring_their_coarser_candidates() {
     let req = [key(0, 0, 0), key(0, 1, 0), key(0, 2, 0), key(0, 3, 0), key(0, 8, 8)];
     let cand = [key(1, 1, 0), key(1, 0, 0), key(1, 4, 4), key(1, 20, 20), key(2, 0, 0)];
     // room for everything: nothing added
-    assert_eq!(with_fallbacks(&req, &cand, 5, 1), {
+    assert_eq!(with_fallbacks(&req, &cand, 5, 1, &Demand::default()), {
         let mut r = req.to_vec();
         r.sort();
         r
     });
-    let out = with_fallbacks(&req, &cand, 3, 1);
+    let out = with_fallbacks(&req, &cand, 3, 1, &Demand::default());
     // the two level-1 candidates near parents (0,0)/(1,0) come first; then (1,4,4) for (0,8,8)
     // once it is left out; (1,20,20) is near nothing, (2,0,0) is two levels up
     assert_eq!(&out[..3], &[key(1, 0, 0), key(1, 1, 0), key(1, 4, 4)]);
@@ -205,4 +205,43 @@ fn left_out_pages_bring_their_coarser_candidates() {
     let a = PageCache::new(3).allocate(&out);
     assert_eq!(a.mapped.iter().map(|m| m.0).collect::<Vec<_>>(), vec![key(1, 0, 0), key(1, 1, 0), key(1, 4, 4)]);
     assert_eq!(a.fallen_back.len(), 5);
+}
+
+#[test]
+fn demand_adds_samples_up_the_chain_and_orders_pages_inside_a_level() {
+    // 5 samples chose level-0 page (0,0), 2 chose (1,0), 7 chose (-1,3); 4 chose level-1 page (3,3)
+    let counts = [(key(0, 0, 0), 5), (key(0, 1, 0), 2), (key(0, -1, 3), 7), (key(1, 3, 3), 4)];
+    let d = Demand::up_the_chain(&counts, 3, 1);
+    assert_eq!((d.of(&key(0, 0, 0)), d.of(&key(0, 1, 0)), d.of(&key(0, 5, 5))), (5, 2, 0));
+    // parents: (0,0) and (1,0) share (0,0) at level 1; (-1,3) -> (-1,1); (3,3) -> level 2 (1,1)
+    assert_eq!((d.of(&key(1, 0, 0)), d.of(&key(1, -1, 1)), d.of(&key(1, 3, 3))), (7, 7, 4));
+    assert_eq!((d.of(&key(2, 0, 0)), d.of(&key(2, -1, 0)), d.of(&key(2, 1, 1))), (7, 7, 4));
+    // no level past the last
+    assert_eq!(d.of(&key(3, 0, 0)), 0);
+    let mut pages = vec![key(0, 0, 0), key(0, 1, 0), key(0, -1, 3), key(0, 5, 5), key(1, 3, 3)];
+    d.sort(&mut pages);
+    assert_eq!(pages, vec![key(1, 3, 3), key(0, -1, 3), key(0, 0, 0), key(0, 1, 0), key(0, 5, 5)]);
+    // a full pool keeps the pages more samples read; equal counts keep page order
+    let a = PageCache::new(3).allocate_by(&pages, &d);
+    assert_eq!(a.mapped.iter().map(|m| m.0).collect::<Vec<_>>(), vec![key(1, 3, 3), key(0, -1, 3), key(0, 0, 0)]);
+    assert_eq!(a.fallen_back, vec![key(0, 1, 0), key(0, 5, 5)]);
+    let mut tie = vec![key(0, 2, 0), key(0, 1, 0)];
+    Demand::default().sort(&mut tie);
+    assert_eq!(tie, vec![key(0, 1, 0), key(0, 2, 0)]);
+}
+
+#[test]
+fn left_out_pages_bring_candidates_of_the_pages_that_fall_back_in_turn() {
+    // 2 slots, both taken by level-2 pages at first: the level-0 pages are left out; their
+    // level-1 candidate is left out too; its own level-2 candidate comes in, ahead of the
+    // level-2 page fewer samples read: the chain never stops short
+    let req = [key(0, 0, 0), key(0, 1, 0), key(2, 5, 5), key(2, 6, 5)];
+    let cand = [key(1, 0, 0), key(2, 0, 0)];
+    let counts = [(key(0, 0, 0), 3), (key(0, 1, 0), 1), (key(2, 5, 5), 2), (key(2, 6, 5), 1)];
+    let d = Demand::up_the_chain(&counts, 3, 1);
+    let out = with_fallbacks(&req, &cand, 2, 1, &d);
+    assert_eq!(out, vec![key(2, 0, 0), key(2, 5, 5), key(2, 6, 5), key(1, 0, 0), key(0, 0, 0), key(0, 1, 0)]);
+    let a = PageCache::new(2).allocate_by(&out, &d);
+    assert_eq!(a.mapped.iter().map(|m| m.0).collect::<Vec<_>>(), vec![key(2, 0, 0), key(2, 5, 5)]);
+    assert_eq!(a.fallen_back, vec![key(2, 6, 5), key(1, 0, 0), key(0, 0, 0), key(0, 1, 0)]);
 }

@@ -5,7 +5,7 @@ use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamValues;
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::virtual_sm::{
-    bias_scale, pixel_angle, with_fallbacks, Allocation, Build, Clipmap, PageCache, PageKey, Projection, StaticCopies,
+    bias_scale, pixel_angle, with_fallbacks, Allocation, Build, Clipmap, Demand, PageCache, PageKey, Projection, StaticCopies,
 };
 
 use super::bounds::ChunkBounds;
@@ -373,12 +373,19 @@ impl Technique for VirtualShadows {
             self.dynamic_boxes = Some(now);
         }
         self.invalidated_total += self.invalidated as u64;
-        let mut req: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f & 1 != 0).map(|(i, _)| c.key_of_index(i)).collect();
+        // mark.wgsl: flags in bits 0-1 (1 requested, 2 a fallback candidate), samples above
+        let pages = |keep: fn(u32) -> bool| -> Vec<PageKey> {
+            flags.iter().enumerate().filter(|(_, f)| keep(**f)).map(|(i, _)| c.key_of_index(i)).collect()
+        };
+        let mut req = pages(|f| f & 1 != 0);
         req.sort();
-        let cand: Vec<PageKey> = flags.iter().enumerate().filter(|(_, f)| **f == 2).map(|(i, _)| c.key_of_index(i)).collect();
-        let all = with_fallbacks(&req, &cand, self.cache.slots() as usize, self.faces);
+        let cand = pages(|f| f & 3 == 2);
+        let counts: Vec<(PageKey, u32)> =
+            flags.iter().enumerate().filter(|(_, f)| **f >> 2 != 0).map(|(i, f)| (c.key_of_index(i), f >> 2)).collect();
+        let demand = Demand::up_the_chain(&counts, c.levels, self.faces);
+        let all = with_fallbacks(&req, &cand, self.cache.slots() as usize, self.faces, &demand);
         self.fallback_added = all.len() - req.len();
-        self.alloc = self.cache.allocate(&all);
+        self.alloc = self.cache.allocate_by(&all, &demand);
         self.requested = req;
         let mut table = vec![0u32; c.table_len()];
         for (k, s) in &self.alloc.mapped {

@@ -10,9 +10,10 @@
 //! (The folder is `virtual_sm`: `virtual` is a Rust keyword, and `vsm` is variance shadow
 //! maps.) Stored depth: 0 = near; linear (directional) or post-projective (spot, as `sm`).
 //!
-//! Per frame: `prepare` marks the requested pages on the GPU (mark.wgsl), reads the flags back
-//! (one stall, `virtual.readback`), and allocates slots on the CPU in a fixed priority order
-//! (coarse levels first; a full pool makes the finest pages fall back, counted); `render` draws
+//! Per frame: `prepare` marks the requested pages on the GPU (mark.wgsl), reads the flags and
+//! per-page sample counts back (one stall, `virtual.readback`), and allocates slots on the CPU
+//! in a priority order (coarse levels first, then the pages more samples read; a full pool makes
+//! the finest pages fall back one level at a time, counted); `render` draws
 //! the new pages, each with its own frustum (orthographic, or the spot's narrowed) into its slot, with the scene's chunks
 //! culled per page; `evaluate` looks every PCF tap up through the page table (eval.wgsl).
 //!
