@@ -33,14 +33,17 @@ pub fn techniques() -> Result<()> {
         println!("  source:  {}", t.source);
         println!("  stalls:  {}", if t.stalls.is_empty() { "none: a frame records into one submit" } else { t.stalls });
         println!("  needs:   {}", if t.needs.is_empty() { "WebGPU's default features and limits" } else { t.needs });
-        if t.params.is_empty() {
+        let runs: Vec<String> = t.compare.iter().map(|a| if a.is_empty() { t.name.to_string() } else { format!("{}:{a}", t.name) }).collect();
+        println!("  compare: {}", if runs.is_empty() { "not in the default set".to_string() } else { runs.join(", ") });
+        if t.params().is_empty() {
             println!("  parameters: none");
         }
-        for p in t.params {
+        for p in t.params() {
             println!("  {:<14} default {:<8} [{}]  {}  (source: {})", p.key, p.default_text(), p.range_text(), p.doc, p.source);
         }
         println!();
     }
     println!("Spec syntax: name or name:key=value,key=value (label=... names the run).");
+    println!("Without -t, compare runs the `compare:` specs above: {}.", shadowlab_gpu::registry::default_compare().join(" "));
     Ok(())
 }

@@ -2,37 +2,13 @@
 //! input (one `error:` line, non-zero exit, no panic, no report left behind).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_shadowlab"));
-    c.env("XDG_RUNTIME_DIR", std::env::temp_dir());
-    c
-}
-
-fn skip_gpu() -> bool {
-    std::env::var("SHADOWLAB_SKIP_GPU_TESTS").as_deref() == Ok("1")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shadowlab-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().expect("run shadowlab")
-}
+mod common;
+use common::*;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shadowlab-core/tests/fixtures")
-}
-
-fn assert_clean_error(out: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected failure, stderr: {err}");
-    assert!(!err.contains("panicked"), "panic instead of an error: {err}");
-    assert!(err.contains("error:") && err.contains(needle), "expected an error mentioning '{needle}', got: {err}");
 }
 
 /// metrics.json without the timings and the peak memory (which legitimately vary).
@@ -298,9 +274,12 @@ fn techniques_and_scenes_list_the_registries() {
     let o = run(&["techniques"]);
     assert!(o.status.success());
     let s = String::from_utf8_lossy(&o.stdout);
-    for needle in ["sm ", "rt ", "res", "default 512", "pcf", "normal_offset", "source:"] {
+    for needle in ["sm ", "rt ", "res", "default 512", "pcf", "normal_offset", "source:", "compare: sm, sm:pcf=3"] {
         assert!(s.contains(needle), "techniques output lacks '{needle}'");
     }
+    // the default compare set is the registry's, listed once
+    let set = shadowlab_gpu::registry::default_compare().join(" ");
+    assert!(s.contains(&format!("Without -t, compare runs the `compare:` specs above: {set}.")), "{s}");
     let o = run(&["scenes"]);
     let s = String::from_utf8_lossy(&o.stdout);
     for needle in ["courtyard", "room", "foliage", "[default]"] {

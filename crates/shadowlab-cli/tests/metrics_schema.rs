@@ -5,6 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+use common::*;
+
 #[path = "../src/metrics/mod.rs"]
 #[allow(dead_code, unused_imports)]
 mod metrics;
@@ -33,10 +36,6 @@ fn written() -> &'static str {
         std::fs::remove_dir_all(&out).unwrap();
         text
     })
-}
-
-fn skip_gpu() -> bool {
-    std::env::var("SHADOWLAB_SKIP_GPU_TESTS").as_deref() == Ok("1")
 }
 
 fn errors(validator: &jsonschema::Validator, v: &serde_json::Value) -> Vec<String> {

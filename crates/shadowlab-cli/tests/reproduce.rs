@@ -3,26 +3,12 @@
 //! claims not comparable, with why. (The verdict logic is unit-tested in reproduce/verdict.rs.)
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
+
+mod common;
+use common::*;
 
 const CLAIMS: &str = include_str!("../src/reproduce/claims.toml");
-
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_shadowlab"));
-    c.env("XDG_RUNTIME_DIR", std::env::temp_dir());
-    c
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shadowlab-reproduce-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
-fn json(p: PathBuf) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
-}
 
 fn stdout(args: &[&str]) -> String {
     let o = bin().args(args).output().unwrap();

@@ -6,30 +6,12 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 
-fn skip_gpu() -> bool {
-    std::env::var("SHADOWLAB_SKIP_GPU_TESTS").as_deref() == Ok("1")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shadowlab-sweep-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shadowlab")).env("XDG_RUNTIME_DIR", std::env::temp_dir()).args(args).output().expect("run shadowlab")
-}
+mod common;
+use common::*;
 
 fn ok(o: &Output) -> String {
     assert!(o.status.success(), "stdout: {}\nstderr: {}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     String::from_utf8_lossy(&o.stdout).to_string()
-}
-
-fn assert_clean_error(o: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success(), "expected failure, stderr: {err}");
-    assert!(!err.contains("panicked"), "panic instead of an error: {err}");
-    assert!(err.contains("error:") && err.contains(needle), "expected an error mentioning '{needle}', got: {err}");
 }
 
 /// The small sweep of these tests: one scene, 3 points.

@@ -14,19 +14,11 @@ use shadowlab_view::render::{Look, Pose, RefStatus, Renderer, Right, Show};
 use shadowlab_view::session;
 use shadowlab_view::widgets::resolve_text;
 
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_shadowlab"));
-    c.env("XDG_RUNTIME_DIR", std::env::temp_dir());
-    c
-}
-
-fn skip_gpu() -> bool {
-    std::env::var("SHADOWLAB_SKIP_GPU_TESTS").as_deref() == Ok("1")
-}
+mod common;
+use common::*;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shadowlab-view-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
+    let d = common::tmp(name);
     std::fs::create_dir_all(&d).unwrap();
     d
 }

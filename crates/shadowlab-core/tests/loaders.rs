@@ -323,11 +323,33 @@ fn malformed_gltf_is_an_error_not_a_panic() {
 fn malformed_obj_is_an_error_not_a_panic() {
     expect_invalid("malformed/bad_indices.obj", "out of bounds");
     expect_invalid("malformed/bad_relative_indices.obj", "out of bounds");
-    expect_invalid("malformed/garbage.obj", "parse");
+    expect_invalid("malformed/garbage.obj", "line 2: malformed OBJ: position parse error ('v 1.0 zz 3.0')");
     expect_invalid("malformed/garbage_binary.obj", "");
     expect_invalid("malformed/empty.obj", "empty");
     expect_invalid("malformed/no_faces.obj", "no faces");
     expect_invalid("malformed/does_not_exist.obj", "cannot open");
+}
+
+/// Every OBJ parse error names its line, wherever it is and whatever its kind.
+#[test]
+fn obj_parse_errors_name_their_line() {
+    let dir = std::env::temp_dir().join(format!("shadowlab-obj-lines-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+    let cases = [
+        ("texcoord", "vt 0.5 x\nf 1 2 3\n", 6, "texcoord parse error"),
+        ("normal", "f 1 2 3\nvn 1 q 0\n", 7, "normal parse error"),
+        ("position", "v 1 2\nf 1 2 3\n", 6, "position parse error"),
+        ("face", "f 1 2 3\nf 1/a 2 3\n", 7, "face parse error"),
+        ("truncated", "f 1 2 3\nv 0.25 1", 7, "position parse error"),
+    ];
+    for (name, tail, line, kind) in cases {
+        let path = dir.join(format!("{name}.obj"));
+        std::fs::write(&path, format!("{good}{tail}")).unwrap();
+        let msg = loaders::load(&path, &SceneTransform::default()).err().unwrap_or_else(|| panic!("{name} loaded")).to_string();
+        assert!(msg.contains(&format!("line {line}: malformed OBJ: {kind}")), "{name}: {msg}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -149,7 +149,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, size: u32, frames: usize) -> Result<HostRes
     for name in ["sm", "lt"] {
         let spec = registry::resolve(&TechniqueSpec::parse(name)?, Some(&light))?;
         let vis = gpu.storage(&format!("host.visibility.{name}"), size as u64 * size as u64 * 4);
-        techs.push((name.to_string(), (spec.info.create)(gpu, &gscene, &spec.values, &light)?, vis));
+        techs.push((name.to_string(), spec.info.create(gpu, &gscene, &spec.values, &light)?, vis));
     }
 
     let g = &view.gbuffer;

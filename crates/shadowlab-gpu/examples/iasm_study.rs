@@ -13,12 +13,13 @@ use glam::{Vec2, Vec3};
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera};
 use shadowlab_core::metrics::compare;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::scene::Scene;
 use shadowlab_core::setup::{SceneSource, Setup};
 use shadowlab_core::techniques::iasm::{self as core, Anchor};
 use shadowlab_gpu::lab::{Lab, PathSpec};
 use shadowlab_gpu::registry::{self, Resolved};
+use shadowlab_gpu::techniques::iasm::IasmSettings;
 use shadowlab_gpu::Gpu;
 
 type Res = Result<(), Box<dyn std::error::Error>>;
@@ -127,8 +128,9 @@ fn corner_study(lab: &Lab, cam: &Camera, light: &shadowlab_core::light::Light, s
         for s in specs {
             let run = lab.run(&v, &TechniqueSpec::parse(s)?, 0)?;
             let side = run.report.counters["square_side"] as f32;
-            let anchor = if run.params.choice("anchor") == "tile" { Anchor::TileCentre } else { Anchor::Circle };
-            let snap = run.params.get_bool("snap").then_some(side / 64.0);
+            let settings = IasmSettings::from_values(&run.params);
+            let anchor = Anchor::from(settings.anchor);
+            let snap = settings.snap.then_some(side / 64.0);
             let p = core::place(direction, c.position, (c.target - c.position).normalize(), side, snap, anchor);
             if first {
                 let thesis = core::place(direction, c.position, (c.target - c.position).normalize(), side, snap, Anchor::Circle);

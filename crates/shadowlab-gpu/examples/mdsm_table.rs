@@ -8,10 +8,11 @@
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::loaders;
 use shadowlab_core::metrics::compare;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::setup::{SceneSource, Setup};
 use shadowlab_core::techniques::mdsm::{crossover_fragments, crossover_measured, distinct_values, max_distinct, DEFAULT_Q, PCF_TAPS};
 use shadowlab_gpu::lab::{Lab, Run};
+use shadowlab_gpu::techniques::mdsm::MdsmSettings;
 use shadowlab_gpu::Gpu;
 
 struct Row {
@@ -78,7 +79,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     for extra in ["n=2,k=9,region_bias=false", "n=3,k=4,region_bias=false", "n=2,k=9,q=25", "n=3,k=4,q=25"] {
         let r = run(&format!("mdsm:res={res},{extra}"))?;
-        let (n, k) = (r.params.get_u32("n"), r.params.get_u32("k"));
+        let s = MdsmSettings::from_values(&r.params);
+        let (n, k) = (s.n, s.k);
         rows.push(row(&r, n, k));
     }
     let sm16 = run(&format!("sm:res={res},pcf=4"))?;

@@ -81,7 +81,7 @@ impl std::fmt::Debug for Resolved {
 }
 
 impl Resolved {
-    /// Values already resolved against `info.params`, under `label`.
+    /// Values already resolved against `info.params()`, under `label`.
     pub fn new(info: &'static TechniqueInfo, values: ParamValues, label: impl Into<String>) -> Resolved {
         let label = label.into();
         Resolved { info, values, text: label.clone(), label }
@@ -106,7 +106,9 @@ impl Resolved {
 /// `light` the light type.
 pub fn resolve(spec: &TechniqueSpec, light: Option<&Light>) -> Result<Resolved, GpuError> {
     let info = find(&spec.name)?;
-    let values = spec.resolve(info.params).map_err(GpuError::Invalid)?;
+    let values = spec.resolve(info.params()).map_err(GpuError::Invalid)?;
+    let given: Vec<&str> = spec.args.iter().map(|(k, _)| k.as_str()).collect();
+    (info.params.check)(&values, &given).map_err(|e| GpuError::Invalid(format!("technique '{}': {e}", info.name)))?;
     let r = Resolved { info, values, label: spec.label(), text: spec.text.clone() };
     if let Some(l) = light {
         r.check_light(l)?;

@@ -9,7 +9,7 @@ use serde::Serialize;
 use shadowlab_core::camera::Camera;
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::SamplingStats;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::{ParamDef, ParamTable, ParamValues};
 
 use crate::gbuffer::GBuffer;
 use crate::record::{Recorded, Recorder};
@@ -190,7 +190,8 @@ pub struct TechniqueInfo {
     pub source: &'static str,
     /// Light types it supports.
     pub lights: &'static [&'static str],
-    pub params: &'static [ParamDef],
+    /// Its parameter set (`ParamTable::of::<Settings>()`): the rows listed, the rules checked.
+    pub params: ParamTable,
     /// Mid-frame readbacks (the frame is submitted and waited for at that point), and any
     /// delayed mode that avoids them; empty when a frame records without a stall.
     pub stalls: &'static str,
@@ -204,4 +205,18 @@ pub struct TechniqueInfo {
     /// (variants of one folder share the list).
     pub shaders: fn() -> Vec<(&'static str, String)>,
     pub create: CreateFn,
+}
+
+impl TechniqueInfo {
+    /// The parameter table, in listing order.
+    pub fn params(&self) -> &'static [ParamDef] {
+        (self.params.defs)()
+    }
+
+    /// Applies the set's rules to `values` (all keys treated as defaults: none reported as
+    /// ineffective), then creates the technique.
+    pub fn create(&self, gpu: &Gpu, scene: &GpuScene, values: &ParamValues, light: &Light) -> Result<Box<dyn Technique>, GpuError> {
+        (self.params.check)(values, &[]).map_err(|e| GpuError::Invalid(format!("technique '{}': {e}", self.name)))?;
+        (self.create)(gpu, scene, values, light)
+    }
 }

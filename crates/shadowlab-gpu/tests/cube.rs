@@ -4,12 +4,12 @@
 use glam::Vec3;
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::light::Light;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::techniques::cube::{face_of, project, tap_texel, texel_size};
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::submit_frame;
-use shadowlab_gpu::techniques::cube::CubeMap;
+use shadowlab_gpu::techniques::cube::{CubeMap, CubeSettings};
 use shadowlab_gpu::GpuError;
 
 mod common;
@@ -54,11 +54,10 @@ fn cube_rejects_other_lights() {
         assert!(matches!((info.create)(&gpu, &lab.gscene, &p, &light), Err(GpuError::Invalid(_))));
         assert!(registry::resolve(&spec("cube-notw"), Some(&light)).is_err());
     }
-    // cube-notw's default window (128) needs res above it: a clear error, not a panic
-    let shadowlab_gpu::registry::Resolved { info, values: p, .. } =
-        registry::resolve(&spec("cube-notw:res=64"), Some(&scene.lights[ROOM_POINT])).unwrap();
-    match (info.create)(&gpu, &lab.gscene, &p, &scene.lights[ROOM_POINT]) {
-        Err(GpuError::Invalid(m)) => assert!(m.contains("window"), "{m}"),
+    // cube-notw's default window (128) needs res above it: a clear error when the spec is
+    // resolved, not a panic
+    match registry::resolve(&spec("cube-notw:res=64"), Some(&scene.lights[ROOM_POINT])) {
+        Err(GpuError::Invalid(m)) => assert!(m.contains("window 128 must be below res 64"), "{m}"),
         _ => panic!("cube-notw:res=64 with window 128 accepted"),
     }
 }
@@ -74,12 +73,13 @@ fn seamless_pcf_reads_the_neighbour_face_as_the_cpu_rules_say() {
     let Light::Point { position } = light else { panic!("room light 1 is a point light") };
     let v = view(&lab, &scene, ROOM_POINT, 256);
     let shadowlab_gpu::registry::Resolved { info: _, values: p, .. } = registry::resolve(&spec("cube:res=64,pcf=3"), Some(&light)).unwrap();
+    let p = CubeSettings::from_values(&p);
     let mut cube = CubeMap::new(&gpu, &lab.gscene, &p, &light).unwrap();
     submit_frame(&mut cube, &gpu, &v.inputs(&lab.gscene)).unwrap();
     let gpu_vis: Vec<f32> = gpu.read_buffer_as(&v.visibility, v.mask.len());
     let faces = cube.read_faces(&gpu);
     let (res, far) = (64u32, cube.far());
-    let (bias, no, max_slope) = (p.get("bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32);
+    let (bias, no, max_slope) = (p.bias.bias as f32, p.bias.normal_offset as f32, p.bias.max_slope as f32);
     let (mut seam, mut seam_agree, mut all, mut all_agree, mut clamp_differs) = (0, 0, 0, 0, 0);
     for (i, m) in v.mask.iter().enumerate() {
         if *m == 0 {
@@ -192,7 +192,7 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 fn cube_notw_lists_notws_parameters_with_eight_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
     // notw's whole list (the same keys in the same order, as the code reads them all)
-    let (a, b) = (cube::NOTW_PARAMS, warp::NOTW_OWN_PARAMS);
+    let (a, b) = (cube::CubeNotwSettings::defs(), warp::NotwSettings::defs());
     assert_eq!(a.len(), b.len());
     assert_eq!(a.iter().map(|p| p.key).collect::<Vec<_>>(), b.iter().map(|p| p.key).collect::<Vec<_>>());
     let own = [
@@ -254,7 +254,7 @@ fn hardware_depth_faces_hold_the_same_distances_and_verdicts_as_distance_faces()
     let mut vis = Vec::new();
     for s in ["cube:depth=distance,pcf=3", "cube:depth=hardware,pcf=3"] {
         let shadowlab_gpu::registry::Resolved { info: _, values: p, .. } = registry::resolve(&spec(s), Some(&light)).unwrap();
-        let mut cube = CubeMap::new(&gpu, &lab.gscene, &p, &light).unwrap();
+        let mut cube = CubeMap::new(&gpu, &lab.gscene, &CubeSettings::from_values(&p), &light).unwrap();
         submit_frame(&mut cube, &gpu, &v.inputs(&lab.gscene)).unwrap();
         faces.push(cube.read_faces(&gpu));
         vis.push(gpu.read_buffer_as::<f32>(&v.visibility, v.gbuffer.pixels()));

@@ -2,11 +2,11 @@
 
 use glam::Vec2;
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::techniques::iasm::{self as core, THESIS_RESOLUTIONS};
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::registry;
-use shadowlab_gpu::techniques::iasm::Iasm;
+use shadowlab_gpu::techniques::iasm::{Iasm, IasmSettings, IasmStore};
 
 mod common;
 use common::*;
@@ -49,7 +49,7 @@ fn gpu_texel_index_matches_cpu_equations() {
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 64);
     let values = registry::resolve(&TechniqueSpec::parse("iasm:store=buffer").unwrap(), Some(&v.light)).unwrap().values;
-    let tech = Iasm::new(&gpu, &lab.gscene, &values, &v.light).unwrap();
+    let tech = Iasm::new(&gpu, &lab.gscene, &IasmSettings::from_values(&values), &v.light).unwrap();
     // a scrambled assignment
     let order = core::rank(&std::array::from_fn(|i| ((i * 11) % 16) as f64), &[false; 16]);
     let res = core::assign(&order, &THESIS_RESOLUTIONS);
@@ -111,7 +111,7 @@ fn atlas_store_matches_buffer_store_and_rt() {
     let v = view(&lab, &scene, 0, 256);
     let buf = lab.run(&v, &TechniqueSpec::parse("iasm:store=buffer").unwrap(), 1).unwrap();
     let atl = lab.run(&v, &TechniqueSpec::parse("iasm").unwrap(), 1).unwrap();
-    assert_eq!(atl.params.choice("store"), "atlas", "atlas is the default store");
+    assert_eq!(IasmSettings::from_values(&atl.params).store, IasmStore::Atlas, "atlas is the default store");
     // the same tiles, frusta and depths; only where the depth lives differs
     let a = agreement(&atl.visibility, &buf.visibility, &v.mask);
     assert!(a >= 99.9, "atlas and buffer agree on {a:.3}%");

@@ -2,10 +2,11 @@
 
 use glam::{Vec2, Vec3};
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::techniques::iasm::Placement;
 use shadowlab_gpu::lab::{Lab, Run, View};
 use shadowlab_gpu::registry;
+use shadowlab_gpu::techniques::iasm::IasmSettings;
 
 mod common;
 use common::*;
@@ -54,7 +55,7 @@ fn fitted_square_contains_every_evaluated_sample_and_is_smaller() {
             "{name}: {got_lo} {got_hi} vs {lo} {hi}"
         );
         // tight: at most the extent, its margin, two steps and one size step larger
-        let margin = fit.params.get("margin") as f32;
+        let margin = IasmSettings::from_values(&fit.params).margin as f32;
         let need = (hi - lo).max_element() * (1.0 + 2.0 * margin) / (1.0 - 2.0 / 64.0);
         assert!(p.size <= need * 1.0444 + tol, "{name}: side {} for extent {}", p.size, (hi - lo).max_element());
         assert!(p.size <= fixed.report.counters["square_side"] as f32 + tol, "{name}: larger than the scene's extent");

@@ -6,13 +6,13 @@ use shadowlab_core::builtin::builtin;
 use shadowlab_core::camera::{path_cameras, Camera};
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::compare;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::scene::Scene;
 use shadowlab_core::techniques::lt::{BIT_LTT, BIT_RS};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::{submit_frame, Technique};
-use shadowlab_gpu::techniques::lt::{LeakTracing, Mode};
+use shadowlab_gpu::techniques::lt::{HybridSettings, LeakTracing, LtSettings, LttSettings, Variant};
 
 mod common;
 use common::*;
@@ -20,12 +20,12 @@ use common::*;
 fn make(lab: &Lab, spec: &str, light: &shadowlab_core::light::Light) -> LeakTracing {
     let spec = TechniqueSpec::parse(spec).unwrap();
     let shadowlab_gpu::registry::Resolved { info, values: params, .. } = registry::resolve(&spec, Some(light)).unwrap();
-    let mode = match info.name {
-        "lt" => Mode::Lt,
-        "ltt" => Mode::Ltt,
-        _ => Mode::HybridPcf,
+    let variant = match info.name {
+        "lt" => Variant::Lt(LtSettings::from_values(&params)),
+        "ltt" => Variant::Ltt(LttSettings::from_values(&params)),
+        _ => Variant::HybridPcf(HybridSettings::from_values(&params)),
     };
-    LeakTracing::new(lab.gpu, &lab.gscene, &params, light, mode).unwrap()
+    LeakTracing::new(lab.gpu, &lab.gscene, &variant, light).unwrap()
 }
 
 fn frame(lab: &Lab, t: &mut LeakTracing, v: &View) -> Vec<f32> {
@@ -139,7 +139,7 @@ fn reprojection_off_screen_forces_a_ray() {
 /// Runs `spec` and `rt` along `cams` (256x256), returning per frame (wrong %, rays, rt rays).
 fn along(lab: &Lab, scene: &Scene, spec: &str, cams: &[Camera]) -> Vec<(f64, f64, f64)> {
     let info = registry::find(&TechniqueSpec::parse(spec).unwrap().name).unwrap();
-    let params = TechniqueSpec::parse(spec).unwrap().resolve(info.params).unwrap();
+    let params = TechniqueSpec::parse(spec).unwrap().resolve(info.params()).unwrap();
     let light = scene.lights[0];
     let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, spec), &light).unwrap();
     let mut rt_inst = lab.instantiate(&shadowlab_gpu::registry::reference(), &light).unwrap();
@@ -395,7 +395,7 @@ const LT_MOVING_MARGIN_PCT: f64 = 0.02;
 /// pixels of `rt` changed between frame 8 and the last frame.
 fn along_moving(lab: &Lab, scene: &Scene, spec: &str, cams: &[Camera]) -> (Vec<(f64, f64, f64)>, usize) {
     let info = registry::find(&TechniqueSpec::parse(spec).unwrap().name).unwrap();
-    let params = TechniqueSpec::parse(spec).unwrap().resolve(info.params).unwrap();
+    let params = TechniqueSpec::parse(spec).unwrap().resolve(info.params()).unwrap();
     let light = scene.lights[0];
     let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, spec), &light).unwrap();
     let mut rt_inst = lab.instantiate(&shadowlab_gpu::registry::reference(), &light).unwrap();

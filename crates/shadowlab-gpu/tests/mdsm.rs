@@ -4,11 +4,11 @@
 use glam::{Mat4, Vec3, Vec4};
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::metrics::compare;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::techniques::mdsm::{distinct_values, max_distinct, pcf, pcf_offsets, region, select, Select};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::technique::submit_frame;
-use shadowlab_gpu::techniques::mdsm::{MultiDepthMap, INFO};
+use shadowlab_gpu::techniques::mdsm::{MdsmSettings, MultiDepthMap, INFO};
 use shadowlab_gpu::Gpu;
 
 mod common;
@@ -21,8 +21,8 @@ fn spec(s: &str) -> TechniqueSpec {
 /// Creates `mdsm:<args>` directly (not through the lab) so its maps can be read back, and runs
 /// one frame on `v`; returns it and the visibility.
 fn run_direct(gpu: &Gpu, lab: &Lab, v: &View, args: &str) -> (MultiDepthMap, Vec<f32>) {
-    let params = spec(&format!("mdsm:{args}")).resolve(INFO.params).unwrap();
-    let mut t = MultiDepthMap::new(gpu, &lab.gscene, &params, &v.light).unwrap();
+    let params = spec(&format!("mdsm:{args}")).resolve(INFO.params()).unwrap();
+    let mut t = MultiDepthMap::new(gpu, &lab.gscene, &MdsmSettings::from_values(&params), &v.light).unwrap();
     let inputs = v.inputs(&lab.gscene);
     submit_frame(&mut t, gpu, &inputs).unwrap();
     gpu.take_error().unwrap();
@@ -41,7 +41,7 @@ fn one_depth_equals_sm_pixel_for_pixel() {
     let scene = builtin("courtyard").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 256);
-    for (md, sm) in [("mdsm:n=1,k=1", "sm:pcf=1"), ("mdsm:n=1,k=9,select=sort", "sm:pcf=3")] {
+    for (md, sm) in [("mdsm:n=1,k=1", "sm:pcf=1"), ("mdsm:n=1,k=9", "sm:pcf=3")] {
         let a = lab.run(&v, &spec(md), 0).unwrap();
         let b = lab.run(&v, &spec(sm), 0).unwrap();
         let evaluated = v.mask.iter().filter(|m| **m != 0).count();
@@ -246,5 +246,5 @@ fn wgsl_constants_match_core() {
     let max_q = SEARCH_SIZES.iter().max().unwrap();
     assert!(select.contains(&format!("const MAX_Q: u32 = {max_q}u;")), "select.wgsl MAX_Q must be {max_q}");
     assert!(select.contains("var z = array<f32, 4>") && MAX_DEPTHS == 4, "one RGBA32F texel holds MAX_DEPTHS = 4 depths");
-    assert_eq!(INFO.params.iter().find(|p| p.key == "n").unwrap().max, MAX_DEPTHS as f64);
+    assert_eq!(INFO.params().iter().find(|p| p.key == "n").unwrap().max, MAX_DEPTHS as f64);
 }

@@ -21,7 +21,7 @@ fn each_technique(mut check: impl FnMut(&str, &str, &shadowlab_gpu::lab::Run, &[
         for (l, light) in scene.lights.iter().enumerate() {
             let v = view(&lab, &scene, l, 96);
             for info in REGISTRY.iter().filter(|t| t.lights.contains(&light.kind())) {
-                let params: ParamValues = shadowlab_core::params::TechniqueSpec::parse(info.name).unwrap().resolve(info.params).unwrap();
+                let params: ParamValues = shadowlab_core::params::TechniqueSpec::parse(info.name).unwrap().resolve(info.params()).unwrap();
                 let mut inst = lab.instantiate(&shadowlab_gpu::registry::Resolved::new(info, params, info.name), light).unwrap();
                 let run = lab.step(&v, &mut inst, true, 1).unwrap();
                 // the visibility buffer after the analysis passes, report and shading

@@ -5,13 +5,13 @@ use std::collections::BTreeSet;
 
 use glam::Vec3;
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, Build, PageKey};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
-use shadowlab_gpu::technique::{submit_frame, Technique};
-use shadowlab_gpu::techniques::virtual_sm::{VirtualShadows, DYNAMIC_CHUNK_TRIANGLES};
+use shadowlab_gpu::technique::submit_frame;
+use shadowlab_gpu::techniques::virtual_sm::{VirtualSettings, VirtualShadows, DYNAMIC_CHUNK_TRIANGLES};
 
 mod common;
 use common::*;
@@ -19,7 +19,7 @@ use common::*;
 fn make(lab: &Lab, v: &View, spec: &str) -> VirtualShadows {
     let spec = TechniqueSpec::parse(spec).unwrap();
     let r = registry::resolve(&spec, Some(&v.light)).unwrap();
-    VirtualShadows::new(lab.gpu, &lab.gscene, &r.values, &v.light).unwrap()
+    VirtualShadows::new(lab.gpu, &lab.gscene, &VirtualSettings::from_values(&r.values), &v.light).unwrap()
 }
 
 fn frame(lab: &Lab, t: &mut VirtualShadows, v: &View) -> Vec<f32> {

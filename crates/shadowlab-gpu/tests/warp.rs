@@ -4,13 +4,13 @@ use glam::{Vec3, Vec4Swizzles};
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::lightspace;
 use shadowlab_core::metrics::compare;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_core::techniques::warp;
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::prefix_sum::{PrefixSum, ScanParams};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique;
-use shadowlab_gpu::techniques::warp::{Variant, Warped};
+use shadowlab_gpu::techniques::warp::{DvSettings, Knobs, NotwSettings, RtwSettings, Variant, Warped};
 use wgpu::BufferUsages;
 
 mod common;
@@ -69,7 +69,12 @@ fn gpu_prefix_sums_equal_the_cpu() {
 fn run_direct(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant: Variant) -> Warped {
     let shadowlab_gpu::registry::Resolved { info: _, values: params, .. } =
         registry::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
-    let mut t = Warped::new(gpu, &lab.gscene, &params, &v.light, variant).unwrap();
+    let knobs = match variant {
+        Variant::Notw => Knobs::notw(&NotwSettings::from_values(&params)),
+        Variant::Rtw => Knobs::rtw(&RtwSettings::from_values(&params)),
+        Variant::Dv => Knobs::dv(&DvSettings::from_values(&params)),
+    };
+    let mut t = Warped::new(gpu, &lab.gscene, &knobs, &v.light).unwrap();
     let f = v.inputs(&lab.gscene);
     technique::submit_frame(&mut t, gpu, &f).unwrap();
     gpu.take_error().unwrap();

@@ -3,18 +3,19 @@
 //! edges unsplit draws fewer pieces without losing agreement with `rt`.
 
 use shadowlab_core::builtin::builtin;
-use shadowlab_core::params::TechniqueSpec;
+use shadowlab_core::params::{ParamSet, TechniqueSpec};
 use shadowlab_gpu::lab::{Lab, View};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::technique;
-use shadowlab_gpu::techniques::warp::{Variant, Warped};
+use shadowlab_gpu::techniques::warp::{Knobs, NotwSettings, Warped};
 
 mod common;
 use common::*;
 
 fn run_direct(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str) -> Warped {
     let resolved = registry::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();
-    let mut t = Warped::new(gpu, &lab.gscene, &resolved.values, &v.light, Variant::Notw).unwrap();
+    let knobs = Knobs::notw(&NotwSettings::from_values(&resolved.values));
+    let mut t = Warped::new(gpu, &lab.gscene, &knobs, &v.light).unwrap();
     technique::submit_frame(&mut t, gpu, &v.inputs(&lab.gscene)).unwrap();
     gpu.take_error().unwrap();
     t

@@ -149,15 +149,15 @@ pub fn explicit_label(r: &Resolved) -> Option<String> {
 
 /// `r` with parameter `key` set to `text` (parsed as `-t` would), keeping its explicit label.
 pub fn with_value(r: &Resolved, key: &str, text: &str) -> Result<Resolved, GpuError> {
-    let def = r.info.params.iter().find(|d| d.key == key).ok_or_else(|| {
-        let keys: Vec<_> = r.info.params.iter().map(|d| d.key).collect();
+    let def = r.info.params().iter().find(|d| d.key == key).ok_or_else(|| {
+        let keys: Vec<_> = r.info.params().iter().map(|d| d.key).collect();
         GpuError::Invalid(format!("technique '{}' has no parameter '{key}' (valid: {})", r.info.name, keys.join(", ")))
     })?;
     let one = TechniqueSpec::parse(&format!("{}:{key}={text}", r.info.name)).map_err(GpuError::Invalid)?;
     let parsed = one.resolve(std::slice::from_ref(def)).map_err(GpuError::Invalid)?;
     let mut values = r.values.clone();
     values.0.insert(key.to_string(), parsed.0[key].clone());
-    resolve_text(&spec_text(r.info.name, r.info.params, &values, explicit_label(r).as_deref()))
+    resolve_text(&spec_text(r.info.name, r.info.params(), &values, explicit_label(r).as_deref()))
 }
 
 #[cfg(test)]
@@ -169,7 +169,7 @@ mod tests {
     fn every_registry_parameter_gets_a_fitting_widget() {
         let mut n = 0;
         for t in REGISTRY {
-            for d in t.params {
+            for d in t.params() {
                 n += 1;
                 let default = d.default_value();
                 match (widget(d), &default) {
@@ -198,7 +198,7 @@ mod tests {
         let mut out = ctx.run_ui(egui::RawInput::default(), |ui| {
             for t in REGISTRY {
                 let r = resolve_text(t.name).expect("bare name resolves");
-                for d in t.params {
+                for d in t.params() {
                     total += 1;
                     let mut v = r.values.0[d.key].clone();
                     let resp = edit(ui, d, &mut v);
@@ -214,7 +214,7 @@ mod tests {
         let r = resolve_text("sm:label=mine").unwrap();
         let e = with_value(&r, "res", "1024").unwrap();
         assert_eq!(e.text, "sm:res=1024,label=mine");
-        assert_eq!((e.label.as_str(), e.values.get_u32("res")), ("mine", 1024));
+        assert_eq!((e.label.as_str(), e.values.value("res").cloned()), ("mine", Some(Value::Integer(1024))));
         assert_eq!(with_value(&e, "res", &r.values.0["res"].to_string()).unwrap().text, "sm:label=mine");
         assert!(with_value(&r, "nope", "1").unwrap_err().to_string().contains("valid:"));
         assert!(with_value(&r, "res", "-3").is_err());

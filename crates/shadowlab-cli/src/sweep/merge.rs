@@ -6,7 +6,8 @@ use anyhow::{bail, Context, Result};
 
 use super::args::MergeArgs;
 use super::cache::SweepDir;
-use super::record::{Row, Sweep};
+use super::json::Sweep;
+use super::record::Row;
 use super::{assemble, finish, summary, Header};
 
 fn read_sweep(dir: &std::path::Path) -> Result<Sweep> {

@@ -11,6 +11,7 @@ mod cache;
 mod choose;
 mod expand;
 mod halving;
+mod json;
 mod key;
 mod merge;
 mod plan;
@@ -30,7 +31,8 @@ use args::{SweepArgs, SweepCli, SweepCommand};
 use cache::SweepDir;
 use choose::{aggregate, recommend, Budget};
 use plan::{Common, SetupInput};
-use record::{PlanEntry, PointFile, Row, SetupInfo, Shard, Sweep, SCHEMA_VERSION};
+use json::Sweep;
+use record::{PlanEntry, PointFile, Row, SetupInfo, Shard, SCHEMA_VERSION};
 
 /// `shadowlab sweep` and `shadowlab sweep merge`.
 pub fn main(cli: &SweepCli) -> Result<()> {

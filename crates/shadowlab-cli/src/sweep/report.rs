@@ -7,7 +7,8 @@ use anyhow::Result;
 use minijinja::context;
 
 use super::choose::{pareto_front, Aggregate};
-use super::record::{Row, Sweep};
+use super::json::Sweep;
+use super::record::Row;
 use super::scatter::{self, Point};
 
 const TEMPLATE: &str = include_str!("sweep.html.j2");

@@ -15,7 +15,8 @@ use serde::Serialize;
 use super::args::{BudgetArgs, SweepArgs};
 use super::choose::{aggregate, Aggregate, Budget};
 use super::halving::{self, Metric, Rung, Search};
-use super::record::{Row, Sweep};
+use super::json::Sweep;
+use super::record::Row;
 
 pub const TUNE_ABOUT: &str = "Tune a technique's parameters on train setups; validate the choice on held-out setups";
 

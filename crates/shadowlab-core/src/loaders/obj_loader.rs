@@ -51,7 +51,7 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
     let options =
         tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true, ..Default::default() };
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &options, |lib| mtl.borrow_mut().load_lib(&obj_dir, lib))
-        .map_err(|e| LoadError::invalid(path, format!("malformed OBJ: {e}")))?;
+        .map_err(|e| LoadError::invalid(path, located(&bytes, &options, &e)))?;
     let MtlState { materials: mtl_materials, warnings } = mtl.into_inner();
 
     if models.iter().all(|md| md.mesh.indices.is_empty()) {
@@ -118,6 +118,30 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
         animations: Vec::new(),
         report: LoadReport { warnings: [warnings, textures.warnings].concat(), ..report },
     })
+}
+
+/// tobj's error `e` with the line it comes from: the first line `n` such that the file's first
+/// `n` lines fail to parse (tobj's errors are about one line and what precedes it, so this is
+/// where it stopped). Only on the error path: about log2(lines) parses of a prefix.
+fn located(bytes: &[u8], options: &tobj::LoadOptions, e: &tobj::LoadError) -> String {
+    let ends: Vec<usize> = bytes.iter().enumerate().filter(|(_, b)| **b == b'\n').map(|(i, _)| i + 1).chain([bytes.len()]).collect();
+    let fails = |n: usize| tobj::load_obj_buf(&mut &bytes[..ends[n - 1]], options, |_| Ok(Default::default())).is_err();
+    let (mut lo, mut hi) = (1usize, ends.len());
+    if !fails(hi) {
+        return format!("malformed OBJ: {e}");
+    }
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if fails(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    let start = if lo > 1 { ends[lo - 2] } else { 0 };
+    let text = String::from_utf8_lossy(&bytes[start..ends[lo - 1]]);
+    let text: String = text.trim().chars().take(60).collect();
+    format!("line {lo}: malformed OBJ: {e} ('{text}')")
 }
 
 /// Checks that every index of every `f`/`l` statement refers to an element defined before it

@@ -69,3 +69,31 @@ pub const NORMAL_OFFSET: ParamDef = ParamDef::number(
 
 /// The whole bias family at its shared defaults, in listing order.
 pub const BIAS_FAMILY: [ParamDef; 4] = [BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET];
+
+crate::param_set! {
+    /// The bias family as one block: constant, slope-scaled (with its clamp) and normal offset,
+    /// in texels of the technique's map.
+    pub struct Bias {
+        pub bias: f64 = BIAS,
+        pub slope_bias: f64 = SLOPE_BIAS,
+        pub max_slope: f64 = MAX_SLOPE,
+        pub normal_offset: f64 = NORMAL_OFFSET,
+    }
+}
+
+impl Bias {
+    /// `max_slope` clamps only the slope bias and the PCF kernel's bias: with neither
+    /// (`slope_bias=0`, `pcf=1`) it does nothing.
+    pub fn ineffective(&self, pcf: u32) -> Vec<(&'static str, String)> {
+        if self.slope_bias == 0.0 && pcf == 1 {
+            vec![("max_slope", "it clamps the slope bias and the PCF kernel's bias, and slope_bias=0, pcf=1".into())]
+        } else {
+            vec![]
+        }
+    }
+
+    /// `[bias, slope_bias, normal_offset, max_slope]`, the order of the WGSL `bias` vectors.
+    pub fn packed(&self) -> [f32; 4] {
+        [self.bias as f32, self.slope_bias as f32, self.normal_offset as f32, self.max_slope as f32]
+    }
+}

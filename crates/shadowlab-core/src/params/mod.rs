@@ -11,6 +11,9 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 pub mod family;
+mod set;
+
+pub use set::{check_table, declare_choice, read_choice, Block, Field, ParamSet, ParamTable};
 
 /// What values a parameter takes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -204,7 +207,7 @@ impl TechniqueSpec {
     /// Resolves the arguments against a parameter table: unknown keys, non-numbers, fractions
     /// for integer parameters and out-of-range values are errors naming the valid choices.
     pub fn resolve(&self, defs: &[ParamDef]) -> Result<ParamValues, String> {
-        let mut values: BTreeMap<String, Value> = defs.iter().map(|d| (d.key.to_string(), d.default_value())).collect();
+        let mut values = ParamValues::defaults(defs).0;
         for (k, v) in &self.args {
             let def = defs.iter().find(|d| d.key == k).ok_or_else(|| {
                 let keys: Vec<_> = defs.iter().map(|d| d.key).collect();
@@ -220,51 +223,22 @@ impl TechniqueSpec {
     }
 }
 
-/// Resolved parameter values (every declared key present), typed. Reading a key the
-/// technique did not declare, or with the accessor of another kind, panics: a programming
-/// error that the registry tests find (every technique is run, and its sources are checked).
+/// Resolved parameter values (every declared key present), as the user wrote them: what
+/// `metrics.json` records and a spec is written back from. A technique reads them once into
+/// its typed settings ([`ParamSet::from_values`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(transparent)]
 pub struct ParamValues(pub BTreeMap<String, Value>);
 
 impl ParamValues {
-    fn value(&self, key: &str) -> &Value {
-        self.0.get(key).unwrap_or_else(|| panic!("parameter '{key}' not declared"))
+    /// Every parameter of `defs` at its default.
+    pub fn defaults(defs: &[ParamDef]) -> ParamValues {
+        ParamValues(defs.iter().map(|d| (d.key.to_string(), d.default_value())).collect())
     }
-    /// A number or whole-number parameter.
-    pub fn get(&self, key: &str) -> f64 {
-        match self.value(key) {
-            Value::Number(x) => *x,
-            Value::Integer(i) => *i as f64,
-            v => panic!("parameter '{key}' is {v:?}, not a number"),
-        }
-    }
-    /// A whole-number parameter.
-    pub fn get_u32(&self, key: &str) -> u32 {
-        match self.value(key) {
-            Value::Integer(i) => *i as u32,
-            v => panic!("parameter '{key}' is {v:?}, not a whole number"),
-        }
-    }
-    /// An on/off parameter ([`ParamDef::flag`]).
-    pub fn get_bool(&self, key: &str) -> bool {
-        match self.value(key) {
-            Value::Flag(b) => *b,
-            v => panic!("parameter '{key}' is {v:?}, not a flag"),
-        }
-    }
-    /// The name chosen for a [`ParamDef::choice`] parameter.
-    pub fn choice(&self, key: &str) -> &str {
-        match self.value(key) {
-            Value::Choice(s) => s,
-            v => panic!("parameter '{key}' is {v:?}, not a choice"),
-        }
-    }
-    /// The position of the chosen name in `names` (the choice's declared names), for code that
-    /// maps a choice to a shader's mode number.
-    pub fn choice_index(&self, key: &str, names: &[&str]) -> usize {
-        let name = self.choice(key);
-        names.iter().position(|n| *n == name).unwrap_or_else(|| panic!("parameter '{key}': '{name}' is not one of {names:?}"))
+    /// The value of `key`, for code that works on tables (listings, widgets, spec text);
+    /// techniques read their typed settings ([`ParamSet::from_values`]) instead.
+    pub fn value(&self, key: &str) -> Option<&Value> {
+        self.0.get(key)
     }
     /// `key=value,...` in key order, as a spec writes them.
     pub fn to_spec_args(&self) -> String {
@@ -284,9 +258,9 @@ mod tests {
     #[test]
     fn choices_and_flags_stay_names() {
         let v = TechniqueSpec::parse("x:select=sort,sd=false").unwrap().resolve(DEFS).unwrap();
-        assert_eq!((v.choice("select"), v.get_bool("sd")), ("sort", false));
+        assert_eq!((v.value("select"), v.value("sd")), (Some(&Value::Choice("sort".into())), Some(&Value::Flag(false))));
         let v = TechniqueSpec::parse("x:sd=1,select=1").unwrap().resolve(DEFS).unwrap();
-        assert!(v.get_bool("sd") && v.choice("select") == "sort");
+        assert_eq!((v.value("select"), v.value("sd")), (Some(&Value::Choice("sort".into())), Some(&Value::Flag(true))));
         let e = TechniqueSpec::parse("x:select=median").unwrap().resolve(DEFS).unwrap_err();
         assert!(e.contains("minmax, sort"), "{e}");
         assert!(TechniqueSpec::parse("x:sd=2").unwrap().resolve(DEFS).is_err());
@@ -299,26 +273,15 @@ mod tests {
         assert_eq!(v.to_spec_args(), "bias=0.5,res=512,sd=true,select=sort");
     }
     #[test]
-    #[should_panic(expected = "not a number")]
-    fn reading_a_flag_as_a_number_panics() {
-        TechniqueSpec::parse("x").unwrap().resolve(DEFS).unwrap().get("sd");
-    }
-    #[test]
-    #[should_panic(expected = "not declared")]
-    fn reading_an_undeclared_key_panics() {
-        TechniqueSpec::parse("x").unwrap().resolve(DEFS).unwrap().get("window");
-    }
-    #[test]
     fn parse_and_resolve() {
         let s = TechniqueSpec::parse("sm:res=2048, bias=1.5,label=big").unwrap();
         assert_eq!(s.name, "sm");
         assert_eq!(s.label(), "big");
         let v = s.resolve(DEFS).unwrap();
-        assert_eq!((v.get("res"), v.get_u32("res")), (2048.0, 2048));
-        assert_eq!(v.get("bias"), 1.5);
+        assert_eq!((v.value("res"), v.value("bias")), (Some(&Value::Integer(2048)), Some(&Value::Number(1.5))));
         let d = TechniqueSpec::parse("sm").unwrap();
         assert_eq!(d.label(), "sm");
-        assert_eq!(d.resolve(DEFS).unwrap().get("res"), 512.0);
+        assert_eq!(d.resolve(DEFS).unwrap(), ParamValues::defaults(DEFS));
     }
     #[test]
     fn errors_are_specific() {

@@ -38,18 +38,20 @@ pub const SEARCH_SIZES: [u32; 4] = [9, 25, 49, 81];
 /// needs more bias on slopes); smaller is impossible for a centred region.
 pub const DEFAULT_Q: u32 = 9;
 
-/// How the n - 1 additional depths are chosen from the q samples (seed 003 section 4.3).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Select {
-    /// O(q): extremes of the region. n = 2: the extreme (min or max) farther from the base depth
-    /// (the paper says "maximum or minimum"; taking the farther one softens both sides of an
-    /// edge symmetrically, ties take the minimum); n = 3: min and max (the paper's own 3-SM);
-    /// n = 4: min, max and the second extreme on the farther side (2nd smallest or 2nd largest).
-    MinMax,
-    /// O(q log q): sort the q samples, split them into n groups of equal count; the group that
-    /// holds the base depth (at the middle of its run of equal values) is represented by the base
-    /// depth, every other group by its median (lower median for even counts).
-    Sort,
+crate::param_choice! {
+    /// How the n - 1 additional depths are chosen from the q samples (seed 003 section 4.3;
+    /// `mdsm`'s `select`).
+    pub enum Select {
+        /// O(q): extremes of the region. n = 2: the extreme (min or max) farther from the base depth
+        /// (the paper says "maximum or minimum"; taking the farther one softens both sides of an
+        /// edge symmetrically, ties take the minimum); n = 3: min and max (the paper's own 3-SM);
+        /// n = 4: min, max and the second extreme on the farther side (2nd smallest or 2nd largest).
+        MinMax = "minmax",
+        /// O(q log q): sort the q samples, split them into n groups of equal count; the group that
+        /// holds the base depth (at the middle of its run of equal values) is represented by the base
+        /// depth, every other group by its median (lower median for even counts).
+        Sort = "sort",
+    }
 }
 
 impl Select {

@@ -294,7 +294,7 @@ impl<'a> Lab<'a> {
     pub fn instantiate(&self, spec: &Resolved, light: &Light) -> Result<Instance, GpuError> {
         spec.check_light(light)?;
         let t0 = std::time::Instant::now();
-        let tech = (spec.info.create)(self.gpu, &self.gscene, &spec.values, light)?;
+        let tech = spec.info.create(self.gpu, &self.gscene, &spec.values, light)?;
         self.gpu.take_error()?;
         Ok(Instance {
             label: spec.label.clone(),

@@ -2,7 +2,7 @@
 //! scene BVH in a compute shader (no hardware ray tracing needed). It is also registered as a
 //! technique so its cost can be compared with the others.
 
-use shadowlab_core::params::ParamDef;
+use shadowlab_core::params::ParamTable;
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -30,7 +30,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "exact (the reference all others are measured against); honours alpha cut-outs",
     source: "Whitted 1980; BVH by obvhs (PLOC + SAH reinsertion)",
     lights: &["directional", "spot", "point"],
-    params: &[] as &[ParamDef],
+    params: ParamTable::NONE,
     stalls: "",
     needs: "9 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[],

@@ -137,7 +137,7 @@ fn technique(app: &mut App, ui: &mut egui::Ui, right: bool) {
     }
     ui.label(format!("spec: {}", cur.text));
     let mut change = None;
-    for d in cur.info.params {
+    for d in cur.info.params() {
         let mut v = cur.values.0[d.key].clone();
         if widgets::edit(ui, d, &mut v).changed() {
             change = Some((d.key, v.to_string()));

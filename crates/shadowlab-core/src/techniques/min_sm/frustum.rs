@@ -221,13 +221,14 @@ impl Reduction {
     }
 }
 
-/// Which rectangle around the hull the map covers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RectFit {
-    /// Minimum area (the seeds' MSF): most texels on the samples, texels may be stretched.
-    Area,
-    /// Shortest longer side: the smallest texel side (square texels in a square map).
-    Side,
+crate::param_choice! {
+    /// Which rectangle around the hull the map covers (`min-sm`'s `fit`).
+    pub enum RectFit {
+        /// Minimum area (the seeds' MSF): most texels on the samples, texels may be stretched.
+        Area = "area",
+        /// Shortest longer side: the smallest texel side (square texels in a square map).
+        Side = "side",
+    }
 }
 
 /// A fitted minimal shadow frustum.

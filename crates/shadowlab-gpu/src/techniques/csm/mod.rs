@@ -19,12 +19,12 @@ mod sdsm;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use shadowlab_core::light::Light;
-use shadowlab_core::params::ParamValues;
+use shadowlab_core::params::{ParamSet, ParamTable};
 use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 
 pub use params::*;
 pub(crate) use sdsm::{decode_bounds, BoundsReduce, OUT_WORDS as SDSM_OUT_WORDS};
-pub use sdsm::{SdsmReduce, OUT_BYTES as SDSM_BOUNDS_BYTES, SDSM_INFO, SDSM_PARAMS};
+pub use sdsm::{SdsmReduce, SdsmSettings, OUT_BYTES as SDSM_BOUNDS_BYTES, SDSM_INFO};
 
 use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, MinMax};
@@ -47,13 +47,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "texel size grows with distance like the view's footprint; seams at cascade switches; no shimmer when snapped",
     source: "Engel 2006; Zhang et al. 2006 (practical splits); seed 001 chapter 2.3 and 4; SDSM (Lauritzen 2011) for tightening",
     lights: &["directional"],
-    params: PARAMS,
+    params: ParamTable::of::<CsmSettings>(),
     stalls:
         "with tighten=true (default): csm.readback, the view depth range read back before the fit; tighten=false, or delayed=true (the previous frame's range), records without a stall",
     needs: "",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, &CsmSettings::from_values(p), light)?)),
 };
 
 /// WGSL `Cascade` (eval.wgsl).
@@ -122,6 +122,15 @@ pub struct Cascaded {
     sample_fit: Option<sdsm::SampleFit>,
 }
 
+/// The settings `csm` and `sdsm` both declare, as [`Cascaded::build`] reads them.
+struct Shared<'a> {
+    maps: &'a CascadeMaps,
+    lookup: &'a CascadeLookup,
+    lambda: f64,
+    blend: f64,
+    snap: bool,
+}
+
 fn texture_depth_array() -> wgpu::BindingType {
     wgpu::BindingType::Texture {
         sample_type: wgpu::TextureSampleType::Depth,
@@ -131,40 +140,33 @@ fn texture_depth_array() -> wgpu::BindingType {
 }
 
 impl Cascaded {
-    /// `csm`.
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<Cascaded, GpuError> {
-        let mut t = Cascaded::build(gpu, scene, p, light, "csm")?;
-        let count = t.count;
-        let manual: Vec<f32> = ["split1", "split2", "split3"].iter().map(|k| p.get(k) as f32).filter(|x| *x > 0.0).collect();
-        if !manual.is_empty() && manual.len() + 1 != count {
-            return Err(GpuError::Invalid(format!(
-                "csm: {} cascades need {} manual split distances (split1..), got {}",
-                count,
-                count - 1,
-                manual.len()
-            )));
-        }
-        t.manual = manual;
-        t.fit = if p.choice("fit") == "sphere" { Fit::Sphere } else { Fit::Box };
-        t.tighten = p.get_bool("tighten");
-        t.delayed = (t.tighten && p.get_bool("delayed")).then(|| DelayedRead::new(gpu, "csm.delayed", PROBE_BYTES));
+    /// `csm` (settings that break [`CsmSettings`]'s rules are an error).
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &CsmSettings, light: &Light) -> Result<Cascaded, GpuError> {
+        p.validate().map_err(|e| GpuError::Invalid(format!("csm: {e}")))?;
+        let shared = Shared { maps: &p.maps, lookup: &p.lookup, lambda: p.lambda, blend: p.blend, snap: p.snap };
+        let mut t = Cascaded::build(gpu, scene, light, "csm", shared)?;
+        t.manual = p.manual_splits().into_iter().map(|(_, d)| d).collect();
+        t.fit = p.fit.into();
+        t.tighten = p.tighten;
+        t.delayed = (t.tighten && p.delayed).then(|| DelayedRead::new(gpu, "csm.delayed", PROBE_BYTES));
         Ok(t)
     }
 
     /// `sdsm`: the cascades of `csm` fitted to the view samples (sdsm.rs).
-    pub fn new_sdsm(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<Cascaded, GpuError> {
-        let mut t = Cascaded::build(gpu, scene, p, light, "sdsm")?;
+    pub fn new_sdsm(gpu: &Gpu, scene: &GpuScene, p: &SdsmSettings, light: &Light) -> Result<Cascaded, GpuError> {
+        let shared = Shared { maps: &p.maps, lookup: &p.lookup, lambda: p.lambda, blend: p.blend, snap: p.snap };
+        let mut t = Cascaded::build(gpu, scene, light, "sdsm", shared)?;
         t.sample_fit = Some(sdsm::SampleFit::new(gpu, p, t.dir, t.count));
         Ok(t)
     }
 
     /// What `csm` and `sdsm` share, from the parameters both declare.
-    fn build(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, name: &'static str) -> Result<Cascaded, GpuError> {
+    fn build(gpu: &Gpu, scene: &GpuScene, light: &Light, name: &'static str, p: Shared) -> Result<Cascaded, GpuError> {
         let Light::Directional { direction } = *light else {
             return Err(GpuError::Invalid(format!("{name} supports directional lights only (got a {} light)", light.kind())));
         };
-        let count = p.get_u32("cascades") as usize;
-        let res = p.get_u32("res");
+        let count = p.maps.cascades as usize;
+        let res = p.maps.res;
         gpu.check_size(res, res, "cascade map")?;
         let d = &gpu.device;
         let maps = raster::depth_target(gpu, "csm.maps", res, res, count as u32, wgpu::TextureUsages::empty());
@@ -172,11 +174,11 @@ impl Cascaded {
             cascades: [CascadeU::zeroed(); MAX_CASCADES],
             count: count as f32,
             res: res as f32,
-            pcf: p.get("pcf") as f32,
-            blend: p.get("blend") as f32,
-            bias: p.get("bias") as f32,
-            normal_offset: p.get("normal_offset") as f32,
-            max_slope: p.get("max_slope") as f32,
+            pcf: p.lookup.pcf as f32,
+            blend: p.blend as f32,
+            bias: p.lookup.bias as f32,
+            normal_offset: p.lookup.normal_offset as f32,
+            max_slope: p.lookup.max_slope as f32,
             pad0: 0.0,
         };
         let uniform = gpu.uniform("csm.params", &params);
@@ -197,13 +199,13 @@ impl Cascaded {
             name,
             count,
             res,
-            lambda: p.get("lambda") as f32,
+            lambda: p.lambda as f32,
             manual: Vec::new(),
-            snap: p.get_bool("snap"),
+            snap: p.snap,
             fit: Fit::Box,
             tighten: false,
             delayed: None,
-            pcf: p.get_u32("pcf"),
+            pcf: p.lookup.pcf,
             dir: direction,
             params,
             boxes: Vec::new(),

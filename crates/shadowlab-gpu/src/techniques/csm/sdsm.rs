@@ -13,11 +13,11 @@ use std::collections::BTreeMap;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use shadowlab_core::camera::Camera;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::{Block, ParamDef, ParamSet, ParamTable};
 use shadowlab_core::techniques::csm::{self as cascades, light_view, CascadeBox, Fit, ViewFrustum, DEPTH_STEPS_PER_OCTAVE};
 use shadowlab_core::techniques::sdsm::{self as fit, CameraMotion, FittedBox, SampleBounds};
 
-use super::{Cascaded, BIAS_PARAM, BLEND, CASCADES, MAX_SLOPE_PARAM, NORMAL_OFFSET_PARAM, PCF_PARAM, RES_PARAM};
+use super::{CascadeLookup, CascadeMaps, Cascaded, BLEND, ONE_CASCADE_BLEND};
 use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, from_order_key, ORDER_KEY_WGSL};
 use crate::technique::{FrameInputs, TechniqueInfo};
@@ -45,28 +45,41 @@ pub const SDSM_INFO: TechniqueInfo = TechniqueInfo {
     quality: "texels only where view samples are: finer than csm's slice fits, most where the view sees little of each slice; snapped sizes barely shimmer; delayed lags one frame",
     source: "Lauritzen, Salvi, Lefohn 2011 (I3D, sample distribution shadow maps); csm (Engel 2006) for the rest",
     lights: &["directional"],
-    params: SDSM_PARAMS,
+    params: ParamTable::of::<SdsmSettings>(),
     stalls: "with delayed=false (default): sdsm.readback, the depth range, splits and per-cascade sample bounds read back before the fit; delayed=true (the previous frame's, frame 0 the frustum-slice fit) records without a stall",
     needs: "",
     // not in the default compare set (its cost is csm's, but the set's time is documented)
     compare: &[],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new_sdsm(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new_sdsm(gpu, scene, &SdsmSettings::from_values(p), light)?)),
 };
 
-pub const SDSM_PARAMS: &[ParamDef] = &[
-    CASCADES,
-    RES_PARAM,
-    ParamDef::number("lambda", fit::DEFAULT_LAMBDA as f64, 0.0, 1.0, "split blend between the samples' min and max depth: 1 logarithmic, 0 uniform; low: coarse near cascade", "Lauritzen et al. 2011 section 3.1 (log partitioning of the tight range)"),
-    BLEND,
-    ParamDef::flag("snap", true, "snap each fitted box: half sides rounded up to 2^(1/16) steps (a fixed set of texel sizes, at most 9 % more area), kept from the last frame until the samples need 2 steps less, and the origin moved by whole texels of that size: the map does not shimmer while the size holds", "Valient 2008 (stable CSM) applied to fitted bounds; steps: shadowlab_core::techniques::sdsm::SIZE_STEPS_PER_OCTAVE"),
-    ParamDef::flag("delayed", false, "use the previous frame's reduction (splits and bounds, read back without a stall; frame 0 uses the frustum-slice fit) instead of this frame's (one sync), each cascade's bounds swept by `reach` x the camera's motion since; a sample outside its cascade's box tries the coarser cascades, then the finer ones, then counts as lit", "Lauritzen et al. 2011 (GPU-only fit) / shadowlab's recorded-frame seam (docs/bench/recorded_frame.md)"),
-    ParamDef::number("reach", 1.0, 0.0, 4.0, "with delayed: grow each cascade's last-frame sample bounds by this x the camera's motion since that frame (swept along how far the view moved at the cascade's far split: the step plus the turn's displacement there, shadowlab_core::techniques::sdsm::CameraMotion); 0: as read back; higher: more margin for what the motion uncovers, coarser texels while moving", "shadowlab (1 = the motion bound for points that stay in view); measured in docs/bench/sdsm.md"),
-    BIAS_PARAM,
-    NORMAL_OFFSET_PARAM,
-    PCF_PARAM,
-    MAX_SLOPE_PARAM,
-];
+shadowlab_core::param_set! {
+    /// `sdsm`'s parameters: `csm`'s maps and lookup, with the samples' split blend and the
+    /// delayed fit's reach.
+    pub struct SdsmSettings {
+        pub maps: CascadeMaps = Block::as_declared(),
+        pub lambda: f64 = ParamDef::number("lambda", fit::DEFAULT_LAMBDA as f64, 0.0, 1.0, "split blend between the samples' min and max depth: 1 logarithmic, 0 uniform; low: coarse near cascade", "Lauritzen et al. 2011 section 3.1 (log partitioning of the tight range)"),
+        pub blend: f64 = BLEND,
+        pub snap: bool = ParamDef::flag("snap", true, "snap each fitted box: half sides rounded up to 2^(1/16) steps (a fixed set of texel sizes, at most 9 % more area), kept from the last frame until the samples need 2 steps less, and the origin moved by whole texels of that size: the map does not shimmer while the size holds", "Valient 2008 (stable CSM) applied to fitted bounds; steps: shadowlab_core::techniques::sdsm::SIZE_STEPS_PER_OCTAVE"),
+        pub delayed: bool = ParamDef::flag("delayed", false, "use the previous frame's reduction (splits and bounds, read back without a stall; frame 0 uses the frustum-slice fit) instead of this frame's (one sync), each cascade's bounds swept by `reach` x the camera's motion since; a sample outside its cascade's box tries the coarser cascades, then the finer ones, then counts as lit", "Lauritzen et al. 2011 (GPU-only fit) / shadowlab's recorded-frame seam (docs/bench/recorded_frame.md)"),
+        pub reach: f64 = ParamDef::number("reach", 1.0, 0.0, 4.0, "with delayed: grow each cascade's last-frame sample bounds by this x the camera's motion since that frame (swept along how far the view moved at the cascade's far split: the step plus the turn's displacement there, shadowlab_core::techniques::sdsm::CameraMotion); 0: as read back; higher: more margin for what the motion uncovers, coarser texels while moving", "shadowlab (1 = the motion bound for points that stay in view); measured in docs/bench/sdsm.md"),
+        pub lookup: CascadeLookup = Block::as_declared(),
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            let mut v = Vec::new();
+            if self.maps.cascades == 1 {
+                v.push(("blend", ONE_CASCADE_BLEND.to_string()));
+            }
+            if !self.delayed {
+                v.push(("reach", "it sweeps the previous frame's bounds, and delayed=false fits this frame's".to_string()));
+            }
+            v.extend(self.lookup.ineffective());
+            v
+        }
+    }
+}
 
 /// WGSL `SdsmReduce` (sdsm_bounds.wgsl).
 #[repr(C)]
@@ -199,13 +212,13 @@ impl BoundsReduce {
 }
 
 impl SampleFit {
-    pub(super) fn new(gpu: &Gpu, p: &ParamValues, dir: Vec3, count: usize) -> SampleFit {
+    pub(super) fn new(gpu: &Gpu, p: &SdsmSettings, dir: Vec3, count: usize) -> SampleFit {
         let reduce_params = SdsmReduce {
             light_view: light_view(dir).to_cols_array_2d(),
             near: 0.0,
             far: 0.0,
             count: count as f32,
-            lambda: p.get("lambda") as f32,
+            lambda: p.lambda as f32,
             steps: DEPTH_STEPS_PER_OCTAVE,
             pad0: 0.0,
             pad1: 0.0,
@@ -216,12 +229,12 @@ impl SampleFit {
             uniform: gpu.uniform("sdsm.bounds", &reduce_params),
             reduce_params,
             out: gpu.storage("sdsm.bounds", OUT_BYTES),
-            delayed: p.get_bool("delayed").then(|| DelayedRead::new(gpu, "sdsm.delayed", OUT_BYTES)),
-            margin: 2.0 + p.get("normal_offset") as f32 + 0.5 * (p.get_u32("pcf") as f32 - 1.0),
+            delayed: p.delayed.then(|| DelayedRead::new(gpu, "sdsm.delayed", OUT_BYTES)),
+            margin: 2.0 + p.lookup.normal_offset as f32 + 0.5 * (p.lookup.pcf as f32 - 1.0),
             bounds: Vec::new(),
             fitted: Vec::new(),
             source: Source::SliceFit,
-            reach: if p.get_bool("delayed") { p.get("reach") as f32 } else { 0.0 },
+            reach: if p.delayed { p.reach as f32 } else { 0.0 },
             read_camera: None,
             swept: Vec::new(),
         }

@@ -18,7 +18,8 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::family::{Bias, PCF, RES};
+use shadowlab_core::params::{Block, ParamDef, ParamSet, ParamTable};
 use shadowlab_core::techniques::cube::{face_view_proj, FACES};
 
 use crate::record::Recorder;
@@ -28,7 +29,6 @@ use crate::technique::{compose_view, view_layout, FrameInputs, Technique, Techni
 use crate::techniques::pictures::{count_image, depth_image};
 use crate::techniques::sm::BIAS_WGSL;
 use crate::{binding, raster, Gpu, GpuError};
-use shadowlab_core::params::family::{BIAS, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
 
 /// The face rules (`shadowlab_core::techniques::cube`), also composed into `virtual`'s shaders.
 pub(crate) const FACES_WGSL: &str = include_str!("faces.wgsl");
@@ -50,10 +50,10 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     vec![("cube/depth.wgsl", depth_src()), ("cube/eval.wgsl", eval_src()), ("cube/split.wgsl", split_src())]
 }
 
-/// sm's parameters apply unchanged: `res` is per face (the seeds' 512), the bias is in texels of
-/// the face at the sample. sm's bias sweep was on directional/spot lights; see docs/bench/point.md
-/// for the point-light check.
-pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET, DEPTH];
+shadowlab_core::param_choice! {
+    /// How a face stores depth (`DEFAULT_DEPTH`).
+    pub enum FaceDepth { Distance = "distance", Hardware = "hardware" }
+}
 
 /// How a face stores depth. `distance` (0): the linear distance to the light written by the
 /// fragment stage (exact per fragment, but every fragment runs a shader and no early depth
@@ -64,7 +64,19 @@ pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_
 /// conference light 1 and sponza-peer (1024x1024; res 512, pcf 3, res 1024): the same wrong %
 /// to three decimals on all four, `cube.render` 3-8x faster (docs/bench/recorded_frame.md).
 pub const DEFAULT_DEPTH: f64 = 1.0;
-pub const DEPTH: ParamDef = ParamDef::choice("depth", &["distance", "hardware"], DEFAULT_DEPTH as usize, "face depth: distance (linear distance per fragment: a fragment shader on every fragment) or hardware (reversed near/z from the rasteriser, no fragment stage without cut-outs; distance recovered in the evaluation)", "distance: seed 002 3.3.1; hardware: the NoTW authors' app (depth-only faces); measured in docs/bench/recorded_frame.md");
+pub const DEPTH: ParamDef = ParamDef::choice("depth", FaceDepth::NAMES, DEFAULT_DEPTH as usize, "face depth: distance (linear distance per fragment: a fragment shader on every fragment) or hardware (reversed near/z from the rasteriser, no fragment stage without cut-outs; distance recovered in the evaluation)", "distance: seed 002 3.3.1; hardware: the NoTW authors' app (depth-only faces); measured in docs/bench/recorded_frame.md");
+
+shadowlab_core::param_set! {
+    /// `cube`'s parameters: sm's apply unchanged (`res` is per face, the seeds' 512; the bias is in
+    /// texels of the face at the sample; sm's bias sweep was on directional/spot lights, see
+    /// docs/bench/point.md for the point-light check), then how the faces store depth.
+    pub struct CubeSettings {
+        pub res: u32 = RES,
+        pub pcf: u32 = PCF,
+        pub bias: Bias = Block::as_declared(),
+        pub depth: FaceDepth = DEPTH,
+    }
+}
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "cube",
@@ -73,12 +85,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "as sm per face; the face the camera looks into gets all the view samples (seed 002 Fig. 5.6)",
     source: "seed 002 section 3.3.1 and chapter 5.3 (CubeSM)",
     lights: &["point"],
-    params: PARAMS,
+    params: ParamTable::of::<CubeSettings>(),
     stalls: "",
     needs: "",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(CubeMap::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(CubeMap::new(gpu, scene, &CubeSettings::from_values(p), light)?)),
 };
 
 use crate::techniques::warp as w;
@@ -145,42 +157,37 @@ pub const DEFAULT_NOTW_EDGE_IMPORTANCE: f64 = 8.0;
 const THREE_SETUPS: &str =
     "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md, point_quality.md)";
 
-/// notw's parameters (same keys, order, ranges and docs), with the window, blur, mix, subdivision,
-/// normal offset, bias footprint, smoothing tent and edge importance defaults measured for cube
-/// faces (tests/cube.rs checks the keys against notw's).
-pub const NOTW_PARAMS: &[ParamDef] = &[
-    w::RES,
-    w::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"),
-    w::NOTW_BLUR.with_default(DEFAULT_NOTW_BLUR, THREE_SETUPS),
-    w::MIX.with_default(DEFAULT_NOTW_MIX, THREE_SETUPS),
-    w::INTERP,
-    w::NOTW_SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, THREE_SETUPS),
-    w::SUBDIV_LEVELS,
-    w::SUBDIV_CAPACITY,
-    w::MIN_PIECE,
-    w::CLOSE_CRACKS,
-    w::NOTW_EXACT,
-    w::PCF,
-    w::NOTW_BIAS,
-    w::SLOPE,
-    w::MAX_SLOPE,
-    w::NORMAL_OFFSET.with_default(DEFAULT_NOTW_NORMAL_OFFSET, THREE_SETUPS),
-    w::DV_MARGIN,
-    w::STRENGTH,
-    w::BIAS_MODE.with_default(DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS),
-    w::FOOTPRINT_CAP,
-    w::DEPTH_CLAMP,
-    w::EXACT_INVERSE,
-    w::CULL_HIDDEN,
-    w::WINDOW_TENT.with_default(
-        DEFAULT_NOTW_WINDOW_TENT,
-        "shadowlab: chosen on sibenik, checked on room, courtyard lantern, conference and eaves point lights (BENCHMARKS.md, issue 18)",
-    ),
-    w::EDGE_IMPORTANCE.with_default(
-        DEFAULT_NOTW_EDGE_IMPORTANCE,
-        "shadowlab: chosen on room and sibenik, checked on conference, courtyard lantern and eaves point lights (BENCHMARKS.md, issue 18)",
-    ),
-];
+shadowlab_core::param_set! {
+    /// `cube-notw`'s parameters: notw's (same keys, order, ranges and docs: each face is a `notw`
+    /// map), with the window, blur, mix, subdivision, normal offset, bias footprint, smoothing
+    /// tent and edge importance defaults measured for cube faces (tests/cube.rs checks the rows
+    /// against notw's).
+    pub struct CubeNotwSettings {
+        pub notw: w::NotwSettings = Block::as_declared()
+            .with(w::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"))
+            .with(w::NOTW_BLUR.with_default(DEFAULT_NOTW_BLUR, THREE_SETUPS))
+            .with(w::MIX.with_default(DEFAULT_NOTW_MIX, THREE_SETUPS))
+            .with(w::NOTW_SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, THREE_SETUPS))
+            .with(w::NORMAL_OFFSET.with_default(DEFAULT_NOTW_NORMAL_OFFSET, THREE_SETUPS))
+            .with(w::BIAS_MODE.with_default(DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS))
+            .with(w::WINDOW_TENT.with_default(
+                DEFAULT_NOTW_WINDOW_TENT,
+                "shadowlab: chosen on sibenik, checked on room, courtyard lantern, conference and eaves point lights (BENCHMARKS.md, issue 18)",
+            ))
+            .with(w::EDGE_IMPORTANCE.with_default(
+                DEFAULT_NOTW_EDGE_IMPORTANCE,
+                "shadowlab: chosen on room and sibenik, checked on conference, courtyard lantern and eaves point lights (BENCHMARKS.md, issue 18)",
+            )),
+    }
+    rules {
+        fn validate(&self) -> Result<(), String> {
+            self.notw.validate()
+        }
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.notw.ineffective()
+        }
+    }
+}
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "cube-notw",
@@ -189,12 +196,12 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     quality: "spreads the view samples over each face; faces with few samples gain little",
     source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
     lights: &["point"],
-    params: NOTW_PARAMS,
+    params: ParamTable::of::<CubeNotwSettings>(),
     stalls: "cube-notw.face_samples: the samples per face are read back to skip empty faces",
     needs: "12 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(CubeNotw::new(gpu, scene, &CubeNotwSettings::from_values(p), light)?)),
 };
 
 /// The light's position, or a clear error for other lights.
@@ -254,13 +261,13 @@ pub struct CubeMap {
 }
 
 impl CubeMap {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<CubeMap, GpuError> {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &CubeSettings, light: &Light) -> Result<CubeMap, GpuError> {
         let pos = point_position("cube", light)?;
-        let (res, pcf) = (p.get_u32("res"), p.get_u32("pcf"));
+        let (res, pcf) = (p.res, p.pcf);
         gpu.check_size(res, res, "cube face")?;
         let far = bounds_far(scene, pos);
         let near = (far * 1e-4).max(1e-5);
-        let hardware = p.choice("depth") == "hardware";
+        let hardware = p.depth == FaceDepth::Hardware;
         let d = &gpu.device;
         let map = raster::depth_target(gpu, "cube.map", res, res, 6, wgpu::TextureUsages::empty());
         let face_layout = binding::layout(d, "cube.depth", wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
@@ -280,15 +287,7 @@ impl CubeMap {
         let depth_pipeline = face_pipeline(gpu, &module, "cube.render", &layouts, hardware, true, scene.has_cutouts);
         let static_pipeline = face_pipeline(gpu, &module, "cube.render.static", &layouts, hardware, false, scene.has_cutouts);
         let face_indices = static_face_lists(gpu, scene, pos);
-        let params = CubeParams {
-            position: pos.into(),
-            far,
-            res: res as f32,
-            pcf: pcf as f32,
-            near,
-            pad0: 0.0,
-            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
-        };
+        let params = CubeParams { position: pos.into(), far, res: res as f32, pcf: pcf as f32, near, pad0: 0.0, bias: p.bias.packed() };
         let array = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Depth,
             view_dimension: wgpu::TextureViewDimension::D2Array,
@@ -520,4 +519,24 @@ fn face_pipeline(
         multiview_mask: None,
         cache: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::techniques::warp::tests::{error, keys};
+
+    #[test]
+    fn the_tables_keep_their_keys_in_order_and_the_rules_apply() {
+        assert_eq!(keys::<CubeSettings>(), ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "depth"]);
+        // each face is a notw map: notw's rows, eight of them with other defaults (tests/cube.rs)
+        assert_eq!(keys::<CubeNotwSettings>(), keys::<w::NotwSettings>());
+        assert_eq!(keys::<CubeNotwSettings>().len(), 25);
+        assert_eq!(CubeSettings::defaults().depth, FaceDepth::Hardware);
+        assert_eq!(error("cube-notw:res=64"), "technique 'cube-notw': window 128 must be below res 64");
+        assert!(error("cube-notw:subdiv=0,cull_hidden=true").contains("cull_hidden has no effect: subdiv=0"));
+        for ok in ["cube:depth=distance,pcf=3", "cube-notw:res=256", "cube-notw:res=256,window=64,cull_hidden=true"] {
+            assert_eq!(error(ok), "", "{ok}");
+        }
+    }
 }

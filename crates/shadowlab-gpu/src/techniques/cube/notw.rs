@@ -10,16 +10,15 @@
 
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::params::ParamValues;
 use shadowlab_core::techniques::cube::FACES;
 
-use super::{clip, point_position, split_src};
+use super::{clip, point_position, split_src, CubeNotwSettings};
 use crate::frame::LightUniform;
 use crate::gbuffer::GBuffer;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{view_layout, FrameInputs, Technique, TechniqueReport};
-use crate::techniques::warp::{Variant, Warped};
+use crate::techniques::warp::{Knobs, Warped};
 use crate::{binding, Gpu, GpuError};
 
 /// The names of the images of a face's `Warped` report that `cube-notw` passes on.
@@ -50,14 +49,13 @@ pub struct CubeNotw {
 }
 
 impl CubeNotw {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<CubeNotw, GpuError> {
+    /// The six faces, each a `notw` map of `p.notw` (its window checked against `res` by
+    /// [`CubeNotwSettings`]'s rules).
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &CubeNotwSettings, light: &Light) -> Result<CubeNotw, GpuError> {
         let position = point_position("cube-notw", light)?;
-        let res = p.get_u32("res");
+        let res = p.notw.res;
         gpu.check_size(res, res, "cube face")?;
-        let window = p.get("window");
-        if window >= res as f64 {
-            return Err(GpuError::Invalid(format!("cube-notw: window {window} must be below res {res} (e.g. window={})", res / 2)));
-        }
+        let knobs = Knobs::notw(&p.notw);
         // near plane of lightspace::fit's spot frustum; clip a little in front of it and a few
         // texels outside the map's square (fit adds one texel of margin)
         let far = scene.bounds.corners().iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
@@ -75,7 +73,7 @@ impl CubeNotw {
             let face_scene = scenes[f].take().expect("each face once");
             // one face = a spot light along the axis whose fitted frustum is the face's square
             let light = Light::Spot { position, direction: FACES[f].n, cone_deg: 45.0 };
-            let warped = Warped::new_sharing(gpu, &face_scene, p, &light, Variant::Notw, shared.as_ref())?;
+            let warped = Warped::new_sharing(gpu, &face_scene, &knobs, &light, shared.as_ref())?;
             shared.get_or_insert_with(|| warped.subdiv_scratch());
             built[f] = Some(Face {
                 warped,

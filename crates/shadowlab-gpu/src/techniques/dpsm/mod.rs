@@ -14,14 +14,14 @@
 
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::params::family;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::family::{self, Bias};
+use shadowlab_core::params::{Block, ParamDef, ParamSet, ParamTable};
 use shadowlab_core::techniques::dpsm::{split_axis, DualParaboloid, Hemisphere, SPLIT_AXES};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::techniques::warp::{self, Projection, Variant, Warped};
+use crate::techniques::warp::{self, Knobs, NotwCore, Projection, Subdivision, Warped};
 use crate::{Gpu, GpuError};
 
 /// Side of each hemisphere's map (texels). The setting: 512 per hemisphere against
@@ -102,52 +102,63 @@ const NOTW_NORMAL_OFFSET: ParamDef = family::NORMAL_OFFSET
 pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
 const EXACT: ParamDef = warp::EXACT_DEPTH.with_default(DEFAULT_EXACT_DEPTH, "shadowlab (docs/bench/point.md)").with_doc("write the exact depth per fragment: the distance along the fragment's direction (warp inverted by Newton steps for dpsm-notw) to its triangle's plane; false = depth interpolated between (warped) vertices, off along chords of the paraboloid; disables early depth test");
 
-pub const DPSM_PARAMS: &[ParamDef] = &[
-    RES,
-    SPLIT,
-    DPSM_SUBDIV,
-    warp::SUBDIV_LEVELS,
-    warp::SUBDIV_CAPACITY,
-    warp::MIN_PIECE,
-    EXACT,
-    family::PCF,
-    DPSM_BIAS,
-    family::SLOPE_BIAS,
-    family::MAX_SLOPE,
-    family::NORMAL_OFFSET,
-    warp::BIAS_MODE_ISOTROPIC,
-    warp::FOOTPRINT_CAP,
-    warp::DEPTH_CLAMP,
-];
-pub const NOTW_PARAMS: &[ParamDef] = &[
-    RES,
-    SPLIT,
-    NOTW_WINDOW,
-    NOTW_BLUR,
-    warp::MIX,
-    warp::INTERP,
-    NOTW_SUBDIV,
-    warp::SUBDIV_LEVELS,
-    warp::SUBDIV_CAPACITY,
-    warp::MIN_PIECE,
-    warp::CLOSE_CRACKS,
-    EXACT,
-    family::PCF,
-    NOTW_BIAS,
-    family::SLOPE_BIAS,
-    family::MAX_SLOPE,
-    NOTW_NORMAL_OFFSET,
-    warp::DV_MARGIN,
-    warp::STRENGTH,
-    warp::BIAS_MODE.with_default(
-        DEFAULT_NOTW_BIAS_MODE,
-        "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point_quality.md)",
-    ),
-    warp::FOOTPRINT_CAP,
-    warp::DEPTH_CLAMP,
-    warp::EXACT_INVERSE,
-    warp::WINDOW_TENT,
-];
+const NOTW_BIAS_MODE: ParamDef = warp::BIAS_MODE.with_default(
+    DEFAULT_NOTW_BIAS_MODE,
+    "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point_quality.md)",
+);
+
+shadowlab_core::param_choice! {
+    /// The split axis (`SPLIT`): the names of `SPLIT_AXES`, in its order.
+    pub enum Split { Y = "y", X = "x", Z = "z" }
+}
+
+shadowlab_core::param_set! {
+    /// `dpsm`'s parameters: the map side and split, the subdivision of the paraboloid mapping,
+    /// exact depth, sm's lookup and bias (no warp, so no footprint mode; a paraboloid map clamps
+    /// the exact depth to the piece's distance range, so no depth clamp).
+    pub struct DpsmSettings {
+        pub res: u32 = RES,
+        pub split: Split = SPLIT,
+        pub subdivision: Subdivision = Block::as_declared().with(DPSM_SUBDIV),
+        pub exact_depth: bool = EXACT,
+        pub pcf: u32 = family::PCF,
+        pub bias: Bias = Block::as_declared().with(DPSM_BIAS),
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.subdivision.dead()
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `dpsm-notw`'s parameters: the map side and split, then NoTW's block (as `notw`'s, with
+    /// sm's docs for the lookup and bias rows and the defaults measured for paraboloid maps) and
+    /// the smoothing's tent.
+    pub struct DpsmNotwSettings {
+        pub res: u32 = RES,
+        pub split: Split = SPLIT,
+        pub core: NotwCore = Block::as_declared()
+            .with(NOTW_WINDOW)
+            .with(NOTW_BLUR)
+            .with(NOTW_SUBDIV)
+            .with(EXACT)
+            .with(family::PCF)
+            .with(NOTW_BIAS)
+            .with(family::SLOPE_BIAS)
+            .with(NOTW_NORMAL_OFFSET)
+            .with(NOTW_BIAS_MODE),
+        pub window_tent: bool = warp::WINDOW_TENT,
+    }
+    rules {
+        fn validate(&self) -> Result<(), String> {
+            self.core.validate_at(self.res)
+        }
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.core.dead(true)
+        }
+    }
+}
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "dpsm",
@@ -156,12 +167,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "resolution fixed per solid angle (twice as fine at the rim as at the centre), blind to the view: aliasing near the camera",
     source: "Brabec, Annen, Seidel 2002; seed 002 section 3.3.2 (eq. 3.3-3.10)",
     lights: &["point"],
-    params: DPSM_PARAMS,
+    params: ParamTable::of::<DpsmSettings>(),
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     compare: &[""],
     shaders: crate::techniques::warp::shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, false)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Dpsm::plain(gpu, scene, &DpsmSettings::from_values(p), light)?)),
 };
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
@@ -171,12 +182,12 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     quality: "the view samples of each hemisphere spread over its whole map; seam at the split plane",
     source: "seed 002 section 5.3 (DPSM with NoTW), seed 000 section 3",
     lights: &["point"],
-    params: NOTW_PARAMS,
+    params: ParamTable::of::<DpsmNotwSettings>(),
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     compare: &[""],
     shaders: crate::techniques::warp::shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Dpsm::new(gpu, scene, p, light, true)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Dpsm::notw(gpu, scene, &DpsmNotwSettings::from_values(p), light)?)),
 };
 
 /// A point light's two hemisphere maps.
@@ -188,30 +199,37 @@ pub struct Dpsm {
 }
 
 impl Dpsm {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, warped: bool) -> Result<Dpsm, GpuError> {
+    /// `dpsm`: the two plain paraboloid maps.
+    pub fn plain(gpu: &Gpu, scene: &GpuScene, p: &DpsmSettings, light: &Light) -> Result<Dpsm, GpuError> {
+        Dpsm::new(gpu, scene, &Knobs::dpsm(p), p.split, light, false)
+    }
+
+    /// `dpsm-notw`: the two maps warped by NoTW (its window checked against `res` by
+    /// [`DpsmNotwSettings`]'s rules).
+    pub fn notw(gpu: &Gpu, scene: &GpuScene, p: &DpsmNotwSettings, light: &Light) -> Result<Dpsm, GpuError> {
+        Dpsm::new(gpu, scene, &Knobs::dpsm_notw(p), p.split, light, true)
+    }
+
+    fn new(gpu: &Gpu, scene: &GpuScene, k: &Knobs, split: Split, light: &Light, warped: bool) -> Result<Dpsm, GpuError> {
         let name = if warped { "dpsm-notw" } else { "dpsm" };
         let Light::Point { position } = *light else {
             return Err(GpuError::Invalid(format!("{name} supports point lights only (got a {} light)", light.kind())));
         };
-        let res = p.get_u32("res");
+        let (res, pcf) = (k.res, k.pcf);
         gpu.check_size(res, res, "paraboloid map")?;
-        if warped && p.get("window") >= res as f64 {
-            return Err(GpuError::Invalid(format!("{name}: window {} must be below res {res}", p.get("window"))));
-        }
-        let axis = split_axis(p.choice_index("split", SPLIT_AXES)).ok_or_else(|| GpuError::Invalid(format!("{name}: bad split axis")))?;
+        let axis = split_axis(split.index()).expect("one axis per split name");
         let dp = DualParaboloid::fit(position, axis, &scene.bounds)
             .ok_or_else(|| GpuError::Invalid(format!("{name}: light position {position} or scene bounds not usable")))?;
         let labels: [&'static str; 2] = if warped { ["dpsm-notw.front", "dpsm-notw.back"] } else { ["dpsm.front", "dpsm.back"] };
-        let variant = if warped { Variant::Notw } else { Variant::Dv };
         let make = |i: usize| {
             let h = Hemisphere::BOTH[i];
-            Warped::with_projection(gpu, scene, p, variant, Projection::Paraboloid { view: dp.view(h), hemisphere: h }, labels[i], warped)
+            Warped::with_projection(gpu, scene, k, Projection::Paraboloid { view: dp.view(h), hemisphere: h }, labels[i])
         };
         // the hemispheres render one after another: one set of subdivision buffers for both
         let front = make(0)?;
         let mut back = make(1)?;
         back.borrow_subdiv(&front.subdiv_scratch());
-        Ok(Dpsm { maps: [front, back], warped, res, pcf: p.get_u32("pcf") })
+        Ok(Dpsm { maps: [front, back], warped, res, pcf })
     }
 }
 
@@ -289,5 +307,40 @@ impl Technique for Dpsm {
         let sum = (total_samples[0] + total_samples[1]).max(1) as f64;
         c.insert("front.sample_fraction".into(), total_samples[0] as f64 / sum);
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::techniques::warp::tests::{error, keys};
+
+    #[test]
+    fn the_tables_keep_their_keys_in_order() {
+        #[rustfmt::skip]
+        let dpsm = ["res", "split", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece", "exact_depth", "pcf", "bias",
+            "slope_bias", "max_slope", "normal_offset"];
+        #[rustfmt::skip]
+        let notw = ["res", "split", "window", "blur", "mix", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
+            "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
+            "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "window_tent"];
+        assert_eq!(keys::<DpsmSettings>(), dpsm);
+        assert_eq!(keys::<DpsmNotwSettings>(), notw);
+        assert_eq!(Split::NAMES, SPLIT_AXES);
+    }
+
+    #[test]
+    fn the_rules_reject_conflicts_and_dead_keys() {
+        assert_eq!(error("dpsm-notw:res=128"), "technique 'dpsm-notw': window 128 must be below res 128");
+        assert!(error("dpsm:subdiv=0,subdiv_levels=3").contains("subdiv_levels has no effect: subdiv=0"));
+        assert!(error("dpsm:bias_mode=2").contains("has no parameter 'bias_mode'"));
+        assert!(error("dpsm:depth_clamp=1").contains("has no parameter 'depth_clamp'"));
+        assert!(error("dpsm-notw:exact_depth=true,depth_clamp=1").contains("depth_clamp has no effect: a paraboloid map"));
+        // dpsm-notw's exact depth is off by default
+        assert!(error("dpsm-notw:exact_inverse=true").contains("exact_inverse has no effect: exact_depth=false"));
+        assert!(error("dpsm-notw:footprint_cap=2").contains("footprint_cap has no effect: bias_mode=0"));
+        for ok in ["dpsm:split=x,subdiv=0,exact_depth=true", "dpsm-notw:exact_depth=true,exact_inverse=true", "dpsm-notw:res=256"] {
+            assert_eq!(error(ok), "", "{ok}");
+        }
     }
 }

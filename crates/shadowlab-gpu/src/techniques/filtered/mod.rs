@@ -21,13 +21,12 @@ mod mips;
 mod technique;
 
 use bytemuck::{Pod, Zeroable};
-use shadowlab_core::params::family;
-use shadowlab_core::params::ParamDef;
+use shadowlab_core::params::{family, Block, ParamDef, ParamSet, ParamTable};
 use shadowlab_core::techniques::filtered as cpu;
 
 use crate::shaders::compose;
 use crate::technique::{compose_view, TechniqueInfo};
-pub use technique::Filtered;
+pub use technique::{Filtered, Representation};
 
 /// The representation library (encoders, bounds, `*_visibility_gather`): self-contained WGSL
 /// with no bindings, for other passes (leak tracing) to prepend.
@@ -51,19 +50,12 @@ fn eval_source() -> String {
     compose_view(&format!("{MOMENTS_WGSL}{PARAMS_WGSL}{EVAL_WGSL}"), false)
 }
 
-/// The four representations; the index is `mode.x` in the WGSL.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    Vsm = 0,
-    Esm = 1,
-    Evsm = 2,
-    Msm = 3,
+shadowlab_core::param_choice! {
+    /// The four representations; the index is `mode.x` in the WGSL (and leak tracing's `base`).
+    pub enum Kind { Vsm = "vsm", Esm = "esm", Evsm = "evsm", Msm = "msm" }
 }
 
 impl Kind {
-    pub fn name(self) -> &'static str {
-        ["vsm", "esm", "evsm", "msm"][self as usize]
-    }
     /// Channels of the (non-sd) map.
     pub fn channels(self) -> u32 {
         [2, 1, 4, 4][self as usize]
@@ -139,10 +131,84 @@ const MOMENT_BIAS: ParamDef = ParamDef::number(
     "seed 004 section 4 (3e-6 with 32-bit floats)",
 );
 
-pub const VSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MIN_VARIANCE];
-pub const ESM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, ESM_C];
-pub const EVSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MIN_VARIANCE, C_POS, C_NEG];
-pub const MSM_PARAMS: &[ParamDef] = &[RES, BLUR, SD, MIPS, BIAS, NORMAL_OFFSET, MOMENT_BIAS];
+shadowlab_core::param_set! {
+    /// The map settings the four filterable maps share: size, pre-filter, single depth, mip
+    /// chain, bias (texels).
+    pub struct FilteredMap {
+        pub res: u32 = RES,
+        pub blur: u32 = BLUR,
+        pub sd: bool = SD,
+        pub mips: bool = MIPS,
+        pub bias: f64 = BIAS,
+        pub normal_offset: f64 = NORMAL_OFFSET,
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            if self.sd {
+                vec![
+                    ("blur", "sd=true stores the depth unblurred".into()),
+                    ("mips", "sd=true builds no mip chain".into()),
+                ]
+            } else {
+                Vec::new()
+            }
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `vsm`'s parameters.
+    pub struct VsmSettings {
+        pub map: FilteredMap = Block::as_declared(),
+        pub min_variance: f64 = MIN_VARIANCE,
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.map.ineffective()
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `esm`'s parameters.
+    pub struct EsmSettings {
+        pub map: FilteredMap = Block::as_declared(),
+        pub c: f64 = ESM_C,
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.map.ineffective()
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `evsm`'s parameters.
+    pub struct EvsmSettings {
+        pub map: FilteredMap = Block::as_declared(),
+        pub min_variance: f64 = MIN_VARIANCE,
+        pub c_pos: f64 = C_POS,
+        pub c_neg: f64 = C_NEG,
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.map.ineffective()
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `msm`'s parameters.
+    pub struct MsmSettings {
+        pub map: FilteredMap = Block::as_declared(),
+        pub moment_bias: f64 = MOMENT_BIAS,
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.map.ineffective()
+        }
+    }
+}
 
 const LIGHTS: &[&str] = &["directional", "spot"];
 const COST: &str = "one pass over the scene into a float map + optional separable blur (2 x width taps per texel) + one 2x2 read per pixel";
@@ -154,12 +220,15 @@ pub const VSM_INFO: TechniqueInfo = TechniqueInfo {
     quality: "soft, bias-free edges; light leaks where an occluder lies in front of another (high variance)",
     source: "Donnelly and Lauritzen 2006; seed 004 section 2.1",
     lights: LIGHTS,
-    params: VSM_PARAMS,
+    params: ParamTable::of::<VsmSettings>(),
     stalls: "",
     needs: "",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Vsm)?)),
+    create: |gpu, scene, p, light| {
+        let s = VsmSettings::from_values(p);
+        Ok(Box::new(Filtered::new(gpu, scene, &s.map, Representation::Vsm { min_variance: s.min_variance }, light)?))
+    },
 };
 pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
     name: "esm",
@@ -168,12 +237,15 @@ pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
     quality: "leaks wherever receiver and occluder are close in depth (contact), worse for large depth ranges",
     source: "Annen et al. 2008, Salvi 2008; seed 004 section 2.1",
     lights: LIGHTS,
-    params: ESM_PARAMS,
+    params: ParamTable::of::<EsmSettings>(),
     stalls: "",
     needs: "",
     compare: &[],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Esm)?)),
+    create: |gpu, scene, p, light| {
+        let s = EsmSettings::from_values(p);
+        Ok(Box::new(Filtered::new(gpu, scene, &s.map, Representation::Esm { c: s.c }, light)?))
+    },
 };
 pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
     name: "evsm",
@@ -182,12 +254,16 @@ pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
     quality: "fewer leaks than VSM and ESM; 16 bytes per texel",
     source: "Lauritzen and McCool 2008; seed 004 section 2.1 (leak tracing's default)",
     lights: LIGHTS,
-    params: EVSM_PARAMS,
+    params: ParamTable::of::<EvsmSettings>(),
     stalls: "",
     needs: "",
     compare: &["", "sd=true"],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Evsm)?)),
+    create: |gpu, scene, p, light| {
+        let s = EvsmSettings::from_values(p);
+        let rep = Representation::Evsm { min_variance: s.min_variance, c_pos: s.c_pos, c_neg: s.c_neg };
+        Ok(Box::new(Filtered::new(gpu, scene, &s.map, rep, light)?))
+    },
 };
 pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
     name: "msm",
@@ -196,12 +272,15 @@ pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
     quality: "sharper bound than VSM for two occluder layers; leaks near steep edges with values near 1",
     source: "Peters and Klein 2015 (algorithm 2); seed 004 section 2.1",
     lights: LIGHTS,
-    params: MSM_PARAMS,
+    params: ParamTable::of::<MsmSettings>(),
     stalls: "",
     needs: "",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Filtered::new(gpu, scene, p, light, Kind::Msm)?)),
+    create: |gpu, scene, p, light| {
+        let s = MsmSettings::from_values(p);
+        Ok(Box::new(Filtered::new(gpu, scene, &s.map, Representation::Msm { moment_bias: s.moment_bias }, light)?))
+    },
 };
 
 /// WGSL `FilteredParams` (render.wgsl and eval.wgsl).
@@ -233,4 +312,46 @@ pub struct FilteredParams {
     /// Texels.
     pub normal_offset: f32,
     pub pad1: f32,
+}
+
+#[cfg(test)]
+mod tests {
+    use shadowlab_core::params::{ParamSet, TechniqueSpec};
+
+    use super::{EsmSettings, EvsmSettings, MsmSettings, VsmSettings};
+    use crate::GpuError;
+
+    fn keys<P: ParamSet>() -> Vec<&'static str> {
+        P::defs().iter().map(|d| d.key).collect()
+    }
+
+    /// The tables as listed before the typed sets (`shadowlab techniques`).
+    #[test]
+    fn tables_keep_their_rows_in_order() {
+        assert_eq!(keys::<VsmSettings>(), ["res", "blur", "sd", "mips", "bias", "normal_offset", "min_variance"]);
+        assert_eq!(keys::<EsmSettings>(), ["res", "blur", "sd", "mips", "bias", "normal_offset", "c"]);
+        assert_eq!(keys::<EvsmSettings>(), ["res", "blur", "sd", "mips", "bias", "normal_offset", "min_variance", "c_pos", "c_neg"]);
+        assert_eq!(keys::<MsmSettings>(), ["res", "blur", "sd", "mips", "bias", "normal_offset", "moment_bias"]);
+    }
+
+    fn resolve(spec: &str) -> Result<(), String> {
+        match crate::registry::resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
+            Ok(_) => Ok(()),
+            Err(GpuError::Invalid(msg)) => Err(msg),
+            Err(e) => panic!("{spec}: {e:?}"),
+        }
+    }
+
+    #[test]
+    fn keys_without_effect_are_reported() {
+        for name in ["vsm", "esm", "evsm", "msm"] {
+            let e = resolve(&format!("{name}:sd=true,mips=true")).unwrap_err();
+            assert!(e.contains(&format!("technique '{name}': mips has no effect: sd=true")), "{e}");
+            let e = resolve(&format!("{name}:blur=5,sd=true")).unwrap_err();
+            assert!(e.contains("blur has no effect: sd=true"), "{e}");
+            for ok in ["sd=true", "sd=true,bias=0.5,normal_offset=0.5,res=1024", "mips=true,blur=5", "sd=false,mips=true"] {
+                resolve(&format!("{name}:{ok}")).unwrap_or_else(|e| panic!("{name}:{ok}: {e}"));
+            }
+        }
+    }
 }

@@ -3,17 +3,36 @@
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::params::ParamValues;
 use shadowlab_core::techniques::filtered as cpu;
 
 use super::mips::{self, MipChain};
-use super::{eval_source, render_source, FilteredParams, Kind};
+use super::{eval_source, render_source, FilteredMap, FilteredParams, Kind};
 use crate::blur::{mip0, Blur};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::techniques::pictures::{count_image, depth_image};
 use crate::{binding, raster, Gpu, GpuError};
+
+/// The representation with the shape parameters its technique declares (mod.rs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Representation {
+    Vsm { min_variance: f64 },
+    Esm { c: f64 },
+    Evsm { min_variance: f64, c_pos: f64, c_neg: f64 },
+    Msm { moment_bias: f64 },
+}
+
+impl Representation {
+    pub fn kind(self) -> Kind {
+        match self {
+            Representation::Vsm { .. } => Kind::Vsm,
+            Representation::Esm { .. } => Kind::Esm,
+            Representation::Evsm { .. } => Kind::Evsm,
+            Representation::Msm { .. } => Kind::Msm,
+        }
+    }
+}
 
 pub struct Filtered {
     kind: Kind,
@@ -38,13 +57,14 @@ pub struct Filtered {
 }
 
 impl Filtered {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, kind: Kind) -> Result<Filtered, GpuError> {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, settings: &FilteredMap, rep: Representation, light: &Light) -> Result<Filtered, GpuError> {
+        let kind = rep.kind();
         let name = kind.name();
-        let res = p.get_u32("res");
+        let res = settings.res;
         gpu.check_size(res, res, "shadow map")?;
-        let sd = p.get_bool("sd");
-        let levels = if p.get_bool("mips") && !sd { mips::levels(res) } else { 1 };
-        let blur_width = p.get_u32("blur");
+        let sd = settings.sd;
+        let levels = if settings.mips && !sd { mips::levels(res) } else { 1 };
+        let blur_width = settings.blur;
         if blur_width.is_multiple_of(2) {
             return Err(GpuError::Invalid(format!("{name}: blur={blur_width} must be odd (1 = no blur)")));
         }
@@ -57,10 +77,13 @@ impl Filtered {
             }
             _ => 0.0,
         };
-        // each kind reads what it declares (mod.rs); the shaders read no slot left at 0
-        let num = |key: &str, used: bool| if used { p.get(key) } else { 0.0 };
-        let (vsm, esm, evsm, msm) = (kind == Kind::Vsm, kind == Kind::Esm, kind == Kind::Evsm, kind == Kind::Msm);
-        let (c, c_pos, c_neg) = (num("c", esm), num("c_pos", evsm), num("c_neg", evsm));
+        // each kind has what it declares (mod.rs); the shaders read no slot left at 0
+        let (min_variance, c, c_pos, c_neg, moment_bias) = match rep {
+            Representation::Vsm { min_variance } => (min_variance, 0.0, 0.0, 0.0, 0.0),
+            Representation::Esm { c } => (0.0, c, 0.0, 0.0, 0.0),
+            Representation::Evsm { min_variance, c_pos, c_neg } => (min_variance, 0.0, c_pos, c_neg, 0.0),
+            Representation::Msm { moment_bias } => (0.0, 0.0, 0.0, 0.0, moment_bias),
+        };
         let params = FilteredParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
             texel_world: lp.texel,
@@ -71,13 +94,13 @@ impl Filtered {
             single_depth: sd as u32,
             mip_levels: levels,
             pad0: 0,
-            min_variance: num("min_variance", vsm || evsm) as f32,
+            min_variance: min_variance as f32,
             esm_c: c as f32,
             evsm_c_pos: c_pos as f32,
             evsm_c_neg: c_neg as f32,
-            moment_bias: num("moment_bias", msm) as f32,
-            depth_bias: p.get("bias") as f32,
-            normal_offset: p.get("normal_offset") as f32,
+            moment_bias: moment_bias as f32,
+            depth_bias: settings.bias as f32,
+            normal_offset: settings.normal_offset as f32,
             pad1: 0.0,
         };
         // the map's clear value: b(1), the farthest depth

@@ -5,14 +5,13 @@
 
 use glam::Vec3;
 use shadowlab_core::light::Light;
-use shadowlab_core::params::ParamValues;
 use shadowlab_core::techniques::iasm::{self as core, Anchor, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
 
 use super::atlas::{make_atlas, Atlas};
 use super::chunks::chunk_bounds;
 use super::fit::ViewFit;
 use super::plan::{Plan, TileStats};
-use super::{analysis_src, eval_src, probe_src, IasmParams, TileParams, RENDER_WGSL};
+use super::{analysis_src, eval_src, probe_src, IasmFit, IasmParams, IasmSettings, IasmStore, TileParams, RENDER_WGSL};
 use crate::record::{DelayedRead, Recorder};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
@@ -67,7 +66,7 @@ pub struct Iasm {
 }
 
 impl Iasm {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<Iasm, GpuError> {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &IasmSettings, light: &Light) -> Result<Iasm, GpuError> {
         let Light::Directional { direction } = *light else {
             return Err(GpuError::Invalid(format!("iasm supports directional lights only, not {}", light.kind())));
         };
@@ -76,13 +75,13 @@ impl Iasm {
         if texels * 4 > gpu.limits.max_storage_buffer_binding_size {
             return Err(GpuError::Invalid("iasm shadow buffer exceeds this device's storage binding limit".into()));
         }
-        let chunk = p.get_u32("chunk").max(1);
+        let chunk = p.chunk.max(1);
         let triangles = scene.triangle_count;
         let (right, up, dir) = core::light_basis(direction);
         let basis = Placement { right, up, dir, origin: glam::Vec2::ZERO, size: 1.0 };
         let boxes = chunk_bounds(gpu, scene, chunk)?.into_iter().map(|(a, b)| core::light_box(&basis, a, b)).collect();
         let sb = core::light_box(&basis, scene.bounds.min, scene.bounds.max);
-        let size = match p.get("size") as f32 {
+        let size = match p.size as f32 {
             s if s > 0.0 => s,
             _ => (sb.1.x - sb.0.x).max(sb.1.y - sb.0.y).max(1e-3),
         };
@@ -133,16 +132,16 @@ impl Iasm {
         let eval_count = gpu.compute_pipeline_with("iasm.evaluate", &eval_src(), "main", &[&eval_layout], crate::context::COUNTING);
         let render = render_pipeline(gpu, &[&render_layout, &scene.layout]);
         let atlas =
-            (p.choice("store") == "atlas").then(|| make_atlas(gpu, &[&render_layout, &scene.layout], scene.has_cutouts)).transpose()?;
+            (p.store == IasmStore::Atlas).then(|| make_atlas(gpu, &[&render_layout, &scene.layout], scene.has_cutouts)).transpose()?;
         Ok(Iasm {
-            m: p.get("m") as f32,
-            k: p.get("k") as f32,
+            m: p.m as f32,
+            k: p.k as f32,
             size,
-            bias: p.get("bias") as f32,
-            normal_offset: p.get("normal_offset") as f32,
-            delayed: p.get_bool("delayed"),
-            snap: p.get_bool("snap"),
-            anchor: if p.choice("anchor") == "tile" { Anchor::TileCentre } else { Anchor::Circle },
+            bias: p.bias as f32,
+            normal_offset: p.normal_offset as f32,
+            delayed: p.delayed,
+            snap: p.snap,
+            anchor: p.anchor.into(),
             chunk,
             triangles,
             light_dir: direction,
@@ -150,8 +149,7 @@ impl Iasm {
             placement: basis,
             plan: Plan::default(),
             atlas,
-            fit: (p.choice("fit") == "view")
-                .then(|| ViewFit::new(gpu, direction, p.get("margin") as f32, 1e-3 * size, p.get_bool("snap"), p.get_bool("delayed"))),
+            fit: (p.fit == IasmFit::View).then(|| ViewFit::new(gpu, direction, p.margin as f32, 1e-3 * size, p.snap, p.delayed)),
             pending: false,
             analysed: basis,
             current: basis,

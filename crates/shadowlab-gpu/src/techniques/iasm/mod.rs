@@ -20,7 +20,8 @@ pub(crate) mod plan;
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::params::family;
-use shadowlab_core::params::ParamDef;
+use shadowlab_core::params::{ParamDef, ParamSet, ParamTable};
+use shadowlab_core::techniques::iasm::Anchor;
 
 use crate::shaders::{compose, compose_depth};
 use crate::technique::{compose_view, TechniqueInfo};
@@ -103,20 +104,61 @@ pub const DEFAULT_FIT: usize = 1;
 /// the wrong % is not monotonic in it (where the tile borders fall moves with the side).
 pub const DEFAULT_MARGIN: f64 = 0.05;
 
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::number("m", DEFAULT_M, 0.0, 1000.0, "importance weight of near samples, p = 1 + m clamp(1 - w/k, 0, 1)", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
-    ParamDef::number("k", DEFAULT_K, 0.0, 1e6, "importance range (world units); 0 = half the light square's side", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
-    ParamDef::number("size", DEFAULT_SIZE, 0.0, 1e6, "side of the light square (world units); 0 = scene extent across the light", "seed 001 ch. 5: sides chosen to encompass all geometry"),
-    family::BIAS.with_doc("constant depth bias, texels of the sample's tile; low: acne, high: peter-panning"),
-    family::NORMAL_OFFSET.with_doc("offset along the normal, texels of the sample's tile"),
-    ParamDef::flag("delayed", false, "use the previous frame's importance and near/far planes (no readback stall)", "seed 001 4.3, deferred delayed IASM"),
-    ParamDef::flag("snap", true, "move the square in steps of the coarsest texel (tile/16) so texel grids do not shimmer", "shadowlab addition (not in seed 001)"),
-    ParamDef::choice("anchor", &["circle", "tile"], 0, "circle: camera on the inscribed circle (Fig. 3.1); tile: then shifted so the camera sits at a tile centre (no four-tile corner at the camera)", "seed 001 3.2 / ch. 5 suggested fix"),
-    ParamDef::choice("store", &["buffer", "atlas"], DEFAULT_STORE as usize, "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)", "seed 001 3.2/3.5; default = the faster on lavapipe (docs/bench/iasm.md)"),
-    ParamDef::choice("fit", &["fixed", "view"], DEFAULT_FIT, "fixed: the thesis's square of side `size` ahead of the camera (Fig. 3.1); view: centred on and sized to the light-space bounds of the evaluated view samples (one more reduction and 320-byte readback; `size`, `anchor` unused)", "seed 001 3.2 / ch. 5 (suggested: fit the frustum to the view); reduction from sdsm (Lauritzen et al. 2011)"),
-    ParamDef::number("margin", DEFAULT_MARGIN, 0.0, 1.0, "fit=view: fraction of the samples' extent added on each side of the square", "shadowlab choice (BENCHMARKS.md, issue 18)"),
-    ParamDef::integer("chunk", DEFAULT_CHUNK, 1.0, 1e7, "triangles per culling chunk (vertex order)", "shadowlab choice; seed 001 4.3: culling decides the cost"),
-];
+shadowlab_core::param_choice! {
+    /// `anchor`: where the camera sits on the fixed square (`shadowlab_core::techniques::iasm::Anchor`).
+    pub enum IasmAnchor { Circle = "circle", Tile = "tile" }
+}
+
+impl From<IasmAnchor> for Anchor {
+    fn from(a: IasmAnchor) -> Anchor {
+        match a {
+            IasmAnchor::Circle => Anchor::Circle,
+            IasmAnchor::Tile => Anchor::TileCentre,
+        }
+    }
+}
+
+shadowlab_core::param_choice! {
+    /// `store`: where the tiles' depth lives (see [`DEFAULT_STORE`]).
+    pub enum IasmStore { Buffer = "buffer", Atlas = "atlas" }
+}
+
+shadowlab_core::param_choice! {
+    /// `fit`: how the square is placed (see [`DEFAULT_FIT`]).
+    pub enum IasmFit { Fixed = "fixed", View = "view" }
+}
+
+shadowlab_core::param_set! {
+    /// `iasm`'s parameters.
+    pub struct IasmSettings {
+        pub m: f64 = ParamDef::number("m", DEFAULT_M, 0.0, 1000.0, "importance weight of near samples, p = 1 + m clamp(1 - w/k, 0, 1)", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
+        pub k: f64 = ParamDef::number("k", DEFAULT_K, 0.0, 1e6, "importance range (world units); 0 = half the light square's side", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
+        pub size: f64 = ParamDef::number("size", DEFAULT_SIZE, 0.0, 1e6, "side of the light square (world units); 0 = scene extent across the light", "seed 001 ch. 5: sides chosen to encompass all geometry"),
+        pub bias: f64 = family::BIAS.with_doc("constant depth bias, texels of the sample's tile; low: acne, high: peter-panning"),
+        pub normal_offset: f64 = family::NORMAL_OFFSET.with_doc("offset along the normal, texels of the sample's tile"),
+        pub delayed: bool = ParamDef::flag("delayed", false, "use the previous frame's importance and near/far planes (no readback stall)", "seed 001 4.3, deferred delayed IASM"),
+        pub snap: bool = ParamDef::flag("snap", true, "move the square in steps of the coarsest texel (tile/16) so texel grids do not shimmer", "shadowlab addition (not in seed 001)"),
+        pub anchor: IasmAnchor = ParamDef::choice("anchor", IasmAnchor::NAMES, 0, "circle: camera on the inscribed circle (Fig. 3.1); tile: then shifted so the camera sits at a tile centre (no four-tile corner at the camera)", "seed 001 3.2 / ch. 5 suggested fix"),
+        pub store: IasmStore = ParamDef::choice("store", IasmStore::NAMES, DEFAULT_STORE as usize, "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)", "seed 001 3.2/3.5; default = the faster on lavapipe (docs/bench/iasm.md)"),
+        pub fit: IasmFit = ParamDef::choice("fit", IasmFit::NAMES, DEFAULT_FIT, "fixed: the thesis's square of side `size` ahead of the camera (Fig. 3.1); view: centred on and sized to the light-space bounds of the evaluated view samples (one more reduction and 320-byte readback; `size`, `anchor` unused)", "seed 001 3.2 / ch. 5 (suggested: fit the frustum to the view); reduction from sdsm (Lauritzen et al. 2011)"),
+        pub margin: f64 = ParamDef::number("margin", DEFAULT_MARGIN, 0.0, 1.0, "fit=view: fraction of the samples' extent added on each side of the square", "shadowlab choice (BENCHMARKS.md, issue 18)"),
+        pub chunk: u32 = ParamDef::integer("chunk", DEFAULT_CHUNK, 1.0, 1e7, "triangles per culling chunk (vertex order)", "shadowlab choice; seed 001 4.3: culling decides the cost"),
+    }
+    rules {
+        // (with fit=view, `size` and `anchor` still place the square of a frame without
+        // evaluated samples, and `size` bounds the fitted side from below: not listed)
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            let mut v = Vec::new();
+            if self.m == 0.0 {
+                v.push(("k", "it shapes the weight of near samples, and m=0 weighs every sample 1".to_string()));
+            }
+            if self.fit == IasmFit::Fixed {
+                v.push(("margin", "it widens the square fitted to the view, and fit=fixed places the thesis's square".to_string()));
+            }
+            v
+        }
+    }
+}
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "iasm",
@@ -126,12 +168,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "resolution follows the camera; tile seams where neighbours differ (four-tile corners, thesis Fig. 4.4)",
     source: "seed 001 (IASM thesis) chapter 3",
     lights: &["directional"],
-    params: PARAMS,
+    params: ParamTable::of::<IasmSettings>(),
     stalls: "iasm.readback: the tile statistics are read back for the plan; fit=view adds iasm.fit.readback before it (the samples' bounds for the square); delayed=true plans with the previous frame's, read back without a stall, and with fit=view the previous frame's bounds (a sync only on the first frame, or when the previous frame has not finished)",
     needs: "",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, &IasmSettings::from_values(p), light)?)),
 };
 
 /// WGSL `IasmParams` (params.wgsl).
@@ -156,4 +198,46 @@ pub struct IasmParams {
 pub struct TileParams {
     pub view_proj: [[f32; 4]; 4],
     pub tile: [u32; 4],
+}
+
+#[cfg(test)]
+mod tests {
+    use shadowlab_core::params::TechniqueSpec;
+
+    use super::*;
+    use crate::registry::{resolve, Resolved};
+    use crate::GpuError;
+
+    fn ok(spec: &str) -> Resolved {
+        resolve(&TechniqueSpec::parse(spec).unwrap(), None).unwrap_or_else(|e| panic!("{spec}: {e}"))
+    }
+
+    fn err(spec: &str) -> String {
+        match resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
+            Err(GpuError::Invalid(m)) => m,
+            other => panic!("{spec}: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn iasm_lists_its_keys_as_before_and_reads_them_typed() {
+        let keys: Vec<_> = IasmSettings::defs().iter().map(|d| d.key).collect();
+        assert_eq!(keys, ["m", "k", "size", "bias", "normal_offset", "delayed", "snap", "anchor", "store", "fit", "margin", "chunk"]);
+        let d = IasmSettings::defaults();
+        assert_eq!((d.store, d.fit, d.anchor, d.margin, d.chunk), (IasmStore::Atlas, IasmFit::View, IasmAnchor::Circle, 0.05, 256));
+        let s = IasmSettings::from_values(&ok("iasm:fit=fixed,size=200,anchor=tile,store=buffer").values);
+        assert_eq!((s.fit, s.size, Anchor::from(s.anchor), s.store), (IasmFit::Fixed, 200.0, Anchor::TileCentre, IasmStore::Buffer));
+    }
+
+    #[test]
+    fn iasm_rejects_keys_without_effect() {
+        let e = err("iasm:fit=fixed,margin=0.1");
+        assert!(e.contains("technique 'iasm': margin has no effect"), "{e}");
+        ok("iasm:fit=view,margin=0.1");
+        ok("iasm:margin=0.1");
+        assert!(err("iasm:m=0,k=3").contains("k has no effect"));
+        ok("iasm:m=2,k=3");
+        // size and anchor still place a fitted square's frames without samples
+        ok("iasm:fit=view,size=200,anchor=tile");
+    }
 }

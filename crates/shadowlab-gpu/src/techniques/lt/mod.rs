@@ -39,14 +39,13 @@ mod report;
 mod screen;
 
 use bytemuck::{Pod, Zeroable};
-use shadowlab_core::params::family;
-use shadowlab_core::params::ParamDef;
+use shadowlab_core::params::{family, Block, ParamDef, ParamSet, ParamTable};
 use shadowlab_core::techniques::filtered as cpu;
 use shadowlab_core::techniques::lt as leak;
 
 use crate::reference::TRACE_WGSL;
 use crate::technique::{compose_view, TechniqueInfo};
-use crate::techniques::filtered::MOMENTS_WGSL;
+use crate::techniques::filtered::{Kind, MOMENTS_WGSL};
 pub use pass::LeakTracing;
 
 const CLASSIFY_WGSL: &str = include_str!("classify.wgsl");
@@ -105,7 +104,7 @@ pub struct LtParams {
     pub inv_far: f32,
     /// [`Mode`] as its index.
     pub technique: u32,
-    /// Index of `base` in [`BASES`].
+    /// `base` as its [`Kind`] index.
     pub base: u32,
     /// Frame index (frames with history).
     pub frame: u32,
@@ -165,11 +164,10 @@ pub const DEFAULT_PCF_NORMAL_OFFSET: f64 = 0.5;
 /// and sub-texel casters missing from the map (wrong pixels the mask cannot find).
 pub const DEFAULT_RES: f64 = 2048.0;
 const RES: ParamDef = family::RES.with_default(DEFAULT_RES, "seed 004 section 4 (2048 per cascade); shadowlab measurement (docs/bench/lt.md)").with_doc("shadow map side (texels, per cascade / spot map / cube face); low: more rays (wider uncertain bands) and missed thin occluders/gaps");
-/// `base`'s names, in the order of the shaders' mode numbers (filtered's `Kind`).
-pub const BASES: &[&str] = &["vsm", "esm", "evsm", "msm"];
+/// `base`'s names are filtered's [`Kind`], in the order of the shaders' mode numbers.
 const BASE: ParamDef = ParamDef::choice(
     "base",
-    BASES,
+    Kind::NAMES,
     2,
     "filterable representation rebuilt from the gathered depths: vsm, esm, evsm, msm",
     "seed 004 section 4.1 (EVSM fastest, VSM close; ESM/MSM need more rays)",
@@ -276,29 +274,141 @@ const PCF_BIAS: ParamDef = family::BIAS
 const PCF_NORMAL_OFFSET: ParamDef =
     family::NORMAL_OFFSET.with_default(DEFAULT_PCF_NORMAL_OFFSET, "sm's default (shadowlab sweep)").with_doc("normal offset (texels)");
 
-pub const LT_PARAMS: &[ParamDef] = &[
-    RES,
-    CASCADES,
-    LAMBDA,
-    ENLARGE,
-    BASE,
-    EPS,
-    RR,
-    REUSE,
-    FULL,
-    HISTORY_TEST,
-    DEPTH_TOL,
-    NORMAL_COS,
-    FORCE_ALL,
-    MIN_VARIANCE,
-    ESM_C,
-    C_POS,
-    C_NEG,
-    MOMENT_BIAS,
-];
-pub const LTT_PARAMS: &[ParamDef] =
-    &[RES, CASCADES, LAMBDA, ENLARGE, BASE, EPS, REUSE, FORCE_ALL, MIN_VARIANCE, ESM_C, C_POS, C_NEG, MOMENT_BIAS];
-pub const HYBRID_PARAMS: &[ParamDef] = &[RES, CASCADES, LAMBDA, ENLARGE, REUSE, FORCE_ALL, PCF_BIAS, PCF_NORMAL_OFFSET];
+shadowlab_core::param_set! {
+    /// The map levels all three techniques share: the map side and, for directional lights,
+    /// the cascades.
+    pub struct MapLevels {
+        pub res: u32 = RES,
+        pub cascades: u32 = CASCADES,
+        pub lambda: f64 = LAMBDA,
+        pub enlarge: f64 = ENLARGE,
+    }
+}
+
+impl MapLevels {
+    /// `lambda` and `enlarge` where they do nothing: one map (no cascades), or (`enlarge`)
+    /// cascades refitted every frame (no reuse).
+    fn ineffective_with(&self, reuse: bool) -> Vec<(&'static str, String)> {
+        if self.cascades == 1 {
+            let why = "cascades=1 is one map over the whole scene (no cascades)";
+            vec![("lambda", why.into()), ("enlarge", why.into())]
+        } else if !reuse {
+            vec![("enlarge", "reuse=false refits the cascade boxes every frame (nothing kept to enlarge)".into())]
+        } else {
+            Vec::new()
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// The shape of the filterable base (`lt`, `ltt`): each base reads some of them.
+    pub struct Moments {
+        pub min_variance: f64 = MIN_VARIANCE,
+        pub c: f64 = ESM_C,
+        pub c_pos: f64 = C_POS,
+        pub c_neg: f64 = C_NEG,
+        pub moment_bias: f64 = MOMENT_BIAS,
+    }
+}
+
+impl Moments {
+    /// The keys `base` does not read (classify.wgsl's `visibility_gather_of`).
+    fn unread_by(base: Kind) -> Vec<(&'static str, String)> {
+        let readers: [(&'static str, &[Kind], &str); 5] = [
+            ("min_variance", &[Kind::Vsm, Kind::Evsm], "vsm and evsm"),
+            ("c", &[Kind::Esm], "esm"),
+            ("c_pos", &[Kind::Evsm], "evsm"),
+            ("c_neg", &[Kind::Evsm], "evsm"),
+            ("moment_bias", &[Kind::Msm], "msm"),
+        ];
+        readers
+            .into_iter()
+            .filter(|(_, by, _)| !by.contains(&base))
+            .map(|(key, _, names)| (key, format!("base={} does not read it (only {names})", base.name())))
+            .collect()
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `lt`'s parameters: the filterable base, LTT and the temporal mask.
+    pub struct LtSettings {
+        pub map: MapLevels = Block::as_declared(),
+        pub base: Kind = BASE,
+        pub eps: f64 = EPS,
+        pub rr: bool = RR,
+        pub reuse: bool = REUSE,
+        pub full: bool = FULL,
+        pub history_test: bool = HISTORY_TEST,
+        pub depth_tol: f64 = DEPTH_TOL,
+        pub normal_cos: f64 = NORMAL_COS,
+        pub force_all: bool = FORCE_ALL,
+        pub moments: Moments = Block::as_declared(),
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            let mut v = self.map.ineffective_with(self.reuse);
+            if !self.history_test {
+                let why = "history_test=false does no depth or normal test";
+                v.extend([("depth_tol", why.into()), ("normal_cos", why.into())]);
+            }
+            v.extend(Moments::unread_by(self.base));
+            v
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `ltt`'s parameters: `lt`'s without the temporal mask.
+    pub struct LttSettings {
+        pub map: MapLevels = Block::as_declared(),
+        pub base: Kind = BASE,
+        pub eps: f64 = EPS,
+        pub reuse: bool = REUSE,
+        pub force_all: bool = FORCE_ALL,
+        pub moments: Moments = Block::as_declared(),
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            let mut v = self.map.ineffective_with(self.reuse);
+            v.extend(Moments::unread_by(self.base));
+            v
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `hybrid-pcf`'s parameters: no filterable base, the plain map's bias instead.
+    pub struct HybridSettings {
+        pub map: MapLevels = Block::as_declared(),
+        pub reuse: bool = REUSE,
+        pub force_all: bool = FORCE_ALL,
+        pub bias: f64 = PCF_BIAS,
+        pub normal_offset: f64 = PCF_NORMAL_OFFSET,
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.map.ineffective_with(self.reuse)
+        }
+    }
+}
+
+/// One of the three techniques with its settings, as [`LeakTracing::new`] takes it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Variant {
+    Lt(LtSettings),
+    Ltt(LttSettings),
+    HybridPcf(HybridSettings),
+}
+
+impl Variant {
+    pub fn mode(&self) -> Mode {
+        match self {
+            Variant::Lt(_) => Mode::Lt,
+            Variant::Ltt(_) => Mode::Ltt,
+            Variant::HybridPcf(_) => Mode::HybridPcf,
+        }
+    }
+}
 
 const LIGHTS: &[&str] = &["directional", "spot", "point"];
 
@@ -309,12 +419,12 @@ pub const LT_INFO: TechniqueInfo = TechniqueInfo {
     quality: "converges to rt within a few frames; thin lit gaps missing from the map can stay closed",
     source: "Kern, Brüll, Grosch 2024 (seed 004) sections 3-3.4",
     lights: LIGHTS,
-    params: LT_PARAMS,
+    params: ParamTable::of::<LtSettings>(),
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Lt)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, &Variant::Lt(LtSettings::from_values(p)), light)?)),
 };
 pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
     name: "ltt",
@@ -323,12 +433,12 @@ pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
     quality: "misses LTT's failure cases (grazing receivers, edges near gaps: seed 004 figure 4)",
     source: "seed 004 eq. 3 ('LTT only' of table 3)",
     lights: LIGHTS,
-    params: LTT_PARAMS,
+    params: ParamTable::of::<LttSettings>(),
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::Ltt)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, &Variant::Ltt(LttSettings::from_values(p)), light)?)),
 };
 pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
     name: "hybrid-pcf",
@@ -337,10 +447,119 @@ pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
     quality: "needs a tuned bias; misses edges the biased map does not see",
     source: "AMD FidelityFX Hybrid Shadows 2021 (seed 004's HySM)",
     lights: LIGHTS,
-    params: HYBRID_PARAMS,
+    params: ParamTable::of::<HybridSettings>(),
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, p, light, Mode::HybridPcf)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, &Variant::HybridPcf(HybridSettings::from_values(p)), light)?)),
 };
+
+#[cfg(test)]
+mod tests {
+    use shadowlab_core::params::{ParamSet, TechniqueSpec};
+
+    use super::{HybridSettings, LtSettings, LttSettings};
+    use crate::GpuError;
+
+    fn keys<P: ParamSet>() -> Vec<&'static str> {
+        P::defs().iter().map(|d| d.key).collect()
+    }
+
+    /// The tables as listed before the typed sets (`shadowlab techniques`).
+    #[test]
+    fn tables_keep_their_rows_in_order() {
+        let lt = [
+            "res",
+            "cascades",
+            "lambda",
+            "enlarge",
+            "base",
+            "eps",
+            "rr",
+            "reuse",
+            "full",
+            "history_test",
+            "depth_tol",
+            "normal_cos",
+            "force_all",
+            "min_variance",
+            "c",
+            "c_pos",
+            "c_neg",
+            "moment_bias",
+        ];
+        assert_eq!(keys::<LtSettings>(), lt);
+        let ltt = [
+            "res",
+            "cascades",
+            "lambda",
+            "enlarge",
+            "base",
+            "eps",
+            "reuse",
+            "force_all",
+            "min_variance",
+            "c",
+            "c_pos",
+            "c_neg",
+            "moment_bias",
+        ];
+        assert_eq!(keys::<LttSettings>(), ltt);
+        assert_eq!(keys::<HybridSettings>(), ["res", "cascades", "lambda", "enlarge", "reuse", "force_all", "bias", "normal_offset"]);
+    }
+
+    fn resolve(spec: &str) -> Result<(), String> {
+        match crate::registry::resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
+            Ok(_) => Ok(()),
+            Err(GpuError::Invalid(msg)) => Err(msg),
+            Err(e) => panic!("{spec}: {e:?}"),
+        }
+    }
+
+    #[test]
+    fn keys_without_effect_are_reported() {
+        for (spec, key) in [
+            ("lt:base=vsm,c_pos=30", "c_pos"),
+            ("lt:base=vsm,c=30", "c"),
+            ("lt:base=vsm,moment_bias=0.001", "moment_bias"),
+            ("lt:base=esm,min_variance=0.001", "min_variance"),
+            ("lt:c_neg=3,base=msm", "c_neg"),
+            ("lt:c=30", "c"),
+            ("lt:moment_bias=0.001", "moment_bias"),
+            ("ltt:base=msm,min_variance=0.001", "min_variance"),
+            ("ltt:base=evsm,c=70", "c"),
+            ("lt:history_test=false,depth_tol=0.1", "depth_tol"),
+            ("lt:history_test=false,normal_cos=0.5", "normal_cos"),
+            ("lt:cascades=1,lambda=0.5", "lambda"),
+            ("ltt:cascades=1,enlarge=0.2", "enlarge"),
+            ("hybrid-pcf:reuse=false,enlarge=0.2", "enlarge"),
+            ("hybrid-pcf:cascades=1,lambda=0.5", "lambda"),
+        ] {
+            let e = resolve(spec).expect_err(spec);
+            assert!(e.starts_with(&format!("technique '{}': ", &spec[..spec.find(':').unwrap()])), "{spec}: {e}");
+            assert!(e.contains(&format!("{key} has no effect")), "{spec}: {e}");
+        }
+        let e = resolve("lt:base=vsm,c_pos=30").unwrap_err();
+        assert!(e.contains("c_pos has no effect: base=vsm"), "{e}");
+        // one reason per key, however many make it dead
+        let e = resolve("lt:cascades=1,reuse=false,enlarge=0.2").unwrap_err();
+        assert_eq!(e.matches("enlarge has no effect").count(), 1, "{e}");
+        for spec in [
+            "lt",
+            "lt:base=vsm,min_variance=0.001",
+            "lt:base=esm,c=70",
+            "lt:c_pos=30,c_neg=3,min_variance=1e-9",
+            "lt:base=msm,moment_bias=0.001",
+            "ltt:base=esm,c=70,eps=0.02",
+            "lt:history_test=true,depth_tol=0.1,normal_cos=0.5",
+            // dead keys not given are not reported
+            "lt:base=vsm,history_test=false,cascades=1,reuse=false",
+            "lt:cascades=2,lambda=0.5,enlarge=0.2",
+            "lt:reuse=false,lambda=0.5",
+            "hybrid-pcf:bias=1,normal_offset=1,cascades=3",
+        ] {
+            resolve(spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
+        }
+    }
+}

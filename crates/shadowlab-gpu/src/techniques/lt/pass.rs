@@ -4,12 +4,11 @@
 use bytemuck::Zeroable;
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
-use shadowlab_core::params::ParamValues;
 use shadowlab_core::techniques::lt as leak;
 
 use super::cascade::{single_level, Cascades};
 use super::screen::Screen;
-use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, ARGS_WGSL, BASES, MAX_MAPS};
+use super::{classify_source, trace_source, LevelU, LtParams, Mode, TraceParams, Variant, ARGS_WGSL, MAX_MAPS};
 use super::{FLAG_DYNAMIC, FLAG_FORCE_ALL, FLAG_FULL, FLAG_HAS_HISTORY, FLAG_HISTORY_TEST, FLAG_POINT, FLAG_RR};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -52,9 +51,27 @@ pub struct LeakTracing {
 }
 
 impl LeakTracing {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, mode: Mode) -> Result<LeakTracing, GpuError> {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, variant: &Variant, light: &Light) -> Result<LeakTracing, GpuError> {
+        let mode = variant.mode();
         let name = mode.name();
-        let res = p.get_u32("res");
+        // what each mode declares (mod.rs): lt all; ltt no temporal mask (rr, full,
+        // history_test, depth_tol, normal_cos); hybrid-pcf no filterable base (base, eps, the
+        // moment shape) but the PCF bias. The shader reads no slot a mode leaves at 0.
+        let (map_levels, reuse, force_all) = match variant {
+            Variant::Lt(s) => (&s.map, s.reuse, s.force_all),
+            Variant::Ltt(s) => (&s.map, s.reuse, s.force_all),
+            Variant::HybridPcf(s) => (&s.map, s.reuse, s.force_all),
+        };
+        let filterable = match variant {
+            Variant::Lt(s) => Some((s.base, s.eps, &s.moments)),
+            Variant::Ltt(s) => Some((s.base, s.eps, &s.moments)),
+            Variant::HybridPcf(_) => None,
+        };
+        let temporal = match variant {
+            Variant::Lt(s) => Some(s),
+            _ => None,
+        };
+        let res = map_levels.res;
         gpu.check_size(res, res, "shadow map")?;
         // point: six cube faces, one layer each (level 0 = the +x face stands for all below)
         let faces = match *light {
@@ -74,32 +91,27 @@ impl LeakTracing {
             _ => 0.0,
         };
         let mask_bits = leak::mask_texel_bits(LIGHTS).map_err(GpuError::Invalid)?;
-        // what each mode declares (mod.rs): lt all; ltt no temporal mask (rr, full,
-        // history_test, depth_tol, normal_cos); hybrid-pcf no filterable base (base, eps, the
-        // moment shape) but the PCF bias. The shader reads no slot a mode leaves at 0.
-        let temporal = mode == Mode::Lt;
-        let filterable = mode != Mode::HybridPcf;
-        let flag = |key: &str, bit: u32| if temporal && p.get_bool(key) { bit } else { 0 };
-        let flags = flag("rr", FLAG_RR)
-            | flag("full", FLAG_FULL)
-            | flag("history_test", FLAG_HISTORY_TEST)
-            | if p.get_bool("force_all") { FLAG_FORCE_ALL } else { 0 }
-            | if faces.is_some() { FLAG_POINT } else { 0 };
-        let (bias, normal_offset) = match mode {
-            Mode::HybridPcf => (p.get("bias"), p.get("normal_offset")),
+        let flag = |on: bool, bit: u32| if on { bit } else { 0 };
+        let flags = temporal.map_or(0, |t| flag(t.rr, FLAG_RR) | flag(t.full, FLAG_FULL) | flag(t.history_test, FLAG_HISTORY_TEST))
+            | flag(force_all, FLAG_FORCE_ALL)
+            | flag(faces.is_some(), FLAG_POINT);
+        let (bias, normal_offset) = match variant {
+            Variant::HybridPcf(s) => (s.bias, s.normal_offset),
             _ => (0.0, 0.0),
         };
-        let num = |key: &str, used: bool| if used { p.get(key) as f32 } else { 0.0 };
-        let (min_variance, esm_c, evsm_c_pos, evsm_c_neg) =
-            (num("min_variance", filterable), num("c", filterable), num("c_pos", filterable), num("c_neg", filterable));
-        let base = if filterable { BASES.iter().position(|b| *b == p.choice("base")).expect("a declared base") as u32 } else { 0 };
+        let (min_variance, esm_c, evsm_c_pos, evsm_c_neg, moment_bias) = filterable.map_or((0.0, 0.0, 0.0, 0.0, 0.0), |(_, _, m)| {
+            (m.min_variance as f32, m.c as f32, m.c_pos as f32, m.c_neg as f32, m.moment_bias as f32)
+        });
+        let base = filterable.map_or(0, |(base, _, _)| base.index() as u32);
+        let eps = filterable.map_or(0.0, |(_, eps, _)| eps as f32);
+        let (depth_tol, normal_cos) = temporal.map_or((0.0, 0.0), |t| (t.depth_tol as f32, t.normal_cos as f32));
         let cascades = match *light {
-            Light::Directional { direction } if p.get_u32("cascades") > 1 => Some(Cascades {
-                count: p.get_u32("cascades") as usize,
-                lambda: p.get("lambda") as f32,
-                enlarge: p.get("enlarge") as f32,
+            Light::Directional { direction } if map_levels.cascades > 1 => Some(Cascades {
+                count: map_levels.cascades as usize,
+                lambda: map_levels.lambda as f32,
+                enlarge: map_levels.enlarge as f32,
                 dir: direction,
-                kept: vec![None; p.get_u32("cascades") as usize - 1],
+                kept: vec![None; map_levels.cascades as usize - 1],
             }),
             _ => None,
         };
@@ -123,12 +135,12 @@ impl LeakTracing {
             esm_c,
             evsm_c_pos,
             evsm_c_neg,
-            moment_bias: num("moment_bias", filterable),
+            moment_bias,
             depth_bias: bias as f32,
             normal_offset: normal_offset as f32,
-            eps: num("eps", filterable),
-            depth_tol: num("depth_tol", temporal),
-            normal_cos: num("normal_cos", temporal),
+            eps,
+            depth_tol,
+            normal_cos,
             mask_bits: mask_bits as f32,
             pad0: 0.0,
         };
@@ -201,7 +213,7 @@ impl LeakTracing {
         Ok(LeakTracing {
             mode,
             res,
-            reuse: p.get_bool("reuse"),
+            reuse,
             params,
             mask_bits,
             static_map,

@@ -12,8 +12,8 @@ use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::params::family;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::family::{self, Bias};
+use shadowlab_core::params::{Block, ParamDef, ParamSet, ParamTable};
 use shadowlab_core::techniques::mdsm::{max_distinct, pcf_width, search_width, Select, DEFAULT_Q, MAX_DEPTHS, PCF_TAPS, SEARCH_SIZES};
 
 use crate::record::Recorder;
@@ -41,53 +41,66 @@ fn eval_src() -> String {
 pub const DEFAULT_N: f64 = 2.0;
 /// PCF taps. 9 (3x3) is the paper's recommended pairing with a 2-SM (PCF(9,2) vs PCF(16,1)).
 pub const DEFAULT_K: f64 = 9.0;
-/// `select` choices, in the order of [`Select::from_index`].
-pub const SELECT_CHOICES: &[&str] = &["minmax", "sort"];
-
-pub const PARAMS: &[ParamDef] = &[
-    family::RES.with_doc("shadow map side (texels)"),
-    ParamDef::integer(
-        "n",
-        DEFAULT_N,
-        1.0,
-        MAX_DEPTHS as f64,
-        "depths per texel (1 = sm); the n-shadow test gives n+1 levels per tap",
-        "seed 003 sections 4.2-4.4 (2-SM, 3-SM; 4 fill one RGBA32F texel)",
-    ),
-    ParamDef::integer(
-        "k",
-        DEFAULT_K,
-        1.0,
-        25.0,
-        "PCF taps, one of 1, 4, 9, 16, 25 (sqrt(k) x sqrt(k) grid one texel apart, centred on the sample)",
-        "seed 003 Table 1, Figures 6-7 (PCF 2x2, 3x3, 4x4)",
-    ),
-    ParamDef::choice(
-        "select",
-        SELECT_CHOICES,
-        0,
-        "how the extra depths are chosen: minmax (region extremes, O(q)) or sort (medians of n groups, O(q log q))",
-        "seed 003 section 4.3; section 5 uses min and max",
-    ),
-    ParamDef::integer(
-        "q",
-        DEFAULT_Q as f64,
-        9.0,
-        81.0,
-        "search region samples, one of 9, 25, 49, 81 (centred square); larger: wider soft zone, more selection cost",
-        "seed 003 section 6 cost example implies q = 9 (f > 1.28 x 512^2 with r = 7)",
-    ),
-    family::BIAS.with_doc("constant depth bias, texels; low: acne, high: peter-panning"),
-    family::SLOPE_BIAS.with_doc("slope-scaled bias, texels x tan(angle to light), tan clamped at max_slope"),
-    family::NORMAL_OFFSET.with_doc("offset along the normal, texels; low: grazing acne, high: shifted shadows"),
-    family::MAX_SLOPE.with_doc("clamp on tan(angle to light) for the slope, kernel and region bias"),
-    ParamDef::flag(
-        "region_bias",
-        true,
-        "add (sqrt(q)-1)/2 x tan texels of bias for the search region (n > 1); false: sloped lit surfaces self-shadow by up to 1/n",
-        "receiver-plane bias (Isidoro 2006) extended to the search region; shadowlab measurement (docs/bench/mdsm.md)",
-    ),
-];
+shadowlab_core::param_set! {
+    /// `mdsm`'s parameters.
+    pub struct MdsmSettings {
+        pub res: u32 = family::RES.with_doc("shadow map side (texels)"),
+        pub n: u32 = ParamDef::integer(
+            "n",
+            DEFAULT_N,
+            1.0,
+            MAX_DEPTHS as f64,
+            "depths per texel (1 = sm); the n-shadow test gives n+1 levels per tap",
+            "seed 003 sections 4.2-4.4 (2-SM, 3-SM; 4 fill one RGBA32F texel)",
+        ),
+        pub k: u32 = ParamDef::integer(
+            "k",
+            DEFAULT_K,
+            1.0,
+            25.0,
+            "PCF taps, one of 1, 4, 9, 16, 25 (sqrt(k) x sqrt(k) grid one texel apart, centred on the sample)",
+            "seed 003 Table 1, Figures 6-7 (PCF 2x2, 3x3, 4x4)",
+        ),
+        pub select: Select = ParamDef::choice(
+            "select",
+            Select::NAMES,
+            0,
+            "how the extra depths are chosen: minmax (region extremes, O(q)) or sort (medians of n groups, O(q log q))",
+            "seed 003 section 4.3; section 5 uses min and max",
+        ),
+        pub q: u32 = ParamDef::integer(
+            "q",
+            DEFAULT_Q as f64,
+            9.0,
+            81.0,
+            "search region samples, one of 9, 25, 49, 81 (centred square); larger: wider soft zone, more selection cost",
+            "seed 003 section 6 cost example implies q = 9 (f > 1.28 x 512^2 with r = 7)",
+        ),
+        pub bias: Bias = Block::as_declared()
+            .with(family::MAX_SLOPE.with_doc("clamp on tan(angle to light) for the slope, kernel and region bias")),
+        pub region_bias: bool = ParamDef::flag(
+            "region_bias",
+            true,
+            "add (sqrt(q)-1)/2 x tan texels of bias for the search region (n > 1); false: sloped lit surfaces self-shadow by up to 1/n",
+            "receiver-plane bias (Isidoro 2006) extended to the search region; shadowlab measurement (docs/bench/mdsm.md)",
+        ),
+    }
+    rules {
+        fn validate(&self) -> Result<(), String> {
+            let (k, q) = (self.k, self.q);
+            pcf_width(k).ok_or_else(|| format!("k={k} is not one of {PCF_TAPS:?} (square PCF grids)"))?;
+            search_width(q).ok_or_else(|| format!("q={q} is not one of {SEARCH_SIZES:?} (centred square regions)"))?;
+            Ok(())
+        }
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            if self.n > 1 {
+                return vec![];
+            }
+            let why = || "with n=1 there is no extra depth to select (the map is sm's)".to_string();
+            vec![("select", why()), ("q", why()), ("region_bias", why())]
+        }
+    }
+}
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "mdsm",
@@ -96,12 +109,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "up to nk+1 shadow levels from k fetches; soft zone about sqrt(q) texels wider than the kernel",
     source: "Pagot, Comba, Oliveira 2004 (seed 003)",
     lights: &["directional", "spot"],
-    params: PARAMS,
+    params: ParamTable::of::<MdsmSettings>(),
     stalls: "",
     needs: "",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(MultiDepthMap::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(MultiDepthMap::new(gpu, scene, &MdsmSettings::from_values(p), light)?)),
 };
 
 /// WGSL `MdsmParams` (select.wgsl and eval.wgsl).
@@ -117,7 +130,7 @@ pub struct MdsmParams {
     pub n: u32,
     /// Search width sqrt(q) (1 when n = 1).
     pub region: u32,
-    /// `select`'s index in `SELECT_CHOICES`.
+    /// `select`'s index in `Select::NAMES`.
     pub select: u32,
     /// 1 if the slope bias covers the search region.
     pub region_bias: u32,
@@ -141,23 +154,20 @@ pub struct MultiDepthMap {
 }
 
 impl MultiDepthMap {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<MultiDepthMap, GpuError> {
-        let res = p.get_u32("res");
+    /// `p` has passed its rules (`k` and `q` are square counts; the table bounds `n`).
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &MdsmSettings, light: &Light) -> Result<MultiDepthMap, GpuError> {
+        let res = p.res;
         gpu.check_size(res, res, "shadow map")?;
-        let (k, n, q) = (p.get_u32("k"), p.get_u32("n"), p.get_u32("q"));
-        let kw = pcf_width(k).ok_or_else(|| GpuError::Invalid(format!("mdsm: k={k} is not one of {PCF_TAPS:?} (square PCF grids)")))?;
-        let qw = search_width(q)
-            .ok_or_else(|| GpuError::Invalid(format!("mdsm: q={q} is not one of {SEARCH_SIZES:?} (centred square regions)")))?;
-        if !(1..=MAX_DEPTHS as u32).contains(&n) {
-            return Err(GpuError::Invalid(format!("mdsm: n={n} must be 1 to {MAX_DEPTHS}")));
-        }
-        let strategy = p.choice_index("select", SELECT_CHOICES) as u32;
-        Select::from_index(strategy).ok_or_else(|| GpuError::Invalid(format!("mdsm: select index {strategy} unknown")))?;
+        let (k, n, q) = (p.k, p.n, p.q);
+        let invalid = |e: String| GpuError::Invalid(format!("mdsm: {e}"));
+        p.validate().map_err(invalid)?;
+        let (kw, qw) = (pcf_width(k).unwrap_or(1), search_width(q).unwrap_or(1));
+        let strategy = p.select.index() as u32;
         let lp =
             lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("mdsm does not support point lights".into()))?;
         let region = if n > 1 { qw } else { 1 };
         // the depth pass reads only light_view_proj; the rest mirrors what sm would hold
-        let sm_params = SmParams::new(&lp, res, kw as f32, p);
+        let sm_params = SmParams::new(&lp, res, kw as f32, &p.bias);
         let params = MdsmParams {
             light_view_proj: sm_params.light_view_proj,
             texel: sm_params.texel,
@@ -165,7 +175,7 @@ impl MultiDepthMap {
             n,
             region,
             select: strategy,
-            region_bias: (p.get_bool("region_bias") && n > 1) as u32,
+            region_bias: (p.region_bias && n > 1) as u32,
         };
         let d = &gpu.device;
         let depth = DepthPass::new(gpu, scene, "mdsm", res, &sm_params);
@@ -265,5 +275,26 @@ impl MultiDepthMap {
         );
         self.eval.record(gpu, rec, "mdsm.evaluate", &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use shadowlab_core::params::{ParamSet, TechniqueSpec};
+
+    fn resolve(spec: &str) -> Result<(), String> {
+        crate::registry::resolve(&TechniqueSpec::parse(spec).unwrap(), None).map(|_| ()).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn the_table_keeps_its_keys_and_the_rules_say_why() {
+        let keys: Vec<_> = super::MdsmSettings::defs().iter().map(|p| p.key).collect();
+        assert_eq!(keys, ["res", "n", "k", "select", "q", "bias", "slope_bias", "max_slope", "normal_offset", "region_bias"]);
+        assert!(resolve("mdsm:k=5").unwrap_err().contains("k=5 is not one of [1, 4, 9, 16, 25]"));
+        assert!(resolve("mdsm:q=10").unwrap_err().contains("q=10 is not one of"));
+        let e = resolve("mdsm:n=1,select=sort").unwrap_err();
+        assert!(e.contains("select has no effect: with n=1"), "{e}");
+        resolve("mdsm:n=3,select=sort,q=25").unwrap();
+        resolve("mdsm:n=1,k=9").unwrap();
     }
 }

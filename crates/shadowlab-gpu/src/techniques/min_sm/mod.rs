@@ -12,15 +12,15 @@
 use bytemuck::Zeroable;
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace::{self, LightProjection};
-use shadowlab_core::params::family;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::family::{self, Bias};
+use shadowlab_core::params::{Block, ParamDef, ParamSet, ParamTable};
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::min_sm::frustum::{self, LightFrame, MinFrustum, RectFit, Reduction};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::techniques::sm::MapPass;
+use crate::techniques::sm::{MapPass, MapSettings};
 use crate::{binding, Gpu, GpuError};
 
 const REDUCE_WGSL: &str = include_str!("reduce.wgsl");
@@ -43,19 +43,30 @@ pub const RUN: u32 = 16;
 /// (lit); too high: wasted texels.
 pub const PAD_MARGIN_TEXELS: f64 = 1.0;
 
-/// `sm`'s parameters (same keys, defaults, docs and sources; the order is checked by a test),
-/// then the reduction grid.
-pub const PARAMS: &[ParamDef] = &[
-    family::RES,
-    family::PCF,
-    family::BIAS,
-    family::SLOPE_BIAS,
-    family::MAX_SLOPE,
-    family::NORMAL_OFFSET,
-    ParamDef::integer("grid", DEFAULT_GRID, 1.0, 16384.0, "bands of the GPU reduction before the hull (hull overshoot <= 1/grid of the samples' extent)", "shadowlab: exact hull up to one band; 1024 = 8 KB read back"),
-    ParamDef::choice("fit", &["area", "side"], 0, "rectangle around the hull: area = minimum area (the seeds' MSF; texels may be stretched up to the rectangle's aspect), side = shortest longer side (smallest square texel)", "seed 000 section 3.2 (area); side: shadowlab, see docs/bench/min_sm.md"),
-    ParamDef::flag("one_pass", true, "true: one pass over the G-buffer, bands over the previous frame's y range (samples outside it go to two overflow slots: always conservative, tight again next frame); false or first frame: two passes (bounds, then bands)", "shadowlab: halves the G-buffer reads in steady state (docs/bench/min_sm.md)"),
-];
+shadowlab_core::param_set! {
+    /// `min-sm`'s parameters: `sm`'s (same keys, defaults, docs and sources), then the
+    /// reduction grid and the rectangle's fit.
+    pub struct MinSmSettings {
+        pub res: u32 = family::RES,
+        pub pcf: u32 = family::PCF,
+        pub bias: Bias = Block::as_declared(),
+        pub grid: u32 = ParamDef::integer("grid", DEFAULT_GRID, 1.0, 16384.0, "bands of the GPU reduction before the hull (hull overshoot <= 1/grid of the samples' extent)", "shadowlab: exact hull up to one band; 1024 = 8 KB read back"),
+        pub fit: RectFit = ParamDef::choice("fit", RectFit::NAMES, 0, "rectangle around the hull: area = minimum area (the seeds' MSF; texels may be stretched up to the rectangle's aspect), side = shortest longer side (smallest square texel)", "seed 000 section 3.2 (area); side: shadowlab, see docs/bench/min_sm.md"),
+        pub one_pass: bool = ParamDef::flag("one_pass", true, "true: one pass over the G-buffer, bands over the previous frame's y range (samples outside it go to two overflow slots: always conservative, tight again next frame); false or first frame: two passes (bounds, then bands)", "shadowlab: halves the G-buffer reads in steady state (docs/bench/min_sm.md)"),
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.bias.ineffective(self.pcf)
+        }
+    }
+}
+
+impl MinSmSettings {
+    /// The map `sm`'s passes draw and evaluate.
+    fn map(&self) -> MapSettings {
+        MapSettings { res: self.res, pcf: self.pcf, bias: self.bias.clone() }
+    }
+}
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "min-sm",
@@ -64,12 +75,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "sm with the map focused on what the view sees: wins on close-ups, near sm on full-scene views; perspective aliasing remains",
     source: "seed 000 section 3.2 and seed 002 section 4.1.5 (MSF after Stamminger & Drettakis 2002, Perspective Shadow Maps); calipers: Toussaint 1983",
     lights: &["directional", "spot"],
-    params: PARAMS,
+    params: ParamTable::of::<MinSmSettings>(),
     stalls: "min-sm.readback: the band reduction of the view samples is read back for the CPU hull and calipers",
     needs: "",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, &MinSmSettings::from_values(p), light)?)),
 };
 
 /// WGSL `MsfReduce` (reduce.wgsl).
@@ -110,14 +121,14 @@ pub struct MinShadowMap {
 }
 
 impl MinShadowMap {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<MinShadowMap, GpuError> {
-        let res = p.get_u32("res");
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &MinSmSettings, light: &Light) -> Result<MinShadowMap, GpuError> {
+        let res = p.res;
         gpu.check_size(res, res, "shadow map")?;
         let no_point = || GpuError::Invalid("min-sm does not support point lights".into());
         let scene_fit = lightspace::fit(light, &scene.bounds, res).ok_or_else(no_point)?;
         let frame = frustum::light_frame(light, &scene.bounds).ok_or_else(no_point)?;
-        let (pcf, grid) = (p.get_u32("pcf"), p.get_u32("grid"));
-        let pass = MapPass::new(gpu, scene, "min-sm", p, &scene_fit);
+        let (pcf, grid) = (p.pcf, p.grid);
+        let pass = MapPass::new(gpu, scene, "min-sm", &p.map(), &scene_fit);
         let d = &gpu.device;
         let reduce = MsfReduce {
             frame_view: frame.view.as_mat4().to_cols_array_2d(),
@@ -137,13 +148,13 @@ impl MinShadowMap {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let pad_texels = p.get("normal_offset") + (pcf as f64 - 1.0) * 0.5 + PAD_MARGIN_TEXELS;
+        let pad_texels = p.bias.normal_offset + (pcf as f64 - 1.0) * 0.5 + PAD_MARGIN_TEXELS;
         Ok(MinShadowMap {
             pass,
             res,
             grid,
-            shape: if p.choice("fit") == "side" { RectFit::Side } else { RectFit::Area },
-            one_pass: p.get_bool("one_pass"),
+            shape: p.fit,
+            one_pass: p.one_pass,
             prior: None,
             last_passes: 0,
             light: *light,
@@ -267,7 +278,8 @@ impl Technique for MinShadowMap {
 mod tests {
     #[test]
     fn shares_sm_parameters_by_key() {
-        let keys: Vec<_> = super::PARAMS.iter().map(|p| p.key).collect();
+        use shadowlab_core::params::ParamSet;
+        let keys: Vec<_> = super::MinSmSettings::defs().iter().map(|p| p.key).collect();
         assert_eq!(keys, ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "grid", "fit", "one_pass"]);
     }
 }

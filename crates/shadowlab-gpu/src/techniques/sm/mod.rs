@@ -6,8 +6,8 @@
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
-use shadowlab_core::params::family::{BIAS, MAX_SLOPE, NORMAL_OFFSET, PCF, RES, SLOPE_BIAS};
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::family::{Bias, PCF, RES};
+use shadowlab_core::params::{Block, ParamSet, ParamTable};
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -37,9 +37,20 @@ pub fn eval_source() -> String {
     compose_view(&format!("{BIAS_WGSL}{EVAL_WGSL}"), false)
 }
 
-/// `sm`'s parameters: the shared map size, PCF and bias family, at their shared defaults
-/// (measured for `sm`; see `shadowlab_core::params::family`).
-pub const PARAMS: &[ParamDef] = &[RES, PCF, BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET];
+shadowlab_core::param_set! {
+    /// `sm`'s parameters (and the map of `min-sm`): the shared map size, PCF and bias family, at
+    /// their shared defaults (measured for `sm`; see `shadowlab_core::params::family`).
+    pub struct MapSettings {
+        pub res: u32 = RES,
+        pub pcf: u32 = PCF,
+        pub bias: Bias = Block::as_declared(),
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            self.bias.ineffective(self.pcf)
+        }
+    }
+}
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "sm",
@@ -48,12 +59,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "aliasing where texels project large on screen (perspective aliasing); acne vs peter-panning trade-off",
     source: "Williams 1978; seed 002 chapter 2; PCF: Reeves, Salesin, Cook 1987",
     lights: &["directional", "spot"],
-    params: PARAMS,
+    params: ParamTable::of::<MapSettings>(),
     stalls: "",
     needs: "",
     compare: &["", "pcf=3"],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(ShadowMap::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(ShadowMap::new(gpu, scene, &MapSettings::from_values(p), light)?)),
 };
 
 /// WGSL `SmParams` (in depth.wgsl and eval.wgsl).
@@ -70,8 +81,8 @@ pub struct ShadowMap {
 }
 
 impl ShadowMap {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<ShadowMap, GpuError> {
-        let res = p.get_u32("res");
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &MapSettings, light: &Light) -> Result<ShadowMap, GpuError> {
+        let res = p.res;
         gpu.check_size(res, res, "shadow map")?;
         let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| GpuError::Invalid("sm does not support point lights".into()))?;
         Ok(ShadowMap { pass: MapPass::new(gpu, scene, "sm", p, &lp) })

@@ -6,9 +6,9 @@
 
 use shadowlab_core::lightspace::LightProjection;
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::params::ParamValues;
+use shadowlab_core::params::family::Bias;
 
-use super::{depth_source, eval_source, SmParams};
+use super::{depth_source, eval_source, MapSettings, SmParams};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{view_layout, EvalPipelines, FrameInputs, TechniqueReport};
@@ -16,13 +16,12 @@ use crate::techniques::pictures::{count_image, depth_image};
 use crate::{binding, raster, Gpu};
 
 impl SmParams {
-    /// The uniform for projection `lp` of a `res x res` map: bias parameters from `p` (`bias`,
-    /// `slope_bias`, `normal_offset`, `max_slope`), `kernel` = PCF grid width.
-    pub fn new(lp: &LightProjection, res: u32, kernel: f32, p: &ParamValues) -> SmParams {
+    /// The uniform for projection `lp` of a `res x res` map with `bias`, `kernel` = PCF grid width.
+    pub fn new(lp: &LightProjection, res: u32, kernel: f32, bias: &Bias) -> SmParams {
         SmParams {
             light_view_proj: lp.view_proj.to_cols_array_2d(),
             texel: [lp.texel, lp.perspective as u32 as f32, res as f32, kernel],
-            bias: [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32],
+            bias: bias.packed(),
         }
     }
 }
@@ -89,11 +88,10 @@ pub struct MapPass {
 }
 
 impl MapPass {
-    /// A `res x res` map (`res`, `pcf` and the bias from `p`, `res` checked by the caller) over
-    /// projection `lp`.
-    pub fn new(gpu: &Gpu, scene: &GpuScene, name: &'static str, p: &ParamValues, lp: &LightProjection) -> MapPass {
-        let (res, pcf) = (p.get_u32("res"), p.get_u32("pcf"));
-        let params = SmParams::new(lp, res, p.get("pcf") as f32, p);
+    /// A `res x res` map (`res` checked by the caller) with `pcf` and `bias` over projection `lp`.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, name: &'static str, map: &MapSettings, lp: &LightProjection) -> MapPass {
+        let (res, pcf) = (map.res, map.pcf);
+        let params = SmParams::new(lp, res, pcf as f32, &map.bias);
         let depth = DepthPass::new(gpu, scene, name, res, &params);
         let label = format!("{name}.eval");
         let eval_layout = view_layout(

@@ -17,7 +17,7 @@ mod pipelines;
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
-use shadowlab_core::params::{ParamDef, ParamValues};
+use shadowlab_core::params::{ParamDef, ParamSet, ParamTable};
 use shadowlab_core::techniques::sv::EdgeList;
 
 use crate::record::Recorder;
@@ -41,10 +41,22 @@ pub const DEFAULT_FAR: f64 = 0.0;
 /// within that depth of a receiver are missed (contact shadows; 16 ulps: 480 wrong on sponza).
 pub const DEFAULT_DEPTH_OFFSET: f64 = 4.0;
 
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::number("far", DEFAULT_FAR, 0.0, 1000.0, "extrusion distance in scene diagonals (>= 1); 0 = infinite (w = 0) with unclipped depth, or 2 where the adapter lacks DEPTH_CLIP_CONTROL", "infinite extrusion: Everitt & Kilgard 2002; unclipped depth replaces their depth clamp"),
-    ParamDef::integer("depth_offset", DEFAULT_DEPTH_OFFSET, 0.0, 65536.0, "receiver depth moved towards the camera, f32 ulps; against self-shadowing of a surface by its own light cap", "shadowlab sweep 0/4/16/64/1024 ulps, 2026-11-22 (docs/bench/sv.md)"),
-];
+shadowlab_core::param_set! {
+    /// `sv`'s parameters.
+    pub struct SvSettings {
+        pub far: f64 = ParamDef::number("far", DEFAULT_FAR, 0.0, 1000.0, "extrusion distance in scene diagonals (>= 1); 0 = infinite (w = 0) with unclipped depth, or 2 where the adapter lacks DEPTH_CLIP_CONTROL", "infinite extrusion: Everitt & Kilgard 2002; unclipped depth replaces their depth clamp"),
+        pub depth_offset: u32 = ParamDef::integer("depth_offset", DEFAULT_DEPTH_OFFSET, 0.0, 65536.0, "receiver depth moved towards the camera, f32 ulps; against self-shadowing of a surface by its own light cap", "shadowlab sweep 0/4/16/64/1024 ulps, 2026-11-22 (docs/bench/sv.md)"),
+    }
+    rules {
+        fn validate(&self) -> Result<(), String> {
+            let far = self.far;
+            if far > 0.0 && far < 1.0 {
+                return Err(format!("far={far}: a finite extrusion must be at least 1 scene diagonal (or 0 = infinite)"));
+            }
+            Ok(())
+        }
+    }
+}
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "sv",
@@ -53,12 +65,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "exact hard shadows of the geometry (the seeds' ground truth); alpha cut-outs are treated as solid, so leaves cast blocks",
     source: "Crow 1977; z-fail: Everitt & Kilgard 2002; multiplicity: Milet, Kobrtek, Zemcik, Peciva 2014 (MKZP14 in seed 000)",
     lights: &["directional", "spot", "point"],
-    params: PARAMS,
+    params: ParamTable::of::<SvSettings>(),
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8); optional: DEPTH_CLIP_CONTROL (unclipped depth for the infinite extrusion) and DEPTH32FLOAT_STENCIL8, used where offered",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(ShadowVolumes::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(ShadowVolumes::new(gpu, scene, &SvSettings::from_values(p), light)?)),
 };
 
 /// WGSL `SvParams` (silhouette.wgsl, volume.wgsl, resolve.wgsl).
@@ -105,13 +117,11 @@ pub struct ShadowVolumes {
 }
 
 impl ShadowVolumes {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<ShadowVolumes, GpuError> {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &SvSettings, light: &Light) -> Result<ShadowVolumes, GpuError> {
         let features = gpu.device.features();
         let unclipped = features.contains(wgpu::Features::DEPTH_CLIP_CONTROL);
-        let far = p.get("far");
-        if far > 0.0 && far < 1.0 {
-            return Err(GpuError::Invalid(format!("sv far={far}: a finite extrusion must be at least 1 scene diagonal (or 0 = infinite)")));
-        }
+        p.validate().map_err(|e| GpuError::Invalid(format!("sv {e}")))?;
+        let far = p.far;
         let infinite = far == 0.0 && unclipped;
         let far = if far == 0.0 && !unclipped { 2.0 } else { far };
         let depth_format = if features.contains(wgpu::Features::DEPTH32FLOAT_STENCIL8) {
@@ -126,7 +136,7 @@ impl ShadowVolumes {
             triangles: scene.triangle_count,
             edges: list.edges.len() as u32,
             side_vertices: vps,
-            depth_offset: p.get_u32("depth_offset"),
+            depth_offset: p.depth_offset,
             extrude: if infinite { 0.0 } else { (far * scene.bounds.diagonal() as f64) as f32 },
             pad0: 0.0,
             pad1: 0.0,

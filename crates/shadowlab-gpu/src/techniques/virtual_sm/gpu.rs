@@ -2,7 +2,7 @@
 //! into the atlas (`render`), evaluation through the page table (`evaluate`).
 
 use shadowlab_core::light::Light;
-use shadowlab_core::params::ParamValues;
+use shadowlab_core::params::ParamSet;
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::virtual_sm::{
     bias_scale, pixel_angle, with_fallbacks, Allocation, Build, Clipmap, Demand, PageCache, PageKey, Projection, StaticCopies,
@@ -10,7 +10,7 @@ use shadowlab_core::techniques::virtual_sm::{
 
 use super::bounds::ChunkBounds;
 use super::draw::{clear_pipeline, copy_pipeline, moving_over, Chunk};
-use super::{eval_source, mark_source, page_source, VirtualParams, MAX_LEVELS};
+use super::{eval_source, mark_source, page_source, VirtualParams, VirtualSettings, MAX_LEVELS};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{view_layout, EvalPipelines, FrameInputs, Technique, TechniqueReport};
@@ -89,22 +89,19 @@ pub struct VirtualShadows {
 }
 
 impl VirtualShadows {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light) -> Result<VirtualShadows, GpuError> {
-        let (virtual_res, page_res, levels) = (p.get_u32("virtual_res"), p.get_u32("page_res"), p.get_u32("levels"));
-        if !page_res.is_power_of_two() || virtual_res % page_res != 0 {
-            return Err(GpuError::Invalid(format!(
-                "virtual: page_res {page_res} must be a power of two dividing virtual_res {virtual_res}"
-            )));
-        }
-        let extent0 = p.get("level0_extent") as f32;
+    /// Settings that break [`VirtualSettings`]'s rules are an error.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &VirtualSettings, light: &Light) -> Result<VirtualShadows, GpuError> {
+        p.validate().map_err(|e| GpuError::Invalid(format!("virtual: {e}")))?;
+        let (virtual_res, page_res, levels) = (p.virtual_res, p.page_res, p.levels);
+        let extent0 = p.level0_extent as f32;
         // the light's projection at creation (the light never moves): chunk rectangles, levels
         let proto = Clipmap::for_light(light, &scene.bounds, scene.bounds.center(), levels, virtual_res, page_res, extent0);
         let levels_param = levels;
         let levels = proto.levels;
         let max = gpu.limits.max_texture_dimension_2d;
         let page_bytes = page_res as f64 * page_res as f64 * 4.0;
-        let pool_mib = p.get("pool_mib");
-        let static_mib = pool_mib * p.get("static_share");
+        let pool_mib = p.pool_mib;
+        let static_mib = pool_mib * p.static_share;
         // the static copies come out of the pool, and only where something moves
         let moving = scene.dynamic_first < scene.triangle_count;
         let static_slots = if moving { atlas_shape((static_mib * 1048576.0 / page_bytes).floor() as u32, page_res, max) } else { (1, 0) };
@@ -178,7 +175,7 @@ impl VirtualShadows {
             }
         }
         let probe = gpu.storage("virtual.probe", table_len * 4 + dynamic.as_ref().map_or(0, |b| b.count as u64 * 24));
-        let kernel_half = (p.get_u32("pcf") as f32 - 1.0) * 0.5;
+        let kernel_half = (p.pcf as f32 - 1.0) * 0.5;
         Ok(VirtualShadows {
             light: *light,
             levels_param,
@@ -188,9 +185,9 @@ impl VirtualShadows {
             virtual_res,
             page_res,
             extent0,
-            bias_scale: bias_scale(p.get("resolution_bias") as f32),
+            bias_scale: bias_scale(p.resolution_bias as f32),
             // the kernel, the normal offset's sideways shift, one texel of rounding
-            reach: kernel_half + p.get("normal_offset") as f32 + 1.0,
+            reach: kernel_half + p.bias.normal_offset as f32 + 1.0,
             params,
             clipmap: None,
             cache: PageCache::new(cols * rows),
@@ -294,12 +291,12 @@ fn atlas_shape(slots: u32, page_res: u32, max: u32) -> (u32, u32) {
 }
 
 impl VirtualParams {
-    fn zeroed_for(p: &ParamValues, proto: &Clipmap, n: u32, page_res: u32, cols: u32) -> VirtualParams {
+    fn zeroed_for(p: &VirtualSettings, proto: &Clipmap, n: u32, page_res: u32, cols: u32) -> VirtualParams {
         let levels = proto.levels;
         let mut v: VirtualParams = bytemuck::Zeroable::zeroed();
         v.dims = [levels, n, page_res, cols];
-        v.bias = [p.get("bias") as f32, p.get("slope_bias") as f32, p.get("normal_offset") as f32, p.get("max_slope") as f32];
-        v.pcf = [p.get_u32("pcf"), 0, proto.mips, proto.faces()];
+        v.bias = p.bias.packed();
+        v.pcf = [p.pcf, 0, proto.mips, proto.faces()];
         if let Some((position, tan_half)) = proto.persp() {
             v.pcf[1] = if matches!(proto.projection, Projection::Cube { .. }) { 2 } else { 1 };
             v.spot = position.extend(tan_half).into();

@@ -32,6 +32,7 @@ mod report;
 use bytemuck::{Pod, Zeroable};
 pub use gpu::{VirtualShadows, CHUNK_TRIANGLES, DYNAMIC_CHUNK_TRIANGLES};
 pub use params::*;
+use shadowlab_core::params::{ParamSet, ParamTable};
 
 use crate::shaders::compose_depth;
 use crate::technique::{compose_view, TechniqueInfo};
@@ -74,12 +75,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     quality: "about one texel per pixel everywhere (resolution_bias); a full pool makes fine pages fall back to coarser ones (reported)",
     source: "Epic Games, Unreal Engine 5 virtual shadow maps (2021); clipmaps: Tanner, Migdal, Jones 1998",
     lights: &["directional", "spot", "point"],
-    params: PARAMS,
+    params: ParamTable::of::<VirtualSettings>(),
     stalls: "virtual.readback: the page requests read back for the CPU allocation (every frame)",
     needs: "",
     compare: &[],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(VirtualShadows::new(gpu, scene, p, light)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(VirtualShadows::new(gpu, scene, &VirtualSettings::from_values(p), light)?)),
 };
 
 /// WGSL `VirtualParams` (pages.wgsl).

@@ -1,8 +1,8 @@
 //! `virtual`'s parameter table: the page geometry of UE5's virtual shadow maps, the pool, and
 //! `sm`'s PCF and bias family (biases in texels of the level a sample uses).
 
-use shadowlab_core::params::family::{BIAS, MAX_SLOPE, NORMAL_OFFSET, PCF, SLOPE_BIAS};
-use shadowlab_core::params::ParamDef;
+use shadowlab_core::params::family::{Bias, PCF};
+use shadowlab_core::params::{Block, ParamDef};
 
 /// Virtual texels per level side: UE5's 16K virtual maps. Lower: coarser levels sooner (more
 /// levels needed); higher: more pages per level (bigger page table and request buffer).
@@ -30,59 +30,133 @@ pub const DEFAULT_POOL_MIB: f64 = 12.0;
 /// pages drawn whole on long paths, fewer pages for the view.
 pub const DEFAULT_STATIC_SHARE: f64 = 0.125;
 
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::integer(
-        "virtual_res",
-        DEFAULT_VIRTUAL_RES,
-        256.0,
-        65536.0,
-        "virtual texels per clipmap level side (a multiple of page_res)",
-        "UE5 virtual shadow maps: 16K",
-    ),
-    ParamDef::integer("page_res", DEFAULT_PAGE_RES, 16.0, 8192.0, "page side in texels (a power of two)", "UE5 virtual shadow maps: 128"),
-    ParamDef::integer(
-        "levels",
-        DEFAULT_LEVELS,
-        1.0,
-        24.0,
-        "clipmap levels; level k covers 2^k x level0_extent (spot: mip levels of the one map, at most down to one page)",
-        "shadowlab: covers 42 km at the default extent",
-    ),
-    ParamDef::number(
-        "level0_extent",
-        DEFAULT_LEVEL0_EXTENT,
-        1e-4,
-        1e6,
-        "world side of clipmap level 0 (scene units; directional lights only)",
-        "UE5 r.Shadow.Virtual.Clipmap.FirstLevel = 6 (radius 2^6 cm)",
-    ),
-    ParamDef::number(
-        "resolution_bias",
-        DEFAULT_RESOLUTION_BIAS,
-        -8.0,
-        8.0,
-        "level = ceil(log2(pixel footprint / level-0 texel at the sample) + bias); negative: finer texels, more pages",
-        "UE5 r.Shadow.Virtual.ResolutionLodBiasDirectional (spot: ...ResolutionLodBiasLocal)",
-    ),
-    ParamDef::number(
-        "pool_mib",
-        DEFAULT_POOL_MIB,
-        0.0625,
-        2048.0,
-        "physical page pool (MiB of Depth32Float pages)",
-        "csm's 3 x 1024^2 (issue 17)",
-    ),
-    ParamDef::number(
-        "static_share",
-        DEFAULT_STATIC_SHARE,
-        0.0,
-        0.9,
-        "share of pool_mib for static copies of pages under moving geometry (scenes with moving geometry only; 0: none)",
-        "UE5 static/dynamic page split (r.Shadow.Virtual.Cache.StaticSeparate); share: shadowlab",
-    ),
-    PCF,
-    BIAS,
-    SLOPE_BIAS,
-    MAX_SLOPE,
-    NORMAL_OFFSET,
-];
+shadowlab_core::param_set! {
+    /// `virtual`'s parameters.
+    pub struct VirtualSettings {
+        pub virtual_res: u32 = ParamDef::integer(
+            "virtual_res",
+            DEFAULT_VIRTUAL_RES,
+            256.0,
+            65536.0,
+            "virtual texels per clipmap level side (a multiple of page_res)",
+            "UE5 virtual shadow maps: 16K",
+        ),
+        pub page_res: u32 = ParamDef::integer("page_res", DEFAULT_PAGE_RES, 16.0, 8192.0, "page side in texels (a power of two)", "UE5 virtual shadow maps: 128"),
+        pub levels: u32 = ParamDef::integer(
+            "levels",
+            DEFAULT_LEVELS,
+            1.0,
+            24.0,
+            "clipmap levels; level k covers 2^k x level0_extent (spot: mip levels of the one map, at most down to one page)",
+            "shadowlab: covers 42 km at the default extent",
+        ),
+        pub level0_extent: f64 = ParamDef::number(
+            "level0_extent",
+            DEFAULT_LEVEL0_EXTENT,
+            1e-4,
+            1e6,
+            "world side of clipmap level 0 (scene units; directional lights only)",
+            "UE5 r.Shadow.Virtual.Clipmap.FirstLevel = 6 (radius 2^6 cm)",
+        ),
+        pub resolution_bias: f64 = ParamDef::number(
+            "resolution_bias",
+            DEFAULT_RESOLUTION_BIAS,
+            -8.0,
+            8.0,
+            "level = ceil(log2(pixel footprint / level-0 texel at the sample) + bias); negative: finer texels, more pages",
+            "UE5 r.Shadow.Virtual.ResolutionLodBiasDirectional (spot: ...ResolutionLodBiasLocal)",
+        ),
+        pub pool_mib: f64 = ParamDef::number(
+            "pool_mib",
+            DEFAULT_POOL_MIB,
+            0.0625,
+            2048.0,
+            "physical page pool (MiB of Depth32Float pages)",
+            "csm's 3 x 1024^2 (issue 17)",
+        ),
+        pub static_share: f64 = ParamDef::number(
+            "static_share",
+            DEFAULT_STATIC_SHARE,
+            0.0,
+            0.9,
+            "share of pool_mib for static copies of pages under moving geometry (scenes with moving geometry only; 0: none)",
+            "UE5 static/dynamic page split (r.Shadow.Virtual.Cache.StaticSeparate); share: shadowlab",
+        ),
+        pub pcf: u32 = PCF,
+        pub bias: Bias = Block::as_declared(),
+    }
+    rules {
+        /// Pages tile each level exactly.
+        fn validate(&self) -> Result<(), String> {
+            let (page_res, virtual_res) = (self.page_res, self.virtual_res);
+            if !page_res.is_power_of_two() || virtual_res % page_res != 0 {
+                return Err(format!("page_res {page_res} must be a power of two dividing virtual_res {virtual_res}"));
+            }
+            Ok(())
+        }
+
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            if self.bias.slope_bias == 0.0 && self.pcf == 1 {
+                vec![("max_slope", "it clamps the slope bias and the PCF kernel's bias, and slope_bias=0 with pcf=1 has neither".to_string())]
+            } else {
+                Vec::new()
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use shadowlab_core::params::{ParamSet, TechniqueSpec};
+
+    use super::*;
+    use crate::registry::{resolve, Resolved};
+    use crate::GpuError;
+
+    fn ok(spec: &str) -> Resolved {
+        resolve(&TechniqueSpec::parse(spec).unwrap(), None).unwrap_or_else(|e| panic!("{spec}: {e}"))
+    }
+
+    fn err(spec: &str) -> String {
+        match resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
+            Err(GpuError::Invalid(m)) => m,
+            other => panic!("{spec}: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn virtual_lists_its_keys_as_before_and_reads_them_typed() {
+        let keys: Vec<_> = VirtualSettings::defs().iter().map(|d| d.key).collect();
+        assert_eq!(
+            keys,
+            [
+                "virtual_res",
+                "page_res",
+                "levels",
+                "level0_extent",
+                "resolution_bias",
+                "pool_mib",
+                "static_share",
+                "pcf",
+                "bias",
+                "slope_bias",
+                "max_slope",
+                "normal_offset"
+            ]
+        );
+        let s = VirtualSettings::from_values(&ok("virtual:pool_mib=64,static_share=0,pcf=3,slope_bias=1").values);
+        assert_eq!((s.pool_mib, s.static_share, s.pcf, s.virtual_res, s.page_res), (64.0, 0.0, 3, 16384, 128));
+        assert_eq!(s.bias.packed(), [0.5, 1.0, 0.5, 4.0]);
+    }
+
+    #[test]
+    fn virtual_checks_its_pages_and_rejects_keys_without_effect() {
+        let e = err("virtual:page_res=96");
+        assert!(e.contains("technique 'virtual': page_res 96 must be a power of two dividing virtual_res 16384"), "{e}");
+        assert!(err("virtual:virtual_res=1000,page_res=64").contains("page_res 64 must be a power of two dividing virtual_res 1000"));
+        ok("virtual:virtual_res=2048,page_res=64");
+        assert!(err("virtual:max_slope=2").contains("max_slope has no effect"));
+        ok("virtual:pcf=3,max_slope=2");
+        ok("virtual:slope_bias=0.5,max_slope=2");
+    }
+}

@@ -30,7 +30,7 @@ pub use params::*;
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
-use shadowlab_core::params::ParamValues;
+use shadowlab_core::params::{ParamSet, ParamTable};
 use shadowlab_core::techniques::dpsm::Hemisphere;
 
 use crate::prefix_sum::PrefixSum;
@@ -84,12 +84,12 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     quality: "samples spread evenly over the map; long triangles bend unless subdivided",
     source: "seed 000 section 3, seed 002 chapter 4 (Navratil et al.)",
     lights: LIGHTS,
-    params: NOTW_OWN_PARAMS,
+    params: ParamTable::of::<NotwSettings>(),
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Notw)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, &Knobs::notw(&NotwSettings::from_values(p)), light)?)),
 };
 
 pub const RTW_INFO: TechniqueInfo = TechniqueInfo {
@@ -99,12 +99,12 @@ pub const RTW_INFO: TechniqueInfo = TechniqueInfo {
     quality: "rectilinear grid: a row/column gets the resolution of its most important texel",
     source: "Rosen 2012; seed 000 section 2.2, seed 002 section 3.2.2",
     lights: LIGHTS,
-    params: RTW_PARAMS,
+    params: ParamTable::of::<RtwSettings>(),
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Rtw)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, &Knobs::rtw(&RtwSettings::from_values(p)), light)?)),
 };
 
 pub const DV_INFO: TechniqueInfo = TechniqueInfo {
@@ -114,12 +114,12 @@ pub const DV_INFO: TechniqueInfo = TechniqueInfo {
     quality: "wins on close-ups; on wide views the crop barely shrinks (seed 000 section 4)",
     source: "seed 000 section 3.2 (\"Ours-DV\"), Rosen 2012's desired view",
     lights: LIGHTS,
-    params: DV_PARAMS,
+    params: ParamTable::of::<DvSettings>(),
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     compare: &[""],
     shaders,
-    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, p, light, Variant::Dv)?)),
+    create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, &Knobs::dv(&DvSettings::from_values(p)), light)?)),
 };
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -286,26 +286,21 @@ pub enum Projection {
 }
 
 impl Warped {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &ParamValues, light: &Light, variant: Variant) -> Result<Warped, GpuError> {
-        Warped::new_sharing(gpu, scene, p, light, variant, None)
+    /// A planar warped map of a directional or spot light, with the knobs of `rtw`, `notw` or
+    /// `notw-dv` ([`Knobs::rtw`], [`Knobs::notw`], [`Knobs::dv`]).
+    pub fn new(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light) -> Result<Warped, GpuError> {
+        Warped::new_sharing(gpu, scene, k, light, None)
     }
 
     /// `new`, borrowing `shared`'s subdivision buffers when they are large enough.
-    pub fn new_sharing(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        p: &ParamValues,
-        light: &Light,
-        variant: Variant,
-        shared: Option<&SubdivScratch>,
-    ) -> Result<Warped, GpuError> {
-        let name = variant.name();
-        let res = p.get_u32("res");
+    pub fn new_sharing(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light, shared: Option<&SubdivScratch>) -> Result<Warped, GpuError> {
+        let name = k.variant.name();
+        let res = k.res;
         gpu.check_size(res, res, "shadow map")?;
         let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
             GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
         })?;
-        let mut w = Warped::with_projection(gpu, scene, p, variant, Projection::Planar(lp), name, true)?;
+        let mut w = Warped::with_projection(gpu, scene, k, Projection::Planar(lp), name)?;
         if let Some(s) = shared {
             w.borrow_subdiv(s);
         }
@@ -335,29 +330,19 @@ impl Warped {
         self.work.size() + self.fwork.size() + self.counts.size() + subdiv + occ
     }
 
-    /// A warped map over `proj`, labelled `name` (wgpu labels, stage names `{name}.<stage>`);
-    /// `dv`: crop to the desired view. `Variant::Dv` without `dv` is the plain (unwarped) map,
-    /// rendered with subdivision when `proj` is a paraboloid. The caller has checked `res`.
-    pub fn with_projection(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        p: &ParamValues,
-        variant: Variant,
-        proj: Projection,
-        name: &'static str,
-        dv: bool,
-    ) -> Result<Warped, GpuError> {
-        let res = p.get_u32("res");
+    /// A warped map over `proj`, labelled `name` (wgpu labels, stage names `{name}.<stage>`),
+    /// with knobs made for that kind of projection (a paraboloid's: [`Knobs::dpsm`],
+    /// [`Knobs::dpsm_notw`]). The knobs also say whether the map is cropped to the desired view:
+    /// `dpsm`'s is not (the plain, unwarped paraboloid map, rendered with subdivision). The
+    /// caller has checked `res`.
+    pub fn with_projection(gpu: &Gpu, scene: &GpuScene, k: &Knobs, proj: Projection, name: &'static str) -> Result<Warped, GpuError> {
+        let (variant, res, dv) = (k.variant, k.res, k.crop);
         let (view_proj, texel, perspective, kind) = match proj {
             Projection::Planar(lp) => (lp.view_proj, lp.texel, lp.perspective, 0),
             // 2/res of the map plane per texel: 2 (1 + n.z) / res radians (core techniques::dpsm)
             Projection::Paraboloid { view, hemisphere } => (view, 2.0 / res as f32, false, 1 + (hemisphere == Hemisphere::Back) as u32),
         };
-        let paraboloid = kind != 0;
-        let k = Knobs::read(p, variant, paraboloid, dv);
-        if k.window >= res {
-            return Err(GpuError::Invalid(format!("{name}: window {} must be below res {res}", k.window)));
-        }
+        assert_eq!(k.paraboloid, kind != 0, "{name}: knobs made for another projection");
         let tris = scene.triangle_count;
         let limit = gpu.limits.max_storage_buffer_binding_size / 16;
         let on = k.subdiv > 0.0;
@@ -380,11 +365,11 @@ impl Warped {
             texel_world: texel,
             perspective: perspective as u32 as f32,
             res: res as f32,
-            pcf: p.get("pcf") as f32,
-            bias: p.get("bias") as f32,
-            slope_bias: p.get("slope_bias") as f32,
-            normal_offset: p.get("normal_offset") as f32,
-            max_slope: p.get("max_slope") as f32,
+            pcf: k.pcf as f32,
+            bias: k.bias[0],
+            slope_bias: k.bias[1],
+            normal_offset: k.bias[2],
+            max_slope: k.bias[3],
             dv_margin: k.dv_margin,
             dv_mode: match (dv, k.close_cracks) {
                 (false, _) => 0.0,
@@ -507,7 +492,7 @@ impl Warped {
             variant,
             label: name,
             res,
-            pcf: p.get_u32("pcf"),
+            pcf: k.pcf,
             params,
             uniform: gpu.uniform(&format!("{name}.params"), &params),
             dv: gpu.storage(&format!("{name}.dv"), 32),

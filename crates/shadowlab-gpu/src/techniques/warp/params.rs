@@ -1,9 +1,14 @@
 //! The parameters of `rtw`, `notw` and `notw-dv`: defaults as named constants with where they
-//! come from and what goes wrong when too low or high.
+//! come from and what goes wrong when too low or high; the typed settings of each variant
+//! ([`RtwSettings`], [`NotwSettings`], [`DvSettings`]) and the blocks the warped point-light
+//! maps share ([`Subdivision`], [`BiasFootprint`], [`NotwCore`]); and the [`Knobs`] a warped map
+//! runs with, made from those settings.
 
-use shadowlab_core::params::{family, ParamDef, ParamValues};
+use shadowlab_core::params::family::{self, Bias};
+use shadowlab_core::params::{Block, ParamDef};
 
 use super::Variant;
+use crate::techniques::dpsm::{DpsmNotwSettings, DpsmSettings};
 
 /// Smoothing window (functions averaged: [i - window/2, i + window/2]). 16 is the authors'
 /// public code (GUIDE). Too low: neighbouring rows warp differently and long triangles bend
@@ -54,7 +59,6 @@ pub const RES: ParamDef = family::RES.with_range(16.0, 8192.0).with_doc("shadow 
 pub const PCF: ParamDef = family::PCF.with_doc("PCF kernel width N in warped texels; 1 = hard test");
 pub const BIAS: ParamDef = family::BIAS.with_doc("constant depth bias, warped texels; low: acne, high: peter-panning");
 pub const SLOPE: ParamDef = family::SLOPE_BIAS.with_doc("slope-scaled bias, warped texels x tan(angle)");
-pub const MAX_SLOPE: ParamDef = family::MAX_SLOPE;
 pub const NORMAL_OFFSET: ParamDef = family::NORMAL_OFFSET
     .with_doc("offset along the normal in warped texels (local size from the warp's Jacobian); low: acne, high: shifted shadows");
 pub const DV_MARGIN: ParamDef = ParamDef::number(
@@ -272,141 +276,440 @@ pub const EDGE_IMPORTANCE: ParamDef = ParamDef::integer(
     "shadowlab (point-light importance, issue 18); edge term: Rosen 2012 (RTW)",
 );
 
-/// The parameters `notw` shares with `cube-notw` and `dpsm-notw` (they override some defaults).
-const NOTW_SHARED: [ParamDef; 17] = [
-    RES,
-    WINDOW,
-    NOTW_BLUR,
-    MIX,
-    INTERP,
-    NOTW_SUBDIV,
-    SUBDIV_LEVELS,
-    SUBDIV_CAPACITY,
-    MIN_PIECE,
-    CLOSE_CRACKS,
-    NOTW_EXACT,
-    PCF,
-    NOTW_BIAS,
-    SLOPE,
-    MAX_SLOPE,
-    NORMAL_OFFSET,
-    DV_MARGIN,
-];
-pub const NOTW_PARAMS: &[ParamDef] = &NOTW_SHARED;
-
-/// `a` then `b` (N = A + B).
-const fn concat<const A: usize, const B: usize, const N: usize>(a: [ParamDef; A], b: [ParamDef; B]) -> [ParamDef; N] {
-    assert!(A + B == N && A > 0);
-    let mut out = [a[0]; N];
-    let mut i = 0;
-    while i < N {
-        out[i] = if i < A { a[i] } else { b[i - A] };
-        i += 1;
-    }
-    out
-}
-
-/// notw's own list: `NOTW_PARAMS` plus the warp strength, the bias footprint parameters, the
-/// exact depth's clamp and inversion, hidden-edge culling and the smoothing's tent.
-pub const NOTW_OWN_PARAMS: &[ParamDef] = &concat::<17, 8, 25>(
-    NOTW_SHARED,
-    [STRENGTH, BIAS_MODE, FOOTPRINT_CAP, DEPTH_CLAMP, EXACT_INVERSE, CULL_HIDDEN, WINDOW_TENT, EDGE_IMPORTANCE],
-);
-
 /// `bias_mode` at 0 (isotropic footprint): what rtw, notw-dv, dpsm and the point-light NoTWs
 /// run with; the gradient footprint (2) was measured for `notw` only.
 pub const BIAS_MODE_ISOTROPIC: ParamDef =
     BIAS_MODE.with_default(0.0, "the isotropic footprint the gradient footprint was measured against (docs/bench/warp_bias.md)");
 
-pub const RTW_PARAMS: &[ParamDef] = &[
-    RES,
-    W_DV,
-    W_EYE,
-    BLUR,
-    INTERP,
-    SUBDIV,
-    SUBDIV_LEVELS,
-    SUBDIV_CAPACITY,
-    MIN_PIECE,
-    CLOSE_CRACKS,
-    EXACT_DEPTH,
-    PCF,
-    BIAS,
-    SLOPE,
-    MAX_SLOPE,
-    NORMAL_OFFSET,
-    DV_MARGIN,
-    STRENGTH,
-    BIAS_MODE_ISOTROPIC,
-    FOOTPRINT_CAP,
-    DEPTH_CLAMP,
-];
-pub const DV_PARAMS: &[ParamDef] =
-    &[RES, PCF, BIAS, SLOPE, MAX_SLOPE, NORMAL_OFFSET, DV_MARGIN, BIAS_MODE_ISOTROPIC, FOOTPRINT_CAP, DEPTH_CLAMP];
+/// The bias family in warped texels (warp's docs for the constant bias, the slope bias and the
+/// normal offset), with `bias` as the constant bias's row.
+fn warped_bias(bias: ParamDef) -> Block {
+    Block::as_declared().with(bias).with(SLOPE).with(NORMAL_OFFSET)
+}
 
-/// The settings a warped map runs with, read from the parameters each variant declares. What a
-/// variant's method does not have is fixed here, not defaulted: RTW has no smoothing window or
-/// uniform floor (its warps are 1D), NoTW no RTW importance, and the DV crop (`notw-dv`, and
-/// `dpsm`'s plain paraboloids) no warp at all (subdivision only on a paraboloid).
+/// Why a paraboloid map's `depth_clamp` does nothing (depth.wgsl: its exact depth is clamped to
+/// the piece's distance range, whatever the clamp).
+pub(crate) const PARABOLOID_CLAMP: &str = "a paraboloid map clamps the exact depth to the piece's distance range";
+
+/// `(key, why)` for each of `keys`, all dead for the same reason.
+fn dead_keys(keys: &[&'static str], why: &str) -> Vec<(&'static str, String)> {
+    keys.iter().map(|k| (*k, why.to_string())).collect()
+}
+
+/// The NoTW smoothing window (functions averaged over [i - window/2, i + window/2]) must be
+/// below the map side.
+fn window_below_res(window: u32, res: u32) -> Result<(), String> {
+    if window >= res {
+        Err(format!("window {window} must be below res {res}"))
+    } else {
+        Ok(())
+    }
+}
+
+shadowlab_core::param_set! {
+    /// Subdivision of the triangles before the warped (or paraboloid) depth pass: the bend
+    /// threshold and its bounds (levels, capacity, smallest piece).
+    pub struct Subdivision {
+        /// Warped texels; 0 = off (f32: the uniform's precision decides "off").
+        pub subdiv: f32 = SUBDIV,
+        pub subdiv_levels: u32 = SUBDIV_LEVELS,
+        pub subdiv_capacity: u32 = SUBDIV_CAPACITY,
+        pub min_piece: f32 = MIN_PIECE,
+    }
+}
+
+impl Subdivision {
+    /// Whether the pieces are subdivided at all.
+    pub fn on(&self) -> bool {
+        self.subdiv > 0.0
+    }
+    /// Without subdivision its bounds do nothing.
+    pub(crate) fn dead(&self) -> Vec<(&'static str, String)> {
+        if self.on() {
+            vec![]
+        } else {
+            dead_keys(&["subdiv_levels", "subdiv_capacity", "min_piece"], "subdiv=0 turns subdivision off")
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// How a warped texel's world size, which scales the bias and the normal offset, is taken
+    /// from the warp (eval.wgsl; see `DEFAULT_BIAS_MODE`).
+    pub struct BiasFootprint {
+        pub bias_mode: u32 = BIAS_MODE,
+        pub footprint_cap: f32 = FOOTPRINT_CAP,
+    }
+}
+
+impl BiasFootprint {
+    /// On a warped map: only modes 2-4 cap the gradient footprint.
+    pub(crate) fn dead(&self) -> Vec<(&'static str, String)> {
+        if self.bias_mode < 2 {
+            dead_keys(
+                &["footprint_cap"],
+                &format!("bias_mode={} does not use the capped gradient footprint (modes 2-4 do)", self.bias_mode),
+            )
+        } else {
+            vec![]
+        }
+    }
+    /// What a map without a warp runs with (`notw-dv`, `dpsm`; they declare no footprint):
+    /// eval.wgsl sizes every texel as the cropped texel whatever the mode, so the mode is the
+    /// isotropic default.
+    pub(crate) fn unwarped() -> BiasFootprint {
+        BiasFootprint { bias_mode: BIAS_MODE_ISOTROPIC.default as u32, footprint_cap: FOOTPRINT_CAP.default as f32 }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// NoTW's warp on one map, shared by `notw`, `cube-notw` (per face) and `dpsm-notw` (per
+    /// hemisphere; they override some defaults): smoothing, counts, subdivision, depth, lookup
+    /// and bias.
+    pub struct NotwCore {
+        pub window: u32 = WINDOW,
+        pub blur: u32 = NOTW_BLUR,
+        pub mix: f32 = MIX,
+        pub interp: bool = INTERP,
+        pub subdivision: Subdivision = Block::as_declared().with(NOTW_SUBDIV),
+        pub close_cracks: bool = CLOSE_CRACKS,
+        pub exact_depth: bool = NOTW_EXACT,
+        pub pcf: u32 = PCF,
+        pub bias: Bias = warped_bias(NOTW_BIAS),
+        pub dv_margin: f32 = DV_MARGIN,
+        pub strength: f32 = STRENGTH,
+        pub footprint: BiasFootprint = Block::as_declared(),
+        pub depth_clamp: u32 = DEPTH_CLAMP,
+        pub exact_inverse: bool = EXACT_INVERSE,
+    }
+}
+
+impl NotwCore {
+    /// The rules of the block on a map of side `res`.
+    pub(crate) fn validate_at(&self, res: u32) -> Result<(), String> {
+        window_below_res(self.window, res)
+    }
+    /// The keys of the block that do nothing with these values; `paraboloid`: a hemisphere of
+    /// `dpsm-notw`, whose exact depth is clamped to the piece's distance range instead.
+    pub(crate) fn dead(&self, paraboloid: bool) -> Vec<(&'static str, String)> {
+        let mut v = self.subdivision.dead();
+        v.extend(self.footprint.dead());
+        if paraboloid {
+            v.extend(dead_keys(&["depth_clamp"], PARABOLOID_CLAMP));
+        } else if !self.exact_depth {
+            v.extend(dead_keys(&["depth_clamp"], "exact_depth=false"));
+        }
+        if !self.exact_depth {
+            v.extend(dead_keys(&["exact_inverse"], "exact_depth=false"));
+        }
+        v
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `rtw`'s parameters: RTW's importance and 1D blur, subdivision, depth, lookup and bias.
+    pub struct RtwSettings {
+        pub res: u32 = RES,
+        pub w_dv: f32 = W_DV,
+        pub w_eye: f32 = W_EYE,
+        pub blur: u32 = BLUR,
+        pub interp: bool = INTERP,
+        pub subdivision: Subdivision = Block::as_declared(),
+        pub close_cracks: bool = CLOSE_CRACKS,
+        pub exact_depth: bool = EXACT_DEPTH,
+        pub pcf: u32 = PCF,
+        pub bias: Bias = warped_bias(BIAS),
+        pub dv_margin: f32 = DV_MARGIN,
+        pub strength: f32 = STRENGTH,
+        pub footprint: BiasFootprint = Block::as_declared().with(BIAS_MODE_ISOTROPIC),
+        pub depth_clamp: u32 = DEPTH_CLAMP,
+    }
+    rules {
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            let mut v = self.subdivision.dead();
+            v.extend(self.footprint.dead());
+            if !self.exact_depth {
+                v.extend(dead_keys(&["depth_clamp"], "exact_depth=false"));
+            }
+            v
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `notw`'s parameters: the NoTW block, then hidden-edge culling, the smoothing's tent and
+    /// the shadow-edge importance (planar maps only).
+    pub struct NotwSettings {
+        pub res: u32 = RES,
+        pub core: NotwCore = Block::as_declared(),
+        pub cull_hidden: bool = CULL_HIDDEN,
+        pub window_tent: bool = WINDOW_TENT,
+        pub edge_importance: u32 = EDGE_IMPORTANCE,
+    }
+    rules {
+        fn validate(&self) -> Result<(), String> {
+            self.core.validate_at(self.res)
+        }
+        fn ineffective(&self) -> Vec<(&'static str, String)> {
+            let mut v = self.core.dead(false);
+            if !self.core.subdivision.on() {
+                v.extend(dead_keys(&["cull_hidden"], "subdiv=0 turns subdivision off"));
+            }
+            v
+        }
+    }
+}
+
+shadowlab_core::param_set! {
+    /// `notw-dv`'s parameters: the DV crop's map, lookup and bias (no warp, so no footprint
+    /// mode; no subdivision, so no exact depth to clamp).
+    pub struct DvSettings {
+        pub res: u32 = RES,
+        pub pcf: u32 = PCF,
+        pub bias: Bias = warped_bias(BIAS),
+        pub dv_margin: f32 = DV_MARGIN,
+    }
+}
+
+/// The settings a warped map runs with, made from the settings each variant declares. What a
+/// variant's method does not have is fixed here ([`Knobs::fixed`]), not defaulted: RTW has no
+/// smoothing window or uniform floor (its warps are 1D), NoTW no RTW importance, and the DV crop
+/// (`notw-dv`, and `dpsm`'s plain paraboloids) no warp at all (subdivision only on a
+/// paraboloid).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Knobs {
-    pub window: u32,
-    pub blur: u32,
-    pub mix: f32,
-    pub w_dv: f32,
-    pub w_eye: f32,
-    pub interp: bool,
+pub struct Knobs {
+    pub(crate) variant: Variant,
+    /// Made for a hemisphere of a dual-paraboloid map ([`super::Projection::Paraboloid`]).
+    pub(crate) paraboloid: bool,
+    /// Cropped to the desired view.
+    pub(crate) crop: bool,
+    pub(crate) res: u32,
+    pub(crate) pcf: u32,
+    /// [`Bias::packed`]: bias, slope bias, normal offset, max slope.
+    pub(crate) bias: [f32; 4],
+    pub(crate) window: u32,
+    pub(crate) blur: u32,
+    pub(crate) mix: f32,
+    pub(crate) w_dv: f32,
+    pub(crate) w_eye: f32,
+    pub(crate) interp: bool,
     /// Subdivision threshold (warped texels); 0 = off.
-    pub subdiv: f32,
-    pub subdiv_levels: u32,
+    pub(crate) subdiv: f32,
+    pub(crate) subdiv_levels: u32,
     /// Pieces beyond the triangles; 0 = automatic.
-    pub subdiv_capacity: u32,
+    pub(crate) subdiv_capacity: u32,
     /// Smallest warped extent (texels) of an edge that is split; 0 = no bound.
-    pub min_piece: f32,
-    pub exact_depth: bool,
-    pub close_cracks: bool,
-    pub dv_margin: f32,
-    pub strength: f32,
-    pub bias_mode: u32,
-    pub footprint_cap: f32,
-    pub depth_clamp: u32,
+    pub(crate) min_piece: f32,
+    pub(crate) exact_depth: bool,
+    pub(crate) close_cracks: bool,
+    pub(crate) dv_margin: f32,
+    pub(crate) strength: f32,
+    pub(crate) bias_mode: u32,
+    pub(crate) footprint_cap: f32,
+    pub(crate) depth_clamp: u32,
     /// Exact inversion in the exact depth pass (the NoTW variants: notw, cube-notw, dpsm-notw).
-    pub exact_inverse: bool,
+    pub(crate) exact_inverse: bool,
     /// Leave hidden edges unsplit (`cull_hidden`; planar projections only).
-    pub cull_hidden: bool,
+    pub(crate) cull_hidden: bool,
     /// Tent-weighted smoothing across functions (`window_tent`, NoTW).
-    pub tent: bool,
+    pub(crate) tent: bool,
     /// Extra count of a shadow-edge sample (`edge_importance`; planar NoTW only).
-    pub edge_importance: u32,
+    pub(crate) edge_importance: u32,
 }
 
 impl Knobs {
-    pub(super) fn read(p: &ParamValues, variant: Variant, paraboloid: bool, dv: bool) -> Knobs {
-        let (notw, rtw, warped) = (variant == Variant::Notw, variant == Variant::Rtw, variant != Variant::Dv);
-        let subdivides = warped || paraboloid;
-        let subdiv = if subdivides { p.get("subdiv") as f32 } else { 0.0 };
+    /// What every variant declares (map, lookup, bias, footprint), with everything else at the
+    /// value of a method that lacks it: no smoothing, counts or RTW importance, no subdivision
+    /// (1 level, automatic capacity) and so no exact depth, no DV margin, the full warp strength
+    /// (there is none to scale), no hidden-edge culling, box smoothing, samples counted alone.
+    #[allow(clippy::too_many_arguments)]
+    fn fixed(
+        variant: Variant,
+        paraboloid: bool,
+        crop: bool,
+        res: u32,
+        pcf: u32,
+        bias: &Bias,
+        footprint: &BiasFootprint,
+        depth_clamp: u32,
+    ) -> Knobs {
         Knobs {
-            window: if notw { p.get_u32("window") } else { 0 },
-            blur: if warped { p.get_u32("blur") } else { 0 },
-            mix: if notw { p.get("mix") as f32 } else { 0.0 },
-            w_dv: if rtw { p.get("w_dv") as f32 } else { 0.0 },
-            w_eye: if rtw { p.get("w_eye") as f32 } else { 0.0 },
-            interp: !warped || p.get_bool("interp"),
-            subdiv,
-            subdiv_levels: if subdivides { p.get_u32("subdiv_levels") } else { 1 },
-            subdiv_capacity: if subdivides { p.get_u32("subdiv_capacity") } else { 0 },
-            min_piece: if subdivides { p.get("min_piece") as f32 } else { 0.0 },
-            exact_depth: subdivides && p.get_bool("exact_depth"),
-            close_cracks: warped && dv && p.get_bool("close_cracks"),
-            dv_margin: if dv { p.get("dv_margin") as f32 } else { 0.0 },
-            strength: if warped { p.get("strength") as f32 } else { 1.0 },
-            bias_mode: p.get_u32("bias_mode"),
-            footprint_cap: p.get("footprint_cap") as f32,
-            depth_clamp: p.get_u32("depth_clamp"),
-            exact_inverse: notw && p.get_bool("exact_inverse"),
-            cull_hidden: notw && !paraboloid && subdiv > 0.0 && p.get_bool("cull_hidden"),
-            tent: notw && p.get_bool("window_tent"),
-            edge_importance: if notw && !paraboloid { p.get_u32("edge_importance") } else { 0 },
+            variant,
+            paraboloid,
+            crop,
+            res,
+            pcf,
+            bias: bias.packed(),
+            window: 0,
+            blur: 0,
+            mix: 0.0,
+            w_dv: 0.0,
+            w_eye: 0.0,
+            interp: true,
+            subdiv: 0.0,
+            subdiv_levels: 1,
+            subdiv_capacity: 0,
+            min_piece: 0.0,
+            exact_depth: false,
+            close_cracks: false,
+            dv_margin: 0.0,
+            strength: 1.0,
+            bias_mode: footprint.bias_mode,
+            footprint_cap: footprint.footprint_cap,
+            depth_clamp,
+            exact_inverse: false,
+            cull_hidden: false,
+            tent: false,
+            edge_importance: 0,
         }
+    }
+
+    /// With `s`'s subdivision and `exact_depth` (which subdivision makes available).
+    fn subdividing(self, s: &Subdivision, exact_depth: bool) -> Knobs {
+        Knobs {
+            subdiv: s.subdiv,
+            subdiv_levels: s.subdiv_levels,
+            subdiv_capacity: s.subdiv_capacity,
+            min_piece: s.min_piece,
+            exact_depth,
+            ..self
+        }
+    }
+
+    /// NoTW's block on a planar map or a paraboloid hemisphere, cropped to the desired view.
+    fn notw_core(c: &NotwCore, res: u32, paraboloid: bool, tent: bool) -> Knobs {
+        Knobs {
+            window: c.window,
+            blur: c.blur,
+            mix: c.mix,
+            interp: c.interp,
+            close_cracks: c.close_cracks,
+            dv_margin: c.dv_margin,
+            strength: c.strength,
+            exact_inverse: c.exact_inverse,
+            tent,
+            ..Knobs::fixed(Variant::Notw, paraboloid, true, res, c.pcf, &c.bias, &c.footprint, c.depth_clamp)
+                .subdividing(&c.subdivision, c.exact_depth)
+        }
+    }
+
+    /// `rtw`: planar, cropped; no smoothing window, uniform floor or NoTW options.
+    pub fn rtw(s: &RtwSettings) -> Knobs {
+        Knobs {
+            blur: s.blur,
+            w_dv: s.w_dv,
+            w_eye: s.w_eye,
+            interp: s.interp,
+            close_cracks: s.close_cracks,
+            dv_margin: s.dv_margin,
+            strength: s.strength,
+            ..Knobs::fixed(Variant::Rtw, false, true, s.res, s.pcf, &s.bias, &s.footprint, s.depth_clamp)
+                .subdividing(&s.subdivision, s.exact_depth)
+        }
+    }
+
+    /// `notw` (and each face of `cube-notw`): planar, cropped, every NoTW option.
+    pub fn notw(s: &NotwSettings) -> Knobs {
+        let k = Knobs::notw_core(&s.core, s.res, false, s.window_tent);
+        Knobs { cull_hidden: k.subdiv > 0.0 && s.cull_hidden, edge_importance: s.edge_importance, ..k }
+    }
+
+    /// `notw-dv`: planar, cropped, no warp and no subdivision.
+    pub fn dv(s: &DvSettings) -> Knobs {
+        Knobs { dv_margin: s.dv_margin, ..Knobs::fixed(Variant::Dv, false, true, s.res, s.pcf, &s.bias, &BiasFootprint::unwarped(), 0) }
+    }
+
+    /// A hemisphere of `dpsm`: the plain paraboloid map (no crop, no warp), subdivided.
+    pub fn dpsm(s: &DpsmSettings) -> Knobs {
+        Knobs::fixed(Variant::Dv, true, false, s.res, s.pcf, &s.bias, &BiasFootprint::unwarped(), 0)
+            .subdividing(&s.subdivision, s.exact_depth)
+    }
+
+    /// A hemisphere of `dpsm-notw`: NoTW on the paraboloid map, cropped (no hidden-edge culling
+    /// or edge importance: those need a planar occluder map).
+    pub fn dpsm_notw(s: &DpsmNotwSettings) -> Knobs {
+        Knobs::notw_core(&s.core, s.res, true, s.window_tent)
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use shadowlab_core::params::{ParamSet, TechniqueSpec};
+
+    use super::*;
+    use crate::GpuError;
+
+    /// The keys of `P`'s table, in listing order.
+    pub(crate) fn keys<P: ParamSet>() -> Vec<&'static str> {
+        P::defs().iter().map(|d| d.key).collect()
+    }
+
+    /// `registry::resolve`'s error for `spec` (which applies the rules), or "" if it resolves.
+    pub(crate) fn error(spec: &str) -> String {
+        match crate::registry::resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
+            Ok(_) => String::new(),
+            Err(GpuError::Invalid(m)) => m,
+            Err(e) => panic!("{spec}: {e}"),
+        }
+    }
+
+    #[test]
+    fn the_tables_keep_their_keys_in_order() {
+        #[rustfmt::skip]
+        let rtw = ["res", "w_dv", "w_eye", "blur", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
+            "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
+            "bias_mode", "footprint_cap", "depth_clamp"];
+        #[rustfmt::skip]
+        let notw = ["res", "window", "blur", "mix", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
+            "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
+            "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "cull_hidden", "window_tent", "edge_importance"];
+        #[rustfmt::skip]
+        let dv = ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin"];
+        assert_eq!(keys::<RtwSettings>(), rtw);
+        assert_eq!(keys::<NotwSettings>(), notw);
+        assert_eq!(keys::<DvSettings>(), dv);
+    }
+
+    #[test]
+    fn the_rules_reject_conflicts_and_dead_keys() {
+        assert_eq!(error("notw:window=512"), "technique 'notw': window 512 must be below res 512");
+        assert_eq!(error("notw:res=1024,window=512"), "");
+        let e = error("notw:subdiv=0,cull_hidden=true");
+        assert_eq!(e, "technique 'notw': cull_hidden has no effect: subdiv=0 turns subdivision off");
+        assert!(error("notw:subdiv=0,min_piece=1,subdiv_levels=3").contains("subdiv_levels has no effect"));
+        assert!(error("rtw:subdiv=0,subdiv_capacity=64").contains("subdiv_capacity has no effect: subdiv=0"));
+        assert!(error("notw:exact_depth=false,exact_inverse=true").contains("exact_inverse has no effect: exact_depth=false"));
+        assert!(error("notw:bias_mode=0,footprint_cap=4").contains("footprint_cap has no effect: bias_mode=0"));
+        // rtw's exact depth is off by default
+        assert!(error("rtw:depth_clamp=1").contains("depth_clamp has no effect: exact_depth=false"));
+        assert!(error("notw-dv:bias_mode=2").contains("has no parameter 'bias_mode'"));
+        // the same keys where they act, and dead keys left at their defaults
+        for ok in [
+            "notw:subdiv=0",
+            "notw:cull_hidden=true,subdiv_levels=3,min_piece=1",
+            "notw:exact_inverse=true,depth_clamp=1,footprint_cap=4",
+            "rtw:exact_depth=true,depth_clamp=1,bias_mode=2,footprint_cap=4",
+            "notw-dv:dv_margin=4,pcf=3",
+        ] {
+            assert_eq!(error(ok), "", "{ok}");
+        }
+    }
+
+    #[test]
+    fn knobs_fix_what_a_variant_lacks() {
+        let dv = Knobs::dv(&DvSettings::defaults());
+        assert_eq!((dv.variant, dv.crop, dv.paraboloid), (Variant::Dv, true, false));
+        assert_eq!((dv.subdiv, dv.subdiv_levels, dv.exact_depth, dv.strength, dv.interp), (0.0, 1, false, 1.0, true));
+        let rtw = Knobs::rtw(&RtwSettings::defaults());
+        assert_eq!((rtw.window, rtw.mix, rtw.exact_inverse, rtw.tent, rtw.edge_importance), (0, 0.0, false, false, 0));
+        // hidden-edge culling only with subdivision
+        let mut s = NotwSettings::defaults();
+        s.cull_hidden = true;
+        assert!(Knobs::notw(&s).cull_hidden);
+        assert_eq!(Knobs::notw(&s).bias, [1.5, 0.0, 0.5, 4.0]);
+        s.core.subdivision.subdiv = 0.0;
+        assert!(!Knobs::notw(&s).cull_hidden);
+        // "off" is judged in the uniform's precision, by the rules as by the knobs
+        assert!(error("notw:subdiv=1e-50,cull_hidden=true").contains("cull_hidden has no effect"));
     }
 }
