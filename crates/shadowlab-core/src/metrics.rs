@@ -2,7 +2,10 @@
 
 use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+/// The quality figures against `rt` every record carries (a frame, a technique's summary over
+/// frames, metrics.json, a sweep row), declared once: the records embed it flattened, so the
+/// fields sit at their top level.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ErrorMetrics {
     /// % of evaluated pixels where (v >= 0.5) != (v_rt >= 0.5).
     pub wrong_pct: f64,

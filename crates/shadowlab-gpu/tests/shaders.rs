@@ -412,3 +412,41 @@ fn virtual_params_layout_matches_rust() {
     check_all(&get("virtual_sm/mark.wgsl"), "VirtualParams", size_of::<VirtualParams>(), f);
     check_all(&get("virtual_sm/eval.wgsl"), "VirtualParams", size_of::<VirtualParams>(), f);
 }
+
+/// The layout checks above are written by hand, one per GPU struct; this keeps them complete:
+/// every `#[repr(C)]` struct in the crate's sources (the structs shared with WGSL) is named in
+/// a check in this file, so a new technique's uniform cannot be left out.
+#[test]
+fn every_repr_c_struct_has_a_layout_check() {
+    fn rs_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                rs_files(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let this = include_str!("shaders.rs");
+    let checks = &this[..this.find("fn every_repr_c_struct_has_a_layout_check").unwrap()];
+    let mut files = Vec::new();
+    rs_files(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), &mut files);
+    let mut found = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        for (i, _) in text.match_indices("#[repr(C)]") {
+            let after = &text[i..];
+            let s = after.find("struct ").expect("a struct follows #[repr(C)]") + "struct ".len();
+            let name: String = after[s..].chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+            let named = checks.match_indices(name.as_str()).any(|(j, _)| {
+                let before = checks[..j].chars().last().is_none_or(|c| !c.is_alphanumeric() && c != '_');
+                let next = checks[j + name.len()..].chars().next().is_none_or(|c| !c.is_alphanumeric() && c != '_');
+                before && next
+            });
+            assert!(named, "{}: #[repr(C)] struct {name} has no layout check in tests/shaders.rs", f.display());
+            found.push(name);
+        }
+    }
+    assert!(found.len() >= 20, "only {} GPU structs found: {found:?}", found.len());
+}

@@ -9,13 +9,13 @@ type Column = (&'static str, fn(&Technique) -> String);
 
 /// Columns after `label,technique`, each read from the technique's summary or its counters.
 pub const COLUMNS: &[Column] = &[
-    ("wrong_pct", |t| cell(t.wrong_pct)),
-    ("false_lit_pct", |t| cell(t.false_lit_pct)),
-    ("false_shadow_pct", |t| cell(t.false_shadow_pct)),
-    ("mae", |t| cell(t.mae)),
+    ("wrong_pct", |t| cell(t.quality.wrong_pct)),
+    ("false_lit_pct", |t| cell(t.quality.false_lit_pct)),
+    ("false_shadow_pct", |t| cell(t.quality.false_shadow_pct)),
+    ("mae", |t| cell(t.quality.mae)),
     ("flip_mean", |t| cell(t.flip_mean)),
     ("flicker_pct", |t| cell(t.flicker_pct)),
-    ("evaluated_pixels", |t| cell(t.evaluated_pixels)),
+    ("evaluated_pixels", |t| cell(t.quality.evaluated_pixels)),
     ("shadow_data_bytes", |t| cell(t.shadow_data_bytes)),
     ("total_ms", |t| cell(t.total_ms)),
     ("fetches_per_pixel", |t| cell(t.counters.get("fetches_per_pixel"))),

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use shadowlab_core::anim::Motion;
 use shadowlab_core::camera::Camera;
 use shadowlab_core::light::Light;
-use shadowlab_core::metrics::SamplingStats;
+use shadowlab_core::metrics::{ErrorMetrics, SamplingStats};
 use shadowlab_core::params::ParamValues;
 use shadowlab_core::scene::LoadReport;
 use shadowlab_gpu::lab::{FrameRecord, ReferenceFrame};
@@ -127,13 +127,11 @@ pub struct Technique {
     pub label: String,
     pub technique: String,
     pub params: ParamValues,
-    pub wrong_pct: f64,
-    pub false_lit_pct: f64,
-    pub false_shadow_pct: f64,
-    pub mae: f64,
+    /// Means over the frames (docs/metrics.md).
+    #[serde(flatten)]
+    pub quality: ErrorMetrics,
     /// Mean FLIP (LDR) of the shaded image against `rt`'s, over all pixels; mean over frames.
     pub flip_mean: f64,
-    pub evaluated_pixels: u64,
     pub flicker_pct: Option<f64>,
     pub shadow_data_bytes: u64,
     pub stages_ms: StagesMs,

@@ -12,7 +12,7 @@ type Chart = (&'static str, fn(&FrameRecord) -> Option<f64>);
 
 /// The per-frame figures charted.
 pub const CHARTS: &[Chart] = &[
-    ("wrong pixels (%)", |r| Some(r.wrong_pct)),
+    ("wrong pixels (%)", |r| Some(r.quality.wrong_pct)),
     ("FLIP (mean)", |r| Some(r.flip_mean)),
     ("flicker vs previous frame (%)", |r| r.flicker_pct),
     ("rays traced", |r| r.rays_traced),

@@ -50,15 +50,15 @@ pub struct Verdict {
 /// A row's figure of `metric` (see claims.toml); None where the row has none.
 pub fn metric(row: &Row, metric: &str) -> Option<f64> {
     Some(match metric {
-        "wrong_pct" => row.wrong_pct,
-        "false_lit_pct" => row.false_lit_pct,
-        "false_shadow_pct" => row.false_shadow_pct,
-        "mae" => row.mae,
+        "wrong_pct" => row.quality.wrong_pct,
+        "false_lit_pct" => row.quality.false_lit_pct,
+        "false_shadow_pct" => row.quality.false_shadow_pct,
+        "mae" => row.quality.mae,
         "flip_mean" => row.flip_mean,
         "total_ms" => row.total_ms,
         "shadow_data_bytes" => row.shadow_data_bytes as f64,
         "stalls" => row.stalls.len() as f64,
-        "rays_per_pixel" => *row.counters.get("rays_traced")? / (row.evaluated_pixels.max(1) as f64),
+        "rays_per_pixel" => *row.counters.get("rays_traced")? / (row.quality.evaluated_pixels.max(1) as f64),
         m => {
             if let Some(c) = m.strip_prefix("counter:") {
                 *row.counters.get(c)?
@@ -278,7 +278,7 @@ paper = "p"
         assert_eq!(v[2].ours, "1048576");
         // a tie breaks an order; a ratio outside its range; a value off by one byte; a rising trend
         let mut a2 = a.clone();
-        a2[2].wrong_pct = 2.0;
+        a2[2].quality.wrong_pct = 2.0;
         a2[2].total_ms = 14.0;
         a2[0].shadow_data_bytes += 1;
         let b2 = vec![row("s", "sm", 3.5, 1.0, 1)];
@@ -311,7 +311,7 @@ paper = "p"
         let mut r = row("s", "iasm", 1.0, 5.0, 1);
         r.stages_ms = BTreeMap::from([("iasm.shadows.t01".into(), 1.5), ("iasm.shadows.t02".into(), 2.0), ("iasm.readback".into(), 0.5)]);
         r.counters.insert("rays_traced".into(), 50.0);
-        r.evaluated_pixels = 200;
+        r.quality.evaluated_pixels = 200;
         assert_eq!(metric(&r, "stage:shadows|render"), Some(3.5));
         assert_eq!(metric(&r, "stage:readback"), Some(0.5));
         assert_eq!(metric(&r, "stage:render"), None);

@@ -141,8 +141,8 @@ mod tests {
         let mut r = row("planebox", "sm", 1.0, 2.0, 3);
         r.key = "abc".into();
         // figures whose shortest decimal form serde_json reads back a bit off without float_roundtrip
-        r.wrong_pct = 1.4845709619086507;
-        r.mae = 1.3390861128498615;
+        r.quality.wrong_pct = 1.4845709619086507;
+        r.quality.mae = 1.3390861128498615;
         r.total_ms = 0.1 + 0.2;
         let p = PointFile { schema_version: SCHEMA_VERSION, key: "abc".into(), key_text: "t".into(), row: r };
         dir.write_point(&p).unwrap();

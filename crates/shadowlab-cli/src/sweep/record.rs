@@ -5,6 +5,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use serde::{Deserialize, Serialize};
+use shadowlab_core::metrics::ErrorMetrics;
 use shadowlab_core::params::ParamValues;
 
 
@@ -24,15 +25,12 @@ pub struct Row {
     pub technique: String,
     pub params: ParamValues,
     /// Quality: means over the frames (see docs/metrics.md).
-    pub wrong_pct: f64,
-    pub false_lit_pct: f64,
-    pub false_shadow_pct: f64,
-    pub mae: f64,
+    #[serde(flatten)]
+    pub quality: ErrorMetrics,
     /// Mean FLIP (LDR) of the shaded image against `rt`'s, over all pixels; mean over frames.
     pub flip_mean: f64,
     /// Mean over consecutive frames; null with one frame.
     pub flicker_pct: Option<f64>,
-    pub evaluated_pixels: u64,
     /// The timed frame (median; see `timer` in sweep.json).
     pub total_ms: f64,
     /// Per-stage breakdown (see `stages_timer`); never summed as the total.
@@ -154,13 +152,13 @@ pub fn csv(rows: &[Row]) -> String {
             quote(&r.setup),
             quote(&r.label),
             quote(&r.technique),
-            num(r.wrong_pct),
-            num(r.false_lit_pct),
-            num(r.false_shadow_pct),
-            num(r.mae),
+            num(r.quality.wrong_pct),
+            num(r.quality.false_lit_pct),
+            num(r.quality.false_shadow_pct),
+            num(r.quality.mae),
             num(r.flip_mean),
             r.flicker_pct.map(num).unwrap_or_default(),
-            r.evaluated_pixels.to_string(),
+            r.quality.evaluated_pixels.to_string(),
             num(r.total_ms),
             num(r.setup_ms),
             r.shadow_data_bytes.to_string(),
@@ -189,13 +187,9 @@ pub mod tests {
             label: label.into(),
             technique: label.split(':').next().unwrap().into(),
             params: ParamValues::default(),
-            wrong_pct: wrong,
-            false_lit_pct: wrong / 2.0,
-            false_shadow_pct: wrong / 2.0,
-            mae: wrong / 100.0,
+            quality: ErrorMetrics { wrong_pct: wrong, false_lit_pct: wrong / 2.0, false_shadow_pct: wrong / 2.0, mae: wrong / 100.0, evaluated_pixels: 100 },
             flip_mean: wrong / 20.0,
             flicker_pct: None,
-            evaluated_pixels: 100,
             total_ms: ms,
             stages_ms: BTreeMap::new(),
             setup_ms: 1.0,

@@ -70,7 +70,7 @@ const QUALITIES: &[Quality] = &[
     Quality {
         id: "wrong",
         title: "wrong pixels (%)",
-        row: |r| r.wrong_pct,
+        row: |r| r.quality.wrong_pct,
         agg: |a, worst| if worst { a.worst_wrong_pct } else { a.mean_wrong_pct },
     },
     Quality {

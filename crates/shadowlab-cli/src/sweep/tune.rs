@@ -142,7 +142,7 @@ fn side(label: &str, rows: &[Row], aggs: &[Aggregate]) -> Result<Side> {
         worst_wrong_pct: a.worst_wrong_pct,
         mean_flip_mean: a.mean_flip_mean,
         worst_total_ms: a.worst_total_ms,
-        wrong_pct_by_setup: rows.iter().filter(|r| r.label == label).map(|r| (r.setup.clone(), r.wrong_pct)).collect(),
+        wrong_pct_by_setup: rows.iter().filter(|r| r.label == label).map(|r| (r.setup.clone(), r.quality.wrong_pct)).collect(),
         flip_mean_by_setup: rows.iter().filter(|r| r.label == label).map(|r| (r.setup.clone(), r.flip_mean)).collect(),
     })
 }
@@ -232,7 +232,7 @@ pub fn tune(a: &TuneArgs) -> Result<()> {
     let (mut points, mut pixels) = (0usize, 0u64);
     let mut count = |s: &Sweep| {
         points += s.rows.len();
-        pixels += s.rows.iter().map(|r| r.evaluated_pixels).sum::<u64>();
+        pixels += s.rows.iter().map(|r| r.quality.evaluated_pixels).sum::<u64>();
     };
     // halving: every rung but the last narrows the candidates
     let mut candidates = grid.clone();

@@ -99,14 +99,12 @@ fn within<T>(r: Result<T, GpuError>, what: impl FnOnce() -> String) -> Result<T,
 #[serde(deny_unknown_fields)]
 pub struct FrameRecord {
     pub frame: usize,
-    pub wrong_pct: f64,
-    pub false_lit_pct: f64,
-    pub false_shadow_pct: f64,
-    pub mae: f64,
+    /// wrong / false lit / false shadow %, MAE, evaluated pixels of this frame.
+    #[serde(flatten)]
+    pub quality: ErrorMetrics,
     /// Mean FLIP (LDR, [`shadowlab_core::flip`]) of the technique's shaded image against
     /// `rt`'s, over all pixels of the image.
     pub flip_mean: f64,
-    pub evaluated_pixels: u64,
     /// Rays the technique traced this frame (ray-assisted techniques).
     pub rays_traced: Option<f64>,
     /// Pixels within one pixel of an `rt` visibility edge this frame (the rays' lower bound).
@@ -203,12 +201,8 @@ impl Lab<'_> {
                 });
                 records[k].push(FrameRecord {
                     frame: f,
-                    wrong_pct: m.wrong_pct,
-                    false_lit_pct: m.false_lit_pct,
-                    false_shadow_pct: m.false_shadow_pct,
-                    mae: m.mae,
+                    quality: m,
                     flip_mean: 0.0, // below, once the frame's images are all there
-                    evaluated_pixels: m.evaluated_pixels,
                     rays_traced: run.report.counters.get("rays_traced").copied(),
                     edge_pixels: edges,
                     flicker_pct: flicker,

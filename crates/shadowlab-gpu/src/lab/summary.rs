@@ -6,20 +6,19 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use shadowlab_core::metrics::ErrorMetrics;
+
 use super::path::{FrameRecord, ReferenceFrame};
 use crate::timing::median;
 
 /// Top-level figures of a technique over its frames.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
-    pub wrong_pct: f64,
-    pub false_lit_pct: f64,
-    pub false_shadow_pct: f64,
-    pub mae: f64,
+    /// Means over the frames (evaluated pixels rounded).
+    #[serde(flatten)]
+    pub quality: ErrorMetrics,
     /// Mean FLIP, the mean over the frames of each frame's image mean.
     pub flip_mean: f64,
-    /// Mean over the frames, rounded.
-    pub evaluated_pixels: u64,
     pub rays_traced: Option<f64>,
     /// Mean over consecutive pairs; None with one frame.
     pub flicker_pct: Option<f64>,
@@ -57,12 +56,14 @@ pub fn summarize(frames: &[FrameRecord]) -> Summary {
         }
     }
     Summary {
-        wrong_pct: q(|r| r.wrong_pct),
-        false_lit_pct: q(|r| r.false_lit_pct),
-        false_shadow_pct: q(|r| r.false_shadow_pct),
-        mae: q(|r| r.mae),
+        quality: ErrorMetrics {
+            wrong_pct: q(|r| r.quality.wrong_pct),
+            false_lit_pct: q(|r| r.quality.false_lit_pct),
+            false_shadow_pct: q(|r| r.quality.false_shadow_pct),
+            mae: q(|r| r.quality.mae),
+            evaluated_pixels: q(|r| r.quality.evaluated_pixels as f64).round() as u64,
+        },
         flip_mean: q(|r| r.flip_mean),
-        evaluated_pixels: q(|r| r.evaluated_pixels as f64).round() as u64,
         rays_traced: if frames.iter().all(|r| r.rays_traced.is_some()) { mean(frames.iter().filter_map(|r| r.rays_traced)) } else { None },
         flicker_pct: mean(frames.iter().filter_map(|r| r.flicker_pct)),
         total_ms: median(&timed.iter().map(|r| r.total_ms).collect::<Vec<_>>()),
@@ -81,12 +82,8 @@ mod tests {
     fn rec(frame: usize, wrong: f64, ms: f64, flicker: Option<f64>) -> FrameRecord {
         FrameRecord {
             frame,
-            wrong_pct: wrong,
-            false_lit_pct: wrong,
-            false_shadow_pct: 0.0,
-            mae: wrong / 100.0,
+            quality: ErrorMetrics { wrong_pct: wrong, false_lit_pct: wrong, false_shadow_pct: 0.0, mae: wrong / 100.0, evaluated_pixels: 100 },
             flip_mean: wrong / 10.0,
-            evaluated_pixels: 100,
             rays_traced: None,
             edge_pixels: 3,
             flicker_pct: flicker,
@@ -98,14 +95,23 @@ mod tests {
     fn summary_means_quality_and_medians_times_after_the_warm_up() {
         let s =
             summarize(&[rec(0, 1.0, 100.0, None), rec(1, 2.0, 5.0, Some(1.0)), rec(2, 3.0, 7.0, Some(3.0)), rec(3, 6.0, 6.0, Some(2.0))]);
-        assert_eq!(s.wrong_pct, 3.0);
+        assert_eq!(s.quality.wrong_pct, 3.0);
         assert!((s.flip_mean - 0.3).abs() < 1e-12, "FLIP is a mean over all frames");
         assert_eq!(s.flicker_pct, Some(2.0));
         assert_eq!(s.total_ms, 6.0, "frame 0 (100 ms warm-up) is not timed");
         assert_eq!(s.stages_ms["a"], 6.0);
         assert_eq!(s.rays_traced, None);
+        // the flattened figures sit at the record's top level, and an unknown field is refused
+        let json = serde_json::to_value(&s).unwrap();
+        assert_eq!(json["wrong_pct"], 3.0);
+        assert_eq!(serde_json::from_value::<Summary>(json.clone()).unwrap(), s);
+        let r = rec(0, 1.0, 2.0, None);
+        let mut v = serde_json::to_value(&r).unwrap();
+        assert_eq!(serde_json::from_value::<FrameRecord>(v.clone()).unwrap(), r);
+        v["wrong_pcnt"] = 1.0.into();
+        assert!(serde_json::from_value::<FrameRecord>(v).is_err(), "deny_unknown_fields still holds with the flattened figures");
         let one = summarize(&[rec(0, 4.0, 9.0, None)]);
-        assert_eq!((one.wrong_pct, one.total_ms, one.flicker_pct), (4.0, 9.0, None));
+        assert_eq!((one.quality.wrong_pct, one.total_ms, one.flicker_pct), (4.0, 9.0, None));
     }
     #[test]
     fn reference_time_skips_the_warm_up_frame() {
