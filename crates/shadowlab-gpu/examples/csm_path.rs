@@ -89,7 +89,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("| technique | wrong % (mean) | wrong % (max) | flicker % (mean) | flicker % (max) |");
     println!("|---|---:|---:|---:|---:|");
     for (spec, t) in resolved.iter().zip(&run.techniques) {
-        let wrong: Vec<f64> = t.frames.iter().map(|r| r.wrong_pct).collect();
+        let wrong: Vec<f64> = t.frames.iter().map(|r| r.quality.wrong_pct).collect();
         let flicker: Vec<f64> = t.frames.iter().filter_map(|r| r.flicker_pct).collect();
         println!("| `{}` | {:.3} | {:.3} | {:.4} | {:.4} |", spec.label, mean(&wrong), max(&wrong), mean(&flicker), max(&flicker));
     }

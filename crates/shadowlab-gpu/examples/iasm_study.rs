@@ -85,7 +85,7 @@ fn path_study(lab: &Lab, scene: &Scene, cam: &Camera, size: u32, frames: usize, 
     println!("| spec | wrong % (mean) | wrong % (max) | flicker % (mean) | flicker % (max) |");
     println!("|---|---|---|---|---|");
     for (spec, t) in specs.iter().zip(&run.techniques) {
-        let wrong: Vec<f64> = t.frames.iter().map(|r| r.wrong_pct).collect();
+        let wrong: Vec<f64> = t.frames.iter().map(|r| r.quality.wrong_pct).collect();
         let flick: Vec<f64> = t.frames.iter().filter_map(|r| r.flicker_pct).collect();
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
         let max = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max);
