@@ -15,6 +15,10 @@
 //! the CPU needs before drawing) calls [`Recorder::sync`] or [`Recorder::read_buffer_as`]: what
 //! was recorded so far is submitted and waited for, and the stall is counted with its reason.
 //! Such techniques declare it in their registry entry (`TechniqueInfo::stalls`).
+//!
+//! [`drive`] is the one frame driver the lab, the viewer and the host examples share: a fresh
+//! encoder, a [`Recorder`] of the chosen [`Clock`], the caller's recording, one submit (plus
+//! the declared stalls) and one wait, and the frame's times.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -230,6 +234,61 @@ impl<'a> Recorder<'a> {
         }
         out
     }
+}
+
+/// How [`drive`] times a frame.
+#[derive(Clone, Copy)]
+pub enum Clock<'a> {
+    /// The wall clock around the one submit and wait (software adapters).
+    Wall,
+    /// The wall clock, and a timestamp pair around each stage (adapters with sane timestamps).
+    Stamped(&'a FrameStamps),
+    /// The breakdown run: each stage submitted and waited for alone ([`Recorder::profiled`]).
+    Profiled,
+}
+
+impl<'a> Clock<'a> {
+    /// Stamped when `stamps` are given, else the wall clock.
+    pub fn of(stamps: Option<&'a FrameStamps>) -> Clock<'a> {
+        stamps.map_or(Clock::Wall, Clock::Stamped)
+    }
+}
+
+/// What [`drive`] measured of one frame.
+#[derive(Debug, Default)]
+pub struct Driven {
+    /// Recording, submit and wait, by the wall clock (ms).
+    pub wall_ms: f64,
+    /// Per-stage GPU ms from the timestamps ([`Clock::Stamped`]).
+    pub stamped_ms: Option<BTreeMap<String, f64>>,
+    /// Per-stage wall ms of a profiled frame ([`Clock::Profiled`]); empty otherwise.
+    pub profile_ms: BTreeMap<String, f64>,
+    /// Mid-frame submits and waits, by reason.
+    pub stalls: Vec<String>,
+}
+
+/// Records one frame with `record` into a fresh encoder labelled `label`, submits it once and
+/// waits. The commands are submitted even when `record` fails part way (what it recorded is
+/// valid), and then its error is returned.
+pub fn drive(gpu: &Gpu, label: &str, clock: Clock, record: impl FnOnce(&mut Recorder) -> Result<(), crate::GpuError>) -> Result<Driven, crate::GpuError> {
+    let t0 = Instant::now();
+    let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    let mut rec = match clock {
+        Clock::Wall => Recorder::new(gpu, &mut enc),
+        Clock::Stamped(s) => Recorder::with_stamps(gpu, &mut enc, s),
+        Clock::Profiled => Recorder::profiled(gpu, &mut enc),
+    };
+    let recorded = record(&mut rec);
+    let done = rec.finish();
+    gpu.submit(enc.finish());
+    gpu.wait();
+    let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+    recorded?;
+    let stamped_ms = match clock {
+        Clock::Stamped(s) => Some(done.read_stamps(gpu, s)),
+        _ => None,
+    };
+    Ok(Driven { wall_ms, stamped_ms, profile_ms: done.profile_ms, stalls: done.stalls })
 }
 
 /// Submits the encoder's commands so far (replacing it with a fresh one of the same label) and

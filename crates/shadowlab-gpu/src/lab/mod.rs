@@ -19,7 +19,7 @@ use shadowlab_core::scene::Scene;
 
 use crate::frame::{FrameUniform, LightUniform};
 use crate::gbuffer::{GBuffer, GBufferPass};
-use crate::record::{FrameStamps, Recorded, Recorder};
+use crate::record::{self, Clock, FrameStamps, Recorder};
 use crate::registry::{self, Resolved};
 use crate::scene_gpu::GpuScene;
 use crate::shade::ShadePass;
@@ -231,32 +231,13 @@ impl<'a> Lab<'a> {
     /// Records one frame with `f`, submits it once and waits: (wall ms, per-stage GPU ms when
     /// the adapter has sane timestamps). Mid-frame syncs inside `f` add their submits.
     fn timed_frame(&self, f: impl FnOnce(&mut Recorder) -> Result<(), GpuError>) -> Result<(f64, Option<BTreeMap<String, f64>>), GpuError> {
-        let gpu = self.gpu;
-        let stamps = self.stamps.as_ref();
-        let t0 = std::time::Instant::now();
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        let mut rec = match stamps {
-            Some(s) => Recorder::with_stamps(gpu, &mut enc, s),
-            None => Recorder::new(gpu, &mut enc),
-        };
-        f(&mut rec)?;
-        let done: Recorded = rec.finish();
-        gpu.submit(enc.finish());
-        gpu.wait();
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
-        Ok((ms, stamps.map(|s| done.read_stamps(gpu, s))))
+        let d = record::drive(self.gpu, "frame", Clock::of(self.stamps.as_ref()), f)?;
+        Ok((d.wall_ms, d.stamped_ms))
     }
 
     /// One profiled frame of `f`: each stage submitted and waited for alone (the breakdown).
     fn profiled_frame(&self, f: impl FnOnce(&mut Recorder) -> Result<(), GpuError>) -> Result<BTreeMap<String, f64>, GpuError> {
-        let gpu = self.gpu;
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("profiled frame") });
-        let mut rec = Recorder::profiled(gpu, &mut enc);
-        f(&mut rec)?;
-        let done = rec.finish();
-        gpu.submit(enc.finish());
-        gpu.wait();
-        Ok(done.profile_ms)
+        Ok(record::drive(self.gpu, "profiled frame", Clock::Profiled, f)?.profile_ms)
     }
 
     /// Resolves `spec`, creates the technique, runs it once to warm up and `repeat` more times
@@ -343,12 +324,7 @@ impl<'a> Lab<'a> {
         let total_ms = median(&totals);
         let visibility: Vec<f32> = gpu.read_buffer_as(&view.visibility, view.gbuffer.pixels());
         // lab-only analysis passes, after the timed frames
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("analysis") });
-        let mut rec = Recorder::new(gpu, &mut enc);
-        tech.analyze(gpu, &inputs, &mut rec)?;
-        rec.finish();
-        gpu.submit(enc.finish());
-        gpu.wait();
+        record::drive(gpu, "analysis", Clock::Wall, |rec| tech.analyze(gpu, &inputs, rec))?;
         gpu.take_error()?;
         let report = tech.report(gpu);
         let shaded = self.shade_pass.shade(gpu, &inputs, &view.color);

@@ -12,7 +12,7 @@ use shadowlab_core::metrics::ErrorMetrics;
 use shadowlab_gpu::frame::{FrameUniform, LightUniform};
 use shadowlab_gpu::gbuffer::{GBuffer, GBufferPass};
 use shadowlab_gpu::lab::{Instance, Lab};
-use shadowlab_gpu::record::{FrameStamps, Recorder};
+use shadowlab_gpu::record::{self, Clock, FrameStamps, Recorder};
 use shadowlab_gpu::registry::{self, Resolved};
 use shadowlab_gpu::shade::ShadePass;
 use shadowlab_gpu::technique::{run_frame, FrameInputs, TechniqueReport};
@@ -352,28 +352,21 @@ impl<'a> Renderer<'a> {
         self.lab.set_time(pose.time, pose.prev_time)?;
         let view_key = self.view_key(pose);
         let eval_current = self.eval.as_ref().is_some_and(|(k, _)| *k == self.eval_key(&view_key));
-        let t0 = std::time::Instant::now();
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("view.frame") });
         let stamps = self.stamps.take();
-        let mut rec = match &stamps {
-            Some(s) => Recorder::with_stamps(gpu, &mut enc, s),
-            None => Recorder::new(gpu, &mut enc),
-        };
         let with_b = look.right == Right::Technique;
         let live_key = format!("{}|{with_b}", self.eval_key(&view_key));
         let reuse = still && self.live.as_deref() == Some(live_key.as_str());
-        let recorded = if reuse { Ok(()) } else { self.record_live(&mut rec, pose, with_b) };
-        self.live = recorded.is_ok().then_some(live_key);
-        if recorded.is_ok() {
-            self.record_compose(&mut rec, look, eval_current);
-        }
-        let done = rec.finish();
-        gpu.submit(enc.finish());
-        gpu.wait();
-        let frame_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let stamped_ms = stamps.as_ref().map(|s| done.read_stamps(gpu, s)).unwrap_or_default();
+        let driven = record::drive(gpu, "view.frame", Clock::of(stamps.as_ref()), |rec| {
+            if !reuse {
+                self.record_live(rec, pose, with_b)?;
+            }
+            self.record_compose(rec, look, eval_current);
+            Ok(())
+        });
         self.stamps = stamps;
-        recorded?;
+        self.live = driven.is_ok().then_some(live_key);
+        let driven = driven?;
+        let (frame_ms, stamped_ms) = (driven.wall_ms, driven.stamped_ms.unwrap_or_default());
         gpu.take_error()?;
         let reference = if still { self.refine(pose, &view_key)? } else { self.status(&view_key) };
         Ok(FrameInfo { frame_ms, stamped_ms, reference, recreated, reused: reuse })

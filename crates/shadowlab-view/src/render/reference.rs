@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 
 use shadowlab_core::metrics::{compare, error_image};
-use shadowlab_gpu::record::Recorder;
+use shadowlab_gpu::record::{self, Clock};
 use shadowlab_gpu::technique::run_frame;
 use shadowlab_gpu::GpuError;
 
@@ -33,21 +33,19 @@ impl Renderer<'_> {
             let t0 = std::time::Instant::now();
             let (r0, r1) = (p.done * rows_per_band, ((p.done + 1) * rows_per_band).min(h));
             let (off, len) = (r0 as u64 * w as u64 * 4, (r1 - r0) as u64 * w as u64 * 4);
-            let t = &self.t;
-            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("view.reference") });
-            let mut rec = Recorder::new(gpu, &mut enc);
-            rec.encoder().clear_buffer(&t.band_g.mask, 0, None);
-            rec.encoder().copy_buffer_to_buffer(&t.g.mask, off, &t.band_g.mask, off, len);
-            let inputs = t.inputs(&self.lab, pose, &t.band_g, &t.band_vis);
-            run_frame(self.rt.tech.as_mut(), gpu, &inputs, &mut rec)?;
-            rec.encoder().copy_buffer_to_buffer(&t.band_vis, off, &t.ref_vis, off, len);
-            if p.done + 1 == p.of {
-                let full = t.inputs(&self.lab, pose, &t.g, &t.ref_vis);
-                self.shade.record(gpu, &mut rec, &full, &t.ref_color);
-            }
-            rec.finish();
-            gpu.submit(enc.finish());
-            gpu.wait();
+            let (t, lab, rt, shade) = (&self.t, &self.lab, &mut self.rt, &self.shade);
+            let last = p.done + 1 == p.of;
+            record::drive(gpu, "view.reference", Clock::Wall, |rec| {
+                rec.encoder().clear_buffer(&t.band_g.mask, 0, None);
+                rec.encoder().copy_buffer_to_buffer(&t.g.mask, off, &t.band_g.mask, off, len);
+                let inputs = t.inputs(lab, pose, &t.band_g, &t.band_vis);
+                run_frame(rt.tech.as_mut(), gpu, &inputs, rec)?;
+                rec.encoder().copy_buffer_to_buffer(&t.band_vis, off, &t.ref_vis, off, len);
+                if last {
+                    shade.record(gpu, rec, &t.inputs(lab, pose, &t.g, &t.ref_vis), &t.ref_color);
+                }
+                Ok(())
+            })?;
             gpu.take_error()?;
             p.done += 1;
             p.ms += t0.elapsed().as_secs_f64() * 1e3;
@@ -74,13 +72,8 @@ impl Renderer<'_> {
         let mut out = Vec::new();
         for s in std::iter::once(&mut self.a).chain(self.b.as_mut()) {
             let inputs = t.inputs(&self.lab, pose, &t.g, &s.vis);
-            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("view.profiled") });
-            let mut rec = Recorder::profiled(gpu, &mut enc);
-            run_frame(s.inst.tech.as_mut(), gpu, &inputs, &mut rec)?;
-            let done = rec.finish();
-            gpu.submit(enc.finish());
-            gpu.wait();
-            out.push(done.profile_ms);
+            let tech = s.inst.tech.as_mut();
+            out.push(record::drive(gpu, "view.profiled", Clock::Profiled, |rec| run_frame(tech, gpu, &inputs, rec))?.profile_ms);
         }
         gpu.take_error()?;
         let (_, e) = self.eval.as_mut().expect("profiled after an evaluation");
@@ -114,12 +107,7 @@ impl Renderer<'_> {
             gpu.queue.write_buffer(&s.error, 0, &error);
             let inputs = t.inputs(&self.lab, pose, &t.g, &s.vis);
             let tech = s.inst.tech.as_mut();
-            let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("view.analysis") });
-            let mut rec = Recorder::new(gpu, &mut enc);
-            tech.analyze(gpu, &inputs, &mut rec)?;
-            rec.finish();
-            gpu.submit(enc.finish());
-            gpu.wait();
+            record::drive(gpu, "view.analysis", Clock::Wall, |rec| tech.analyze(gpu, &inputs, rec))?;
             let report = tech.report(gpu);
             gpu.take_error()?;
             sides.push(SideEval {
