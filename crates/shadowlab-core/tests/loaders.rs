@@ -304,17 +304,18 @@ fn expect_invalid(rel: &str, needle: &str) {
     assert!(msg.to_lowercase().contains(&needle.to_lowercase()), "{rel}: message should mention {needle:?}: {msg}");
 }
 
+/// Each error names its place: the JSON path (or the JSON text's line and column).
 #[test]
 fn malformed_gltf_is_an_error_not_a_panic() {
     expect_invalid("malformed/truncated.glb", "truncated");
     expect_invalid("malformed/huge_length.glb", "truncated");
-    expect_invalid("malformed/bad_json.gltf", "EOF");
-    expect_invalid("malformed/bad_accessor.gltf", "out of bounds");
-    expect_invalid("malformed/bad_buffer_index.gltf", "buffer");
-    expect_invalid("malformed/bad_position_index.gltf", "accessor 42");
-    expect_invalid("malformed/bad_view_range.gltf", "out of bounds");
-    expect_invalid("malformed/bad_index_value.gltf", "index 7");
-    expect_invalid("malformed/bad_base64.gltf", "base64");
+    expect_invalid("malformed/bad_json.gltf", "at line 1 column 59");
+    expect_invalid("malformed/bad_accessor.gltf", "meshes[0].primitives[0]: accessors[0]: out of bounds");
+    expect_invalid("malformed/bad_buffer_index.gltf", "bufferViews[0].buffer: index out of bounds");
+    expect_invalid("malformed/bad_position_index.gltf", "meshes[0].primitives[0].attributes: accessors[42]");
+    expect_invalid("malformed/bad_view_range.gltf", "meshes[0].primitives[0]: bufferViews[1]: out of bounds");
+    expect_invalid("malformed/bad_index_value.gltf", "meshes[0].primitives[0]: indices: accessors[1] element 2 is index 7");
+    expect_invalid("malformed/bad_base64.gltf", "buffers[0]: invalid base64");
     expect_invalid("malformed/does_not_exist.gltf", "cannot read");
     expect_invalid("malformed/does_not_exist.glb", "cannot read");
 }
@@ -324,7 +325,7 @@ fn malformed_obj_is_an_error_not_a_panic() {
     expect_invalid("malformed/bad_indices.obj", "out of bounds");
     expect_invalid("malformed/bad_relative_indices.obj", "out of bounds");
     expect_invalid("malformed/garbage.obj", "line 2: malformed OBJ: position parse error ('v 1.0 zz 3.0')");
-    expect_invalid("malformed/garbage_binary.obj", "");
+    expect_invalid("malformed/garbage_binary.obj", "line 2: malformed OBJ");
     expect_invalid("malformed/empty.obj", "empty");
     expect_invalid("malformed/no_faces.obj", "no faces");
     expect_invalid("malformed/does_not_exist.obj", "cannot open");

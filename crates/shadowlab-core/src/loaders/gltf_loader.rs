@@ -105,7 +105,7 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
     let mut visits = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > node_count {
-            return Err(fail(format!("node hierarchy has a cycle (through node {})", node.index())));
+            return Err(fail(format!("nodes[{}]: the node hierarchy has a cycle through it", node.index())));
         }
         visits += 1;
         if visits > MAX_NODE_VISITS {
@@ -142,7 +142,7 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
             let data = match cache.entry(key) {
                 Entry::Occupied(e) => e.into_mut(),
                 Entry::Vacant(e) => e.insert(
-                    read_primitive(&prim, &buffers).map_err(|e| fail(format!("mesh {} primitive {}: {e}", mesh.index(), prim.index())))?,
+                    read_primitive(&prim, &buffers).map_err(|e| fail(format!("meshes[{}].primitives[{}]: {e}", mesh.index(), prim.index())))?,
                 ),
             };
             let material = match prim.material().index() {
@@ -214,7 +214,7 @@ fn precheck(json: &gltf::json::Root) -> Result<(), String> {
             for index in prim.attributes.values() {
                 if index.value() >= json.accessors.len() {
                     return Err(format!(
-                        "mesh {mi} primitive {pi}: attribute accessor {} out of range ({} accessors)",
+                        "meshes[{mi}].primitives[{pi}].attributes: accessors[{}] out of range ({} accessors)",
                         index.value(),
                         json.accessors.len()
                     ));
@@ -230,12 +230,12 @@ fn load_buffers(doc: &gltf::Document, base: &Path, mut blob: Option<Vec<u8>>) ->
     for b in doc.buffers() {
         let data = match b.source() {
             gltf::buffer::Source::Bin => {
-                blob.take().ok_or_else(|| format!("buffer {} refers to the GLB binary chunk, which is missing", b.index()))?
+                blob.take().ok_or_else(|| format!("buffers[{}]: refers to the GLB binary chunk, which is missing", b.index()))?
             }
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, base).map_err(|e| format!("buffer {}: {e}", b.index()))?.bytes,
+            gltf::buffer::Source::Uri(uri) => read_uri(uri, base).map_err(|e| format!("buffers[{}]: {e}", b.index()))?.bytes,
         };
         if data.len() < b.length() {
-            return Err(format!("buffer {}: declares {} bytes but has {}", b.index(), b.length(), data.len()));
+            return Err(format!("buffers[{}]: declares {} bytes but has {}", b.index(), b.length(), data.len()));
         }
         buffers.push(data);
     }
@@ -332,7 +332,7 @@ struct Primitive {
 fn read_primitive(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Primitive, String> {
     let pos_acc = prim.get(&Semantic::Positions).ok_or("no POSITION attribute")?;
     if pos_acc.dimensions() != Dimensions::Vec3 {
-        return Err(format!("POSITION accessor {} is {:?}, expected VEC3", pos_acc.index(), pos_acc.dimensions()));
+        return Err(format!("attributes.POSITION: accessors[{}] is {:?}, expected VEC3", pos_acc.index(), pos_acc.dimensions()));
     }
     let positions: Vec<Vec3> = read_floats(&pos_acc, buffers)?.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
     let n = positions.len();
@@ -341,11 +341,11 @@ fn read_primitive(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Primiti
     let uvs = match prim.get(&Semantic::TexCoords(set)) {
         Some(acc) => {
             if acc.dimensions() != Dimensions::Vec2 {
-                return Err(format!("TEXCOORD_{set} accessor {} is {:?}, expected VEC2", acc.index(), acc.dimensions()));
+                return Err(format!("attributes.TEXCOORD_{set}: accessors[{}] is {:?}, expected VEC2", acc.index(), acc.dimensions()));
             }
             let uv: Vec<Vec2> = read_floats(&acc, buffers)?.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])).collect();
             if uv.len() != n {
-                return Err(format!("TEXCOORD_{set} has {} elements but POSITION has {n}", uv.len()));
+                return Err(format!("attributes.TEXCOORD_{set}: {} elements but POSITION has {n}", uv.len()));
             }
             uv
         }
@@ -355,11 +355,11 @@ fn read_primitive(prim: &gltf::Primitive, buffers: &[Vec<u8>]) -> Result<Primiti
     let indices: Vec<u32> = match prim.indices() {
         Some(acc) => {
             if acc.dimensions() != Dimensions::Scalar {
-                return Err(format!("index accessor {} is {:?}, expected SCALAR", acc.index(), acc.dimensions()));
+                return Err(format!("indices: accessors[{}] is {:?}, expected SCALAR", acc.index(), acc.dimensions()));
             }
             let idx = read_indices(&acc, buffers)?;
             if let Some((k, &bad)) = idx.iter().enumerate().find(|(_, &i)| i as usize >= n) {
-                return Err(format!("index {bad} (element {k} of accessor {}) out of range: {n} vertices", acc.index()));
+                return Err(format!("indices: accessors[{}] element {k} is index {bad}, out of range: {n} vertices", acc.index()));
             }
             idx
         }
@@ -390,7 +390,7 @@ fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>],
     let dims = acc.dimensions().multiplicity();
     let comp = acc.data_type().size();
     let elem = dims * comp;
-    let total = count.checked_mul(dims).ok_or_else(|| format!("accessor {id}: count {count} too large"))?;
+    let total = count.checked_mul(dims).ok_or_else(|| format!("accessors[{id}]: count {count} too large"))?;
 
     let mut out = Vec::new();
     match acc.view() {
@@ -398,17 +398,17 @@ fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>],
             let data = view_bytes(&view, buffers)?;
             let stride = view.stride().unwrap_or(elem);
             if stride < elem {
-                return Err(format!("accessor {id}: byteStride {stride} is smaller than its element ({elem} bytes)"));
+                return Err(format!("accessors[{id}]: byteStride {stride} is smaller than its element ({elem} bytes)"));
             }
             if count > 0 {
                 let need = (count - 1)
                     .checked_mul(stride)
                     .and_then(|x| x.checked_add(elem))
                     .and_then(|x| x.checked_add(acc.offset()))
-                    .ok_or_else(|| format!("accessor {id}: size overflows"))?;
+                    .ok_or_else(|| format!("accessors[{id}]: size overflows"))?;
                 if need > data.len() {
                     return Err(format!(
-                        "accessor {id} out of bounds: needs {need} bytes of bufferView {} which has {}",
+                        "accessors[{id}]: out of bounds: needs {need} bytes of bufferViews[{}] which has {}",
                         view.index(),
                         data.len()
                     ));
@@ -424,7 +424,7 @@ fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>],
         }
         None => {
             if total > MAX_SYNTHETIC_COMPONENTS {
-                return Err(format!("accessor {id}: {count} elements without a bufferView"));
+                return Err(format!("accessors[{id}]: {count} elements without a bufferView"));
             }
             out.resize(total, T::default());
         }
@@ -441,7 +441,7 @@ fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>],
         let val_off = sparse.values().offset();
         let fits = |off: usize, size: usize, len: usize| n.checked_mul(size).and_then(|x| x.checked_add(off)).is_some_and(|e| e <= len);
         if !fits(idx_off, isize_, idx_data.len()) || !fits(val_off, elem, val_data.len()) {
-            return Err(format!("accessor {id}: sparse indices or values out of bounds"));
+            return Err(format!("accessors[{id}].sparse: indices or values out of bounds"));
         }
         for k in 0..n {
             let b = &idx_data[idx_off + k * isize_..idx_off + (k + 1) * isize_];
@@ -451,7 +451,7 @@ fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>],
                 gltf::accessor::sparse::IndexType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
             };
             if target >= count {
-                return Err(format!("accessor {id}: sparse index {target} out of range ({count} elements)"));
+                return Err(format!("accessors[{id}].sparse: index {target} out of range ({count} elements)"));
             }
             for c in 0..dims {
                 let at = val_off + k * elem + c * comp;
@@ -464,12 +464,12 @@ fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>],
 
 fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&'b [u8], String> {
     let buf =
-        buffers.get(view.buffer().index()).ok_or_else(|| format!("bufferView {}: no buffer {}", view.index(), view.buffer().index()))?;
+        buffers.get(view.buffer().index()).ok_or_else(|| format!("bufferViews[{}]: no buffers[{}]", view.index(), view.buffer().index()))?;
     let end = view.offset().checked_add(view.length());
     match end {
         Some(end) if end <= buf.len() => Ok(&buf[view.offset()..end]),
         _ => Err(format!(
-            "bufferView {} out of bounds: bytes {}+{} of buffer {} which has {}",
+            "bufferViews[{}]: out of bounds: bytes {}+{} of buffers[{}] which has {}",
             view.index(),
             view.offset(),
             view.length(),
@@ -518,7 +518,7 @@ fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, S
         DataType::U8 => read_components(acc, buffers, |b| b[0] as u32),
         DataType::U16 => read_components(acc, buffers, |b| u16::from_le_bytes([b[0], b[1]]) as u32),
         DataType::U32 => read_components(acc, buffers, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
-        other => Err(format!("index accessor {} has component type {other:?}, expected an unsigned integer", acc.index())),
+        other => Err(format!("indices: accessors[{}] has component type {other:?}, expected an unsigned integer", acc.index())),
     }
 }
 
