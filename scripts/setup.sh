@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Makes sure a Vulkan driver is present (Mesa's lavapipe on machines without a GPU), and Xvfb
-# with xvfb-run and xauth (the viewer's smoke test opens its window on a virtual display).
+# Makes sure a Vulkan driver is present (Mesa's lavapipe on machines without a GPU), Xvfb
+# with xvfb-run and xauth (the viewer's smoke test opens its window on a virtual display), and
+# Debian's Chromium (the report's browser test loads it headless).
 # Installs them with apt when running as root or with password-less sudo; otherwise prints the
 # exact command and fails.
 set -euo pipefail
@@ -29,13 +30,17 @@ have_xvfb() {
     command -v xvfb-run >/dev/null 2>&1 && command -v Xvfb >/dev/null 2>&1 && command -v xauth >/dev/null 2>&1
 }
 
-if have_driver && have_xvfb; then
+have_chromium() {
+    [ -x /usr/bin/chromium ]
+}
+
+if have_driver && have_xvfb && have_chromium; then
     exit 0
 fi
 
-PKGS="mesa-vulkan-drivers libvulkan1 xvfb xauth"
+PKGS="mesa-vulkan-drivers libvulkan1 xvfb xauth chromium"
 if ! command -v apt-get >/dev/null 2>&1; then
-    echo "error: a Vulkan driver or Xvfb is missing and apt-get is not available; install your platform's Vulkan driver and Xvfb (on Debian/Ubuntu: sudo apt-get install $PKGS)" >&2
+    echo "error: a Vulkan driver, Xvfb or Chromium is missing and apt-get is not available; install your platform's Vulkan driver and Xvfb (on Debian/Ubuntu: sudo apt-get install $PKGS)" >&2
     exit 1
 fi
 if [ "$(id -u)" -eq 0 ]; then
@@ -43,12 +48,13 @@ if [ "$(id -u)" -eq 0 ]; then
 elif sudo -n true 2>/dev/null; then
     SUDO="sudo -n"
 else
-    echo "error: a Vulkan driver or Xvfb is missing. Run: sudo apt-get install -y $PKGS" >&2
+    echo "error: a Vulkan driver, Xvfb or Chromium is missing. Run: sudo apt-get install -y $PKGS" >&2
     exit 1
 fi
-echo "setup: installing $PKGS (software Vulkan for machines without a GPU; Xvfb for the viewer's smoke test)" >&2
+echo "setup: installing $PKGS (software Vulkan for machines without a GPU; Xvfb for the viewer's smoke test; Chromium for the report's browser test)" >&2
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq $PKGS >/dev/null
 have_driver || { echo "error: Vulkan driver still missing after installing $PKGS" >&2; exit 1; }
 have_xvfb || { echo "error: xvfb-run still missing after installing $PKGS" >&2; exit 1; }
+have_chromium || { echo "error: /usr/bin/chromium still missing after installing $PKGS" >&2; exit 1; }

@@ -379,3 +379,43 @@ fn out_refuses_a_directory_or_file_shadowlab_did_not_write() {
     std::fs::remove_dir_all(&dir).unwrap();
     std::fs::remove_file(&file).unwrap();
 }
+
+/// The report in a real browser: the table sorts by a column and hides columns (the view a
+/// link carries in its fragment), and the quality/cost chart is there.
+#[test]
+fn the_report_sorts_and_hides_columns_in_chromium() {
+    if skip_gpu() {
+        return;
+    }
+    let out = tmp("report-browser");
+    let specs = ["sm:pcf=3", "sm", "sv", "vsm"];
+    let mut args = vec!["compare", "--scene", "planebox", "--size", "96x64", "--repeat", "1", "--quiet", "--out", out.to_str().unwrap()];
+    for s in &specs {
+        args.extend(["-t", s]);
+    }
+    let o = run(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let metrics: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    let mut by_wrong: Vec<(f64, String)> = metrics["techniques"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| (t["wrong_pct"].as_f64().unwrap(), t["label"].as_str().unwrap().to_string()))
+        .collect();
+    by_wrong.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let url = format!("file://{}#sort=1,desc&hide=2,3", out.join("index.html").display());
+    let dom = chromium_dom(&url);
+    let table = &dom[dom.find("<table id=\"metrics\">").expect("the metrics table")..];
+    let table = &table[..table.find("</table>").unwrap()];
+    // rows in the DOM's order, by their first cell
+    let order: Vec<&str> = table.split("<tr>").skip(2).map(|r| r.split("<td>").nth(1).unwrap().split('<').next().unwrap().trim()).collect();
+    let want: Vec<&str> = by_wrong.iter().map(|(_, l)| l.as_str()).collect();
+    // equal wrong % may come in either order; the sorted figures must not increase
+    assert_eq!(order.len(), want.len(), "{order:?}");
+    let wrong_of = |l: &str| by_wrong.iter().find(|(_, x)| x == l).unwrap().0;
+    assert!(order.windows(2).all(|w| wrong_of(w[0]) >= wrong_of(w[1])), "sorted by wrong % descending: {order:?} vs {want:?}");
+    assert!(dom.contains("th class=\"sortable desc\""), "the sorted column is marked");
+    assert_eq!(table.matches("display: none").count(), 2 * (1 + specs.len()), "FLIP and false-lit hidden in every row");
+    assert!(dom.contains("Quality against cost") && dom.matches("<svg").count() >= 2, "the quality/cost charts");
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -2,6 +2,7 @@
 //! `index.html.j2` and the same record that goes to metrics.json ([`Metrics`]).
 
 mod plots;
+pub(crate) mod scatter;
 
 use anyhow::Result;
 use minijinja::value::{Value, ValueKind};
@@ -31,8 +32,12 @@ pub fn html(metrics: &Metrics) -> Result<String> {
     });
     let charts: Vec<Value> =
         plots::frame_charts(metrics)?.into_iter().map(|(title, svg)| minijinja::context! { title => title, svg => svg }).collect();
+    let tradeoffs: Vec<Value> = plots::tradeoff_charts(metrics)?
+        .into_iter()
+        .map(|(title, svg, missing)| minijinja::context! { title => title, svg => svg, missing => missing })
+        .collect();
     let m = Value::from_serialize(metrics);
-    Ok(env.get_template("index.html")?.render(minijinja::context! { m => m, charts => charts })?)
+    Ok(env.get_template("index.html")?.render(minijinja::context! { m => m, charts => charts, tradeoffs => tradeoffs })?)
 }
 
 #[cfg(test)]
@@ -50,7 +55,11 @@ mod tests {
         assert!(h.contains("<td>9</td>"), "fetches print as whole numbers");
         assert!(h.contains("<td>1.250</td><td>0.0625</td>"), "FLIP sits beside wrong %");
         assert!(h.contains("src=\"d.png\" alt=\"FLIP\""), "the FLIP map is shown with the other images");
-        assert!(!h.contains("http://") && !h.contains("https://"), "report must work offline");
+        // the SVG namespace is a name, not a fetch
+        let loaded = h.replace("xmlns=\"http://www.w3.org/2000/svg\"", "");
+        assert!(!loaded.contains("http://") && !loaded.contains("https://"), "report must work offline");
+        assert!(h.contains("Quality against cost") && h.contains("wrong pixels against total ms"), "the quality/cost chart");
+        assert!(h.contains("<table id=\"metrics\">") && h.contains("th.classList.add(\"sortable\")"), "a sortable table");
         assert!(!h.contains("moving"), "a still scene says nothing about moving objects");
         let mut moving = m.clone();
         moving.animation.dynamic_triangles = 12;

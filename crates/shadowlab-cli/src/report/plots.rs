@@ -98,3 +98,35 @@ mod tests {
         assert!(frame_charts(&sample::metrics(1)).unwrap().is_empty());
     }
 }
+
+/// The quality/cost charts of a compare report: wrong % against the timed frame's ms and
+/// against texel fetches per pixel (a cost every GPU pays), marker area by shadow data bytes,
+/// the Pareto front drawn. As (title, svg, the labels left out of that chart and why). A
+/// technique that traces rays is left out of the fetch chart: its rays are a cost of another
+/// kind.
+pub fn tradeoff_charts(metrics: &Metrics) -> Result<Vec<(String, String, Vec<String>)>> {
+    use super::scatter::{svg, Point};
+    type Cost = (&'static str, fn(&crate::metrics::Technique) -> Option<f64>);
+    let costs: [Cost; 2] = [("total ms (timed frame)", |t| Some(t.total_ms)), ("texel fetches per pixel", |t| t.counters.get("fetches_per_pixel").copied())];
+    let mut out = Vec::new();
+    for (name, cost) in costs {
+        let (mut points, mut missing) = (Vec::new(), Vec::new());
+        let fetches = name.contains("fetches");
+        for t in &metrics.techniques {
+            match cost(t) {
+                _ if fetches && t.counters.contains_key("rays_traced") => missing.push(format!("{} (traces rays)", t.label)),
+                Some(c) if c.is_finite() => {
+                    points.push(Point { label: t.label.clone(), cost: c, quality: t.quality.wrong_pct, bytes: t.shadow_data_bytes })
+                }
+                _ => missing.push(format!("{} (no such count)", t.label)),
+            }
+        }
+        if points.len() < 2 {
+            continue;
+        }
+        let title = format!("wrong pixels against {name}");
+        let s = svg(&title, name, "wrong pixels (%)", &points)?;
+        out.push((title, s, missing));
+    }
+    Ok(out)
+}

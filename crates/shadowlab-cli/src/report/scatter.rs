@@ -1,11 +1,27 @@
-//! The sweep report's scatter plots: a quality figure (wrong % or mean FLIP) against a cost, marker area by memory (shadow data
-//! bytes), the Pareto front drawn and marked, every point labelled. SVG from plotters (no fonts,
+//! Quality/cost scatter plots (the compare report's and the sweep report's): a quality figure
+//! (wrong % or mean FLIP) against a cost, marker area by memory (shadow data bytes), the Pareto
+//! front drawn and marked, every point labelled. SVG from plotters (no fonts,
 //! no network). Costs spanning more than a factor 20 are drawn on a log10 axis.
 
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 
-use super::choose::pareto_front;
+
+/// Indices of the points (cost, quality) on the Pareto front, both minimised: no other point
+/// is at most as costly and at most as wrong, and better in one. Sorted by cost, then quality;
+/// equal points are all on the front; non-finite points are never on it.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
+    let finite = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite();
+    let mut front: Vec<usize> = (0..points.len())
+        .filter(|&i| finite(&points[i]))
+        .filter(|&i| {
+            let p = points[i];
+            !points.iter().any(|q| finite(q) && q.0 <= p.0 && q.1 <= p.1 && (q.0 < p.0 || q.1 < p.1))
+        })
+        .collect();
+    front.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0).then(points[a].1.total_cmp(&points[b].1)).then(a.cmp(&b)));
+    front
+}
 
 /// One point of a scatter.
 #[derive(Clone, Debug, PartialEq)]
@@ -108,6 +124,17 @@ mod tests {
 
     fn p(label: &str, cost: f64, wrong: f64, bytes: u64) -> Point {
         Point { label: label.into(), cost, quality: wrong, bytes }
+    }
+
+    #[test]
+    fn the_pareto_front_keeps_only_undominated_points() {
+        // (cost, wrong): 0 dominates 3 (cheaper and better); 4 equals 0, 7 equals 1; 5 is NaN
+        let pts = [(1.0, 5.0), (3.0, 1.0), (2.0, 2.0), (2.5, 6.0), (1.0, 5.0), (f64::NAN, 0.0), (0.5, 9.0), (3.0, 1.0)];
+        assert_eq!(pareto_front(&pts), vec![6, 0, 4, 2, 1, 7]);
+        assert_eq!(pareto_front(&[]), Vec::<usize>::new());
+        assert_eq!(pareto_front(&[(1.0, 1.0)]), vec![0]);
+        // a point equal in cost but worse is dominated
+        assert_eq!(pareto_front(&[(1.0, 1.0), (1.0, 2.0), (2.0, 1.0)]), vec![0]);
     }
 
     #[test]

@@ -18,7 +18,6 @@ mod plan;
 pub(crate) mod record;
 mod report;
 mod run;
-mod scatter;
 pub mod tune;
 
 use std::collections::BTreeSet;

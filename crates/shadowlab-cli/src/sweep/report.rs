@@ -6,10 +6,11 @@
 use anyhow::Result;
 use minijinja::context;
 
-use super::choose::{pareto_front, Aggregate};
+use super::choose::Aggregate;
+use crate::report::scatter::pareto_front;
 use super::json::Sweep;
 use super::record::Row;
-use super::scatter::{self, Point};
+use crate::report::scatter::{self, Point};
 
 const TEMPLATE: &str = include_str!("sweep.html.j2");
 

@@ -41,3 +41,23 @@ pub fn assert_clean_error(out: &Output, needle: &str) {
 pub fn json(p: PathBuf) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
 }
+
+/// Debian's Chromium (installed by `make`'s set-up, scripts/setup.sh).
+pub const CHROMIUM: &str = "/usr/bin/chromium";
+
+/// The DOM of `url` after its scripts ran, from headless Chromium (a fresh profile, no network
+/// chatter). Panics naming the fix when Chromium is missing: the set-up installs it.
+pub fn chromium_dom(url: &str) -> String {
+    assert!(std::path::Path::new(CHROMIUM).exists(), "{CHROMIUM} missing: run `make test` (scripts/setup.sh installs chromium)");
+    let profile = tmp("chromium-profile");
+    let o = Command::new(CHROMIUM)
+        .args(["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run"])
+        .args(["--disable-background-networking", "--disable-component-update", "--disable-sync"])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(["--virtual-time-budget=5000", "--dump-dom", url])
+        .output()
+        .expect("run chromium");
+    let _ = std::fs::remove_dir_all(&profile);
+    assert!(o.status.success(), "chromium failed: {}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
