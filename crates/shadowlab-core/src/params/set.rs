@@ -15,7 +15,7 @@
 //!         pub bias: family::Bias = Block::as_declared(),
 //!     }
 //! }
-//! let s = MySettings::from_values(&Default::default());
+//! let s = MySettings::defaults();
 //! assert_eq!((s.res, s.filter, s.bias.bias), (512, Filter::Nearest, 0.5));
 //! assert_eq!(MySettings::defs().len(), 6);
 //! ```
