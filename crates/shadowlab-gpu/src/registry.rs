@@ -6,7 +6,7 @@ use shadowlab_core::light::Light;
 use shadowlab_core::params::{ParamValues, TechniqueSpec};
 
 use crate::technique::TechniqueInfo;
-use crate::techniques::{csm, cube, dpsm, filtered, iasm, lt, mdsm, min_sm, sm, sv, virtual_sm, warp};
+use crate::techniques::{csm, cube, dpsm, filtered, iasm, lt, mdsm, min_sm, sdsm, sm, sv, virtual_sm, warp};
 use crate::GpuError;
 
 /// Every technique, in listing order.
@@ -24,7 +24,7 @@ pub static REGISTRY: &[&TechniqueInfo] = &[
     &filtered::EVSM_INFO,
     &filtered::MSM_INFO,
     &csm::INFO,
-    &csm::SDSM_INFO,
+    &sdsm::INFO,
     &iasm::INFO,
     &cube::INFO,
     &cube::NOTW_INFO,

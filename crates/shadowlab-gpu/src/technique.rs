@@ -109,6 +109,34 @@ impl EvalPipelines {
     }
 }
 
+/// Inside an `impl Technique for T`: [`Technique::evaluate`] and [`Technique::analyze`] as the
+/// two variants of one evaluation, `T::eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec:
+/// &mut Recorder, counting: bool) -> Result<(), GpuError>`: `evaluate` records it as shipped
+/// (`counting` false), `analyze` the lab's variant that also counts the view samples per texel
+/// (`counting` true, [`EvalPipelines`]).
+macro_rules! counted_evaluation {
+    () => {
+        fn evaluate(
+            &mut self,
+            gpu: &$crate::Gpu,
+            f: &$crate::technique::FrameInputs,
+            rec: &mut $crate::record::Recorder,
+        ) -> Result<(), $crate::GpuError> {
+            self.eval_pass(gpu, f, rec, false)
+        }
+
+        fn analyze(
+            &mut self,
+            gpu: &$crate::Gpu,
+            f: &$crate::technique::FrameInputs,
+            rec: &mut $crate::record::Recorder,
+        ) -> Result<(), $crate::GpuError> {
+            self.eval_pass(gpu, f, rec, true)
+        }
+    };
+}
+pub(crate) use counted_evaluation;
+
 /// An RGBA8 picture a technique offers the report (shadow maps, count maps, warps).
 #[derive(Clone, Debug)]
 pub struct NamedImage {

@@ -111,3 +111,31 @@ fn no_technique_reads_values_by_key() {
     }
     assert!(scanned.len() > 40, "{} files scanned", scanned.len());
 }
+
+/// The registry is the one list: every `TechniqueInfo` defined in a technique folder (or the
+/// reference's) is in `REGISTRY`, and every registry entry is defined in exactly one folder, so
+/// a technique cannot be added without its registry line, nor listed twice.
+#[test]
+fn every_technique_folder_is_in_the_registry() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut defined: Vec<(String, String)> = Vec::new();
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("techniques")).unwrap().map(|e| e.unwrap().path()).filter(|p| p.is_dir()).collect();
+    dirs.push(root.join("reference"));
+    for dir in dirs {
+        for f in sources(&dir) {
+            let text = std::fs::read_to_string(&f).unwrap();
+            for (i, _) in text.match_indices("TechniqueInfo {\n    name: \"") {
+                let rest = &text[i + "TechniqueInfo {\n    name: \"".len()..];
+                let name = &rest[..rest.find('"').unwrap()];
+                defined.push((name.to_string(), dir.file_name().unwrap().to_string_lossy().into_owned()));
+            }
+        }
+    }
+    for (name, folder) in &defined {
+        assert!(REGISTRY.iter().any(|t| t.name == name), "techniques/{folder}/ defines '{name}', which REGISTRY does not list");
+    }
+    for t in REGISTRY {
+        let n = defined.iter().filter(|(name, _)| name == t.name).count();
+        assert_eq!(n, 1, "'{}' is defined in {n} folders", t.name);
+    }
+}

@@ -11,6 +11,7 @@ pub mod lt;
 pub mod mdsm;
 pub mod min_sm;
 pub mod pictures;
+pub mod sdsm;
 pub mod sm;
 pub mod sv;
 pub mod virtual_sm;

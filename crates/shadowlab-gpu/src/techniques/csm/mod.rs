@@ -10,27 +10,30 @@
 //! the view's camera on the CPU (`shadowlab_core::techniques::csm`); `render` draws
 //! the scene once per cascade; `evaluate` picks the cascade per pixel by view depth.
 //!
-//! `sdsm` (sdsm.rs) is the same type with its boxes fitted to the view samples instead.
+//! `sdsm` (techniques/sdsm) renders and evaluates through a [`Cascaded`] whose boxes it fits to
+//! the view samples instead, with the sample-bounds reduction of bounds.rs (which `iasm` uses
+//! too).
 
+mod bounds;
 mod params;
 mod report;
-mod sdsm;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use shadowlab_core::light::Light;
 use shadowlab_core::params::{ParamSet, ParamTable};
+use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFrustum, MAX_CASCADES};
 
+pub(crate) use bounds::{decode_bounds, source as bounds_source, BoundsReduce, OUT_WORDS as SDSM_OUT_WORDS};
+pub use bounds::{SdsmReduce, OUT_BYTES as SDSM_BOUNDS_BYTES};
 pub use params::*;
-pub(crate) use sdsm::{decode_bounds, BoundsReduce, OUT_WORDS as SDSM_OUT_WORDS};
-pub use sdsm::{SdsmReduce, SdsmSettings, OUT_BYTES as SDSM_BOUNDS_BYTES, SDSM_INFO};
 
 use crate::record::{DelayedRead, Recorder};
 use crate::reduce::{decode, MinMax};
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose_depth;
-use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::technique::{compose_view, counted_evaluation, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::{binding, raster, Gpu, GpuError};
 
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
@@ -118,17 +121,15 @@ pub struct Cascaded {
     sampler: wgpu::Sampler,
     reduce: MinMax,
     probe: wgpu::Buffer,
-    /// `sdsm`: the boxes fitted to the samples' bounds.
-    sample_fit: Option<sdsm::SampleFit>,
 }
 
 /// The settings `csm` and `sdsm` both declare, as [`Cascaded::build`] reads them.
-struct Shared<'a> {
-    maps: &'a CascadeMaps,
-    lookup: &'a CascadeLookup,
-    lambda: f64,
-    blend: f64,
-    snap: bool,
+pub(crate) struct Shared<'a> {
+    pub maps: &'a CascadeMaps,
+    pub lookup: &'a CascadeLookup,
+    pub lambda: f64,
+    pub blend: f64,
+    pub snap: bool,
 }
 
 fn texture_depth_array() -> wgpu::BindingType {
@@ -152,16 +153,9 @@ impl Cascaded {
         Ok(t)
     }
 
-    /// `sdsm`: the cascades of `csm` fitted to the view samples (sdsm.rs).
-    pub fn new_sdsm(gpu: &Gpu, scene: &GpuScene, p: &SdsmSettings, light: &Light) -> Result<Cascaded, GpuError> {
-        let shared = Shared { maps: &p.maps, lookup: &p.lookup, lambda: p.lambda, blend: p.blend, snap: p.snap };
-        let mut t = Cascaded::build(gpu, scene, light, "sdsm", shared)?;
-        t.sample_fit = Some(sdsm::SampleFit::new(gpu, p, t.dir, t.count));
-        Ok(t)
-    }
-
-    /// What `csm` and `sdsm` share, from the parameters both declare.
-    fn build(gpu: &Gpu, scene: &GpuScene, light: &Light, name: &'static str, p: Shared) -> Result<Cascaded, GpuError> {
+    /// What `csm` and `sdsm` share, from the parameters both declare; `name` prefixes the stage
+    /// names.
+    pub(crate) fn build(gpu: &Gpu, scene: &GpuScene, light: &Light, name: &'static str, p: Shared) -> Result<Cascaded, GpuError> {
         let Light::Directional { direction } = *light else {
             return Err(GpuError::Invalid(format!("{name} supports directional lights only (got a {} light)", light.kind())));
         };
@@ -222,13 +216,64 @@ impl Cascaded {
             sampler,
             reduce: MinMax::new(gpu, "csm.reduce", 3),
             probe: gpu.storage("csm.probe", PROBE_BYTES),
-            sample_fit: None,
         })
     }
 
     /// The boxes of the last frame (for tests and leak tracing).
     pub fn boxes(&self) -> &[CascadeBox] {
         &self.boxes
+    }
+
+    /// Cascades in use.
+    pub(crate) fn count(&self) -> usize {
+        self.count
+    }
+
+    /// Side of each cascade's map (texels).
+    pub(crate) fn res(&self) -> u32 {
+        self.res
+    }
+
+    /// Whether the boxes are snapped (`snap`).
+    pub(crate) fn snap(&self) -> bool {
+        self.snap
+    }
+
+    /// The split blend (`lambda`).
+    pub(crate) fn lambda(&self) -> f32 {
+        self.lambda
+    }
+
+    /// The light's direction.
+    pub(crate) fn light_dir(&self) -> Vec3 {
+        self.dir
+    }
+
+    /// The G-buffer's min/max view-depth reduction.
+    pub(crate) fn depth_reduce(&self) -> &MinMax {
+        &self.reduce
+    }
+
+    /// The boxes of the view slices between `splits` (n + 1 view depths), fitted by `fit` and
+    /// extended over `scene`, with this map's light, size and snapping.
+    pub(crate) fn slice_boxes(&self, frustum: &ViewFrustum, scene: &Bounds, splits: &[f32], fit: Fit) -> Vec<CascadeBox> {
+        cascades::fit_cascades(frustum, self.dir, scene, splits, self.res, self.snap, fit)
+    }
+
+    /// A frame's fit from outside (`sdsm`): the G-buffer's depth range (None: not known), the
+    /// slice boxes (what [`Cascaded::boxes`] reports), and the (world -> light clip, texel size)
+    /// of each cascade as the depth passes and the evaluation use it, between `splits`.
+    pub(crate) fn set_fit(
+        &mut self,
+        rec: &mut Recorder,
+        depth_range: Option<(f32, f32)>,
+        slices: Vec<CascadeBox>,
+        used: &[(Mat4, f32)],
+        splits: &[f32],
+    ) {
+        self.depth_range = depth_range;
+        self.upload(rec, used, splits);
+        self.boxes = slices;
     }
 
     fn layer_view(&self, layer: u32) -> wgpu::TextureView {
@@ -244,9 +289,6 @@ impl Cascaded {
 impl Technique for Cascaded {
     /// Depth reduction on the GPU and one readback (with `tighten`), the fit on the CPU.
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        if self.sample_fit.is_some() {
-            return sdsm::prepare(self, gpu, f, rec);
-        }
         self.depth_range = None;
         if let Some(d) = self.delayed.as_mut() {
             // the previous frame's range (None on the first frame: the whole frustum), then this
@@ -275,7 +317,7 @@ impl Technique for Cascaded {
         } else {
             cascades::manual_splits(frustum.near, frustum.far, &self.manual).map_err(|e| GpuError::Invalid(format!("csm: {e}")))?
         };
-        self.boxes = cascades::fit_cascades(&frustum, self.dir, &f.scene.bounds, &splits, self.res, self.snap, self.fit);
+        self.boxes = self.slice_boxes(&frustum, &f.scene.bounds, &splits, self.fit);
         let boxes: Vec<(Mat4, f32)> = self.boxes.iter().map(|b| (b.view_proj, b.texel)).collect();
         self.upload(rec, &boxes, &splits);
         rec.cpu("csm.fit", t0.elapsed().as_secs_f64() * 1e3);
@@ -297,13 +339,7 @@ impl Technique for Cascaded {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.eval_pass(gpu, f, rec, false)
-    }
-
-    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.eval_pass(gpu, f, rec, true)
-    }
+    counted_evaluation!();
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
         report::report(self, gpu)

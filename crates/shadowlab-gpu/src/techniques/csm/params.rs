@@ -1,5 +1,5 @@
-//! `csm` and `sdsm` parameters and their defaults: the typed settings of both entries, with the
-//! rows they share declared once (the cascade maps, the lookup in the chosen cascade).
+//! `csm`'s parameters and their defaults, with the rows `sdsm` shares declared once (the cascade
+//! maps, the lookup in the chosen cascade; `sdsm`'s own settings are in techniques/sdsm).
 
 use shadowlab_core::params::family;
 use shadowlab_core::params::{Block, ParamDef};
@@ -81,7 +81,7 @@ shadowlab_core::param_set! {
 }
 
 /// Why `blend` does nothing with `cascades=1` (`csm` and `sdsm`).
-pub(super) const ONE_CASCADE_BLEND: &str = "cascades=1 has no next cascade to blend with";
+pub(crate) const ONE_CASCADE_BLEND: &str = "cascades=1 has no next cascade to blend with";
 
 shadowlab_core::param_choice! {
     /// `csm`'s slice enclosure (`shadowlab_core::techniques::csm::Fit`).
@@ -165,7 +165,6 @@ mod tests {
 
     use super::*;
     use crate::registry::{resolve, Resolved};
-    use crate::techniques::csm::SdsmSettings;
     use crate::GpuError;
 
     fn keys(defs: &[ParamDef]) -> Vec<&'static str> {
@@ -184,7 +183,7 @@ mod tests {
     }
 
     #[test]
-    fn csm_and_sdsm_list_their_keys_as_before() {
+    fn csm_lists_its_keys_as_before() {
         assert_eq!(
             keys(CsmSettings::defs()),
             [
@@ -205,10 +204,6 @@ mod tests {
                 "max_slope"
             ]
         );
-        assert_eq!(
-            keys(SdsmSettings::defs()),
-            ["cascades", "res", "lambda", "blend", "snap", "delayed", "reach", "bias", "normal_offset", "pcf", "max_slope"]
-        );
     }
 
     #[test]
@@ -227,7 +222,7 @@ mod tests {
     }
 
     #[test]
-    fn csm_and_sdsm_reject_keys_without_effect() {
+    fn csm_rejects_keys_without_effect() {
         assert!(err("csm:tighten=false,delayed=true").contains("delayed has no effect"));
         ok("csm:delayed=true");
         assert!(err("csm:split1=4,split2=12,lambda=0.5").contains("lambda has no effect"));
@@ -237,13 +232,5 @@ mod tests {
         ok("csm:blend=0.1");
         assert!(err("csm:max_slope=2").contains("max_slope has no effect"));
         ok("csm:pcf=3,max_slope=2");
-
-        let e = err("sdsm:reach=2");
-        assert!(e.contains("technique 'sdsm': reach has no effect"), "{e}");
-        ok("sdsm:delayed=true,reach=2");
-        assert!(err("sdsm:cascades=1,blend=0.2").contains("blend has no effect"));
-        assert!(err("sdsm:max_slope=2").contains("max_slope has no effect"));
-        let s = SdsmSettings::from_values(&ok("sdsm:res=2048,cascades=4,blend=0.2,pcf=3,max_slope=2").values);
-        assert_eq!((s.maps.cascades, s.maps.res, s.blend, s.lookup.pcf, s.lookup.max_slope), (4, 2048, 0.2, 3, 2.0));
     }
 }

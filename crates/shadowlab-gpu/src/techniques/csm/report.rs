@@ -1,6 +1,6 @@
 //! `csm`'s report: memory, per-cascade splits and texel sizes, sampling over all cascades,
-//! each cascade's depth and count maps, and the cascade each pixel used; for `sdsm` also its
-//! fitted boxes against the frustum slices' (`SampleFit::counters`).
+//! each cascade's depth and count maps, and the cascade each pixel used (`sdsm` adds its fitted
+//! boxes to it).
 
 use shadowlab_core::metrics::sampling_stats;
 
@@ -16,13 +16,8 @@ const COLOURS: [[u8; 3]; 8] =
 pub(super) fn report(t: &Cascaded, gpu: &Gpu) -> TechniqueReport {
     let texels = t.res as usize * t.res as usize;
     let counts: Vec<u32> = gpu.read_buffer_as(&t.counts, t.count * texels);
-    // sdsm keeps its reduction's output too
-    let extra = if t.sample_fit.is_some() { super::sdsm::OUT_BYTES } else { 0 };
-    let mut r = TechniqueReport {
-        shadow_data_bytes: (t.count * texels * 4) as u64 + extra,
-        sampling: Some(sampling_stats(&counts)),
-        ..Default::default()
-    };
+    let mut r =
+        TechniqueReport { shadow_data_bytes: (t.count * texels * 4) as u64, sampling: Some(sampling_stats(&counts)), ..Default::default() };
     let c = &mut r.counters;
     c.insert("cascades".into(), t.count as f64);
     c.insert("shadow_map_texels".into(), (t.count * texels) as f64);
@@ -36,9 +31,6 @@ pub(super) fn report(t: &Cascaded, gpu: &Gpu) -> TechniqueReport {
         c.insert(format!("split_{}", i + 1), u.info[2] as f64);
         c.insert(format!("texel_{i}"), u.info[0] as f64);
         c.insert(format!("box_side_{i}"), u.info[0] as f64 * t.res as f64);
-    }
-    if let Some(s) = &t.sample_fit {
-        s.counters(&t.boxes, c);
     }
     if let Some((lo, hi)) = t.depth_range {
         c.insert("gbuffer_depth_min".into(), lo as f64);

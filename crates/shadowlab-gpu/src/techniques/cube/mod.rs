@@ -9,45 +9,33 @@
 //! - `cube-notw` (notw.rs): NoTW per face: each face is a 90 degree square perspective frustum
 //!   (a spot light along the face axis) handled by `warp::Warped` with the face's view samples
 //!   only (its own desired view, count map and warps: 8 w^2 bytes per face).
+//!
+//! `cube`'s map is made and reported in map.rs, its faces drawn in depth.rs, evaluated in
+//! eval.rs; `cube-notw`'s per-face scenes are clip.rs.
 
 mod clip;
+mod depth;
+mod eval;
+mod map;
 mod notw;
+pub use map::read_layers;
 pub use notw::CubeNotw;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use shadowlab_core::light::Light;
-use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::params::family::{Bias, PCF, RES};
 use shadowlab_core::params::{Block, ParamDef, ParamSet, ParamTable};
-use shadowlab_core::techniques::cube::{face_view_proj, FACES};
 
 use crate::record::Recorder;
-use crate::scene_gpu::GpuScene;
-use crate::shaders::compose_depth;
-use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::techniques::pictures::{count_image, depth_image};
-use crate::techniques::sm::BIAS_WGSL;
-use crate::{binding, raster, Gpu, GpuError};
+use crate::technique::{counted_evaluation, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::{Gpu, GpuError};
 
 /// The face rules (`shadowlab_core::techniques::cube`), also composed into `virtual`'s shaders.
 pub(crate) const FACES_WGSL: &str = include_str!("faces.wgsl");
-const DEPTH_WGSL: &str = include_str!("depth.wgsl");
-const EVAL_WGSL: &str = include_str!("eval.wgsl");
-const SPLIT_WGSL: &str = include_str!("split.wgsl");
-
-fn depth_src() -> String {
-    compose_depth(&format!("{FACES_WGSL}{DEPTH_WGSL}"))
-}
-fn eval_src() -> String {
-    compose_view(&format!("{FACES_WGSL}{BIAS_WGSL}{EVAL_WGSL}"), false)
-}
-fn split_src() -> String {
-    compose_view(&format!("{FACES_WGSL}{SPLIT_WGSL}"), false)
-}
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("cube/depth.wgsl", depth_src()), ("cube/eval.wgsl", eval_src()), ("cube/split.wgsl", split_src())]
+    vec![("cube/depth.wgsl", depth::source()), ("cube/eval.wgsl", eval::source()), ("cube/split.wgsl", notw::split_source())]
 }
 
 shadowlab_core::param_choice! {
@@ -260,265 +248,47 @@ pub struct CubeMap {
     eval: crate::technique::EvalPipelines,
 }
 
-impl CubeMap {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &CubeSettings, light: &Light) -> Result<CubeMap, GpuError> {
-        let pos = point_position("cube", light)?;
-        let (res, pcf) = (p.res, p.pcf);
-        gpu.check_size(res, res, "cube face")?;
-        let far = bounds_far(scene, pos);
-        let near = (far * 1e-4).max(1e-5);
-        let hardware = p.depth == FaceDepth::Hardware;
-        let d = &gpu.device;
-        let map = raster::depth_target(gpu, "cube.map", res, res, 6, wgpu::TextureUsages::empty());
-        let face_layout = binding::layout(d, "cube.depth", wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
-        let face_groups = (0..6)
-            .map(|f| {
-                let u = CubeFace {
-                    view_proj: face_view_proj(pos, f, near, far).to_cols_array_2d(),
-                    light: pos.extend(far).into(),
-                    face: [f as u32, near.to_bits(), 0, 0],
-                };
-                let buf = gpu.uniform(&format!("cube.face{f}"), &u);
-                binding::group(d, "cube.depth", &face_layout, &[buf.as_entire_binding()])
-            })
-            .collect();
-        let layouts = [&face_layout, &scene.layout];
-        let module = gpu.shader("cube.render", &depth_src());
-        let depth_pipeline = face_pipeline(gpu, &module, "cube.render", &layouts, hardware, true, scene.has_cutouts);
-        let static_pipeline = face_pipeline(gpu, &module, "cube.render.static", &layouts, hardware, false, scene.has_cutouts);
-        let face_indices = static_face_lists(gpu, scene, pos);
-        let params = CubeParams { position: pos.into(), far, res: res as f32, pcf: pcf as f32, near, pad0: 0.0, bias: p.bias.packed() };
-        let array = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Depth,
-            view_dimension: wgpu::TextureViewDimension::D2Array,
-            multisampled: false,
-        };
-        let eval_layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
-        let hw = if hardware { 1.0 } else { 0.0 };
-        let eval = crate::technique::EvalPipelines::new(gpu, "cube.evaluate", &eval_src(), &eval_layout, &[("HW_DEPTH", hw)]);
-        Ok(CubeMap {
-            res,
-            far,
-            near,
-            hardware,
-            pcf,
-            map,
-            face_groups,
-            depth_pipeline,
-            face_indices,
-            static_pipeline,
-            params: gpu.uniform("cube.params", &params),
-            counts: gpu.storage("cube.counts", 6 * res as u64 * res as u64 * 4),
-            eval_layout,
-            eval,
-        })
-    }
-
-    /// The distance stored as depth 1 (the faces hold distance / far).
-    pub fn far(&self) -> f32 {
-        self.far
-    }
-
-    /// The six faces (+x, -x, +y, -y, +z, -z), each `res x res` row-major: distance / far.
-    /// The faces as distance / far (1 = empty), whichever way they store depth.
-    pub fn read_faces(&self, gpu: &Gpu) -> Vec<Vec<f32>> {
-        let mut faces = read_layers(gpu, &self.map);
-        if self.hardware {
-            let res = self.res as usize;
-            for (f, face) in faces.iter_mut().enumerate() {
-                for (i, v) in face.iter_mut().enumerate() {
-                    let (x, y) = ((i % res) as f32 + 0.5, (i / res) as f32 + 0.5);
-                    let dc = shadowlab_core::techniques::cube::direction(f, x / res as f32, y / res as f32);
-                    *v = if *v <= 0.0 { 1.0 } else { (self.near / *v * dc.length() / self.far).min(1.0) };
-                }
-            }
-        }
-        faces
-    }
-
-    /// View samples per texel of the last evaluation, face after face.
-    pub fn read_counts(&self, gpu: &Gpu) -> Vec<u32> {
-        gpu.read_buffer_as(&self.counts, 6 * (self.res * self.res) as usize)
-    }
-}
-
-/// The largest distance from `pos` to a corner of the scene bounds (+1 %): depth 1.
-fn bounds_far(scene: &GpuScene, pos: Vec3) -> f32 {
-    let far = scene.bounds.corners().iter().map(|c| (*c - pos).length()).fold(0.0f32, f32::max);
-    (far * 1.01).max(1e-3)
-}
-
-/// Every layer of a Depth32Float array texture, copied out one layer at a time.
-pub fn read_layers(gpu: &Gpu, tex: &wgpu::Texture) -> Vec<Vec<f32>> {
-    let (w, h) = (tex.width(), tex.height());
-    let tmp = raster::depth_target(gpu, "cube.readback", w, h, 1, wgpu::TextureUsages::COPY_DST);
-    (0..tex.depth_or_array_layers())
-        .map(|layer| {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            let src = wgpu::TexelCopyTextureInfo {
-                texture: tex,
-                mip_level: 0,
-                origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
-                aspect: wgpu::TextureAspect::All,
-            };
-            enc.copy_texture_to_texture(src, tmp.as_image_copy(), wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 });
-            gpu.submit(enc.finish());
-            bytemuck::pod_collect_to_vec(&gpu.read_texture(&tmp, 4))
-        })
-        .collect()
-}
-
 impl Technique for CubeMap {
     fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let views: Vec<wgpu::TextureView> = (0..6)
-            .map(|layer| {
-                self.map.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
-        // reversed depth clears to 0 (empty = farthest)
-        let clear = if self.hardware { 0.0 } else { 1.0 };
-        rec.stage("cube.render", |enc| {
-            for ((view, group), (indices, n)) in views.iter().zip(&self.face_groups).zip(&self.face_indices) {
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("cube.render"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view,
-                        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_bind_group(0, group, &[]);
-                pass.set_bind_group(1, &f.scene.group, &[]);
-                if *n > 0 {
-                    pass.set_pipeline(&self.static_pipeline);
-                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..*n, 0, 0..1);
-                }
-                if f.scene.dynamic_first < f.scene.triangle_count {
-                    pass.set_pipeline(&self.depth_pipeline);
-                    pass.draw(f.scene.dynamic_first * 3..f.scene.triangle_count * 3, 0..1);
-                }
-            }
-        });
+        self.render_faces(f, rec);
         Ok(())
+    }
+
+    counted_evaluation!();
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        map::report(self, gpu)
+    }
+}
+
+/// A frame of `cube-notw`: the view samples split by face (one readback of their counts), then
+/// each face with samples runs `notw`'s passes on its own samples, and the faces' visibility is
+/// merged.
+impl Technique for CubeNotw {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.split_samples(gpu, f, rec);
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.prepare(gpu, fi, t))
+    }
+
+    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.render(gpu, fi, t))
     }
 
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.eval_pass(gpu, f, rec, false)
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.evaluate(gpu, fi, t))?;
+        self.merge_faces(gpu, f, rec);
+        Ok(())
     }
 
+    /// Each face's analysis pass (its per-face visibility is rewritten with the same values, so
+    /// the merged visibility stands).
     fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.eval_pass(gpu, f, rec, true)
+        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.analyze(gpu, fi, t))
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
-        let (res, n) = (self.res, (self.res * self.res) as usize);
-        let counts = self.read_counts(gpu);
-        let mut r = TechniqueReport { shadow_data_bytes: 6 * n as u64 * 4, sampling: Some(sampling_stats(&counts)), ..Default::default() };
-        r.counters.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
-        r.counters.insert("shadow_map_texels".into(), 6.0 * n as f64);
-        // the per-face lists of static triangles (geometry, kept per light; not shadow data)
-        r.counters.insert("face_list_bytes".into(), self.face_indices.iter().map(|(_, k)| *k as f64 * 4.0).sum());
-        r.counters.insert("face_list_triangles".into(), self.face_indices.iter().map(|(_, k)| (*k / 3) as f64).sum());
-        for (f, face) in self.read_faces(gpu).iter().enumerate() {
-            let samples = counts[f * n..(f + 1) * n].iter().map(|&c| c as u64).sum::<u64>();
-            r.counters.insert(format!("view_samples_face_{}", FACES[f].name), samples as f64);
-            r.images.push(depth_image(&format!("face {} (distance)", FACES[f].name), res, face));
-        }
-        for (f, c) in counts.chunks(n).enumerate() {
-            r.images.push(count_image(&format!("face {} view samples per texel", FACES[f].name), res, c));
-        }
-        r
+        self.face_report(gpu)
     }
-}
-
-impl CubeMap {
-    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
-    fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
-        let view = self
-            .map
-            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
-        let group = f.view_group(
-            gpu,
-            "cube.evaluate",
-            &self.eval_layout,
-            &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), self.counts.as_entire_binding()],
-        );
-        self.eval.record(gpu, rec, "cube.evaluate", &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
-        Ok(())
-    }
-}
-
-/// Per face, the vertex indices of the static triangles not wholly outside it
-/// (`cube::outside_face`): the faces then draw about a sixth of the scene each, with no per-face
-/// test in the vertex stage. The light of a technique instance never moves.
-fn static_face_lists(gpu: &Gpu, scene: &GpuScene, light: Vec3) -> Vec<(wgpu::Buffer, u32)> {
-    let verts = scene.read_vertices(gpu);
-    (0..6)
-        .map(|f| {
-            let idx: Vec<u32> = (0..scene.dynamic_first)
-                .filter(|&t| {
-                    let v = &verts[3 * t as usize..3 * t as usize + 3];
-                    !shadowlab_core::techniques::cube::outside_face(&[v[0].pos.into(), v[1].pos.into(), v[2].pos.into()], light, f)
-                })
-                .flat_map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-                .collect();
-            let n = idx.len() as u32;
-            (gpu.buffer_init(&format!("cube.face{f}.indices"), bytemuck::cast_slice(&idx), wgpu::BufferUsages::INDEX), n)
-        })
-        .collect()
-}
-
-/// A face pipeline: `distance` writes the linear distance in the fragment stage (`fs_main`);
-/// `hardware` keeps the rasteriser's reversed depth (test `Greater`), with a fragment stage
-/// only for the cut-out test. `cull_in_vs`: the vertex stage's per-face test (moving triangles).
-fn face_pipeline(
-    gpu: &Gpu,
-    module: &wgpu::ShaderModule,
-    label: &str,
-    layouts: &[&wgpu::BindGroupLayout],
-    hardware: bool,
-    cull_in_vs: bool,
-    cutouts: bool,
-) -> wgpu::RenderPipeline {
-    let constants = [("CULL_IN_VS", if cull_in_vs { 1.0 } else { 0.0 }), ("HW_DEPTH", if hardware { 1.0 } else { 0.0 })];
-    let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-    let fragment = match (hardware, cutouts) {
-        (false, _) => Some("fs_main"),
-        (true, true) => Some("fs_cut_out"),
-        (true, false) => None,
-    };
-    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(&gpu.pipeline_layout(label, layouts)),
-        vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: options.clone(), buffers: &[] },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: raster::DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(if hardware { wgpu::CompareFunction::Greater } else { wgpu::CompareFunction::Less }),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: fragment.map(|entry| wgpu::FragmentState {
-            module,
-            entry_point: Some(entry),
-            compilation_options: options,
-            targets: &[],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
 }
 
 #[cfg(test)]

@@ -12,14 +12,21 @@ use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::techniques::cube::FACES;
 
-use super::{clip, point_position, split_src, CubeNotwSettings};
+use super::{clip, point_position, CubeNotwSettings, FACES_WGSL};
 use crate::frame::LightUniform;
 use crate::gbuffer::GBuffer;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::technique::{view_layout, FrameInputs, Technique, TechniqueReport};
+use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueReport};
 use crate::techniques::warp::{Knobs, Warped};
 use crate::{binding, Gpu, GpuError};
+
+const SPLIT_WGSL: &str = include_str!("split.wgsl");
+
+/// The `split` and `merge` passes (split.wgsl).
+pub(super) fn split_source() -> String {
+    compose_view(&format!("{FACES_WGSL}{SPLIT_WGSL}"), false)
+}
 
 /// The names of the images of a face's `Warped` report that `cube-notw` passes on.
 const FACE_IMAGES: &[&str] = &["count map before warping", "count map after warping", "warped shadow map", "row warping", "column warping"];
@@ -89,7 +96,7 @@ impl CubeNotw {
         let faces: Vec<Face> = built.into_iter().map(|f| f.expect("all six built")).collect();
         let rw = binding::storage(false);
         let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw, rw, rw]);
-        let src = split_src();
+        let src = split_source();
         Ok(CubeNotw {
             res,
             faces,
@@ -123,7 +130,7 @@ impl CubeNotw {
 
     /// Runs `step` on every face with view samples, with that face's inputs (its light, mask
     /// and visibility buffer), and records the stages summed over the faces as `cube-notw.*`.
-    fn each_face(
+    pub(super) fn each_face(
         &mut self,
         gpu: &Gpu,
         f: &FrameInputs,
@@ -163,10 +170,10 @@ impl CubeNotw {
         rec.set_rename(outer);
         result
     }
-}
 
-impl Technique for CubeNotw {
-    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+    /// The `split` stage: each face's mask of the view samples on it (sized to the view), and
+    /// the samples per face read back (`cube-notw.face_samples`) so empty faces are skipped.
+    pub(super) fn split_samples(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         let pixels = w as u64 * h as u64;
         if pixels != self.pixels {
@@ -187,31 +194,21 @@ impl Technique for CubeNotw {
         for (face, s) in self.faces.iter_mut().zip(samples) {
             face.samples = s;
         }
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.prepare(gpu, fi, t))
     }
 
-    fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.render(gpu, fi, t))
-    }
-
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.evaluate(gpu, fi, t))?;
+    /// The `merge` stage: each pixel's visibility copied from its face's.
+    pub(super) fn merge_faces(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
         rec.stage("cube-notw.merge", |enc| {
             for g in &groups {
                 gpu.dispatch_2d(enc, "cube-notw.merge", &self.merge, &[g], f.gbuffer.width, f.gbuffer.height);
             }
         });
-        Ok(())
     }
 
-    /// Each face's analysis pass (its per-face visibility is rewritten with the same values, so
-    /// the merged visibility stands).
-    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.analyze(gpu, fi, t))
-    }
-
-    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+    /// The faces' reports summed (memory, subdivision counters) or named per face (samples,
+    /// clipped triangles, sampling fractions, pictures), sampling over the six faces.
+    pub(super) fn face_report(&mut self, gpu: &Gpu) -> TechniqueReport {
         let n = (self.res * self.res) as usize;
         let mut r = TechniqueReport::default();
         let mut after = Vec::with_capacity(6 * n);

@@ -201,13 +201,13 @@ pub struct Dpsm {
 impl Dpsm {
     /// `dpsm`: the two plain paraboloid maps.
     pub fn plain(gpu: &Gpu, scene: &GpuScene, p: &DpsmSettings, light: &Light) -> Result<Dpsm, GpuError> {
-        Dpsm::new(gpu, scene, &Knobs::dpsm(p), p.split, light, false)
+        Dpsm::new(gpu, scene, &Knobs::dpsm(p.res, p.pcf, &p.bias, &p.subdivision, p.exact_depth), p.split, light, false)
     }
 
     /// `dpsm-notw`: the two maps warped by NoTW (its window checked against `res` by
     /// [`DpsmNotwSettings`]'s rules).
     pub fn notw(gpu: &Gpu, scene: &GpuScene, p: &DpsmNotwSettings, light: &Light) -> Result<Dpsm, GpuError> {
-        Dpsm::new(gpu, scene, &Knobs::dpsm_notw(p), p.split, light, true)
+        Dpsm::new(gpu, scene, &Knobs::dpsm_notw(&p.core, p.res, p.window_tent), p.split, light, true)
     }
 
     fn new(gpu: &Gpu, scene: &GpuScene, k: &Knobs, split: Split, light: &Light, warped: bool) -> Result<Dpsm, GpuError> {

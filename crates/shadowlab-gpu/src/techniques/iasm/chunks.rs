@@ -6,10 +6,16 @@
 use glam::Vec3;
 
 use super::plan::unkey;
-use super::BOUNDS_WGSL;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
 use crate::{binding, Gpu, GpuError};
+
+/// Also `virtual`'s chunk bounds (with a first-triangle offset).
+pub(crate) const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
+
+pub(super) fn source() -> String {
+    compose(BOUNDS_WGSL, true)
+}
 
 /// World AABBs of chunks of `chunk` triangles in vertex order, computed once on the GPU (the
 /// lab keeps no CPU copy of the vertices). Returns the boxes; a chunk with a moving triangle
@@ -26,7 +32,7 @@ pub(super) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Ve
     let cp = gpu.uniform("iasm.chunk_params", &[chunk, scene.triangle_count, 0, 0]);
     let layout = binding::layout(d, "iasm.bounds", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
     let group = binding::group(d, "iasm.bounds", &layout, &[cp.as_entire_binding(), boxes.as_entire_binding()]);
-    let pipeline = gpu.compute_pipeline("iasm.bounds", &compose(BOUNDS_WGSL, true), "main", &[&layout, &scene.layout]);
+    let pipeline = gpu.compute_pipeline("iasm.bounds", &source(), "main", &[&layout, &scene.layout]);
     let groups = scene.triangle_count.div_ceil(64).max(1);
     let mut enc = d.create_command_encoder(&Default::default());
     {

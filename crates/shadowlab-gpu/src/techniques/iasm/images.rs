@@ -2,9 +2,12 @@
 //! depth as a 4x4 mosaic at a common size, and the tile resolutions with their importance).
 
 use shadowlab_core::metrics::sampling_stats;
-use shadowlab_core::techniques::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
+use shadowlab_core::techniques::iasm::{self as core, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
 
-use super::gpu::Iasm;
+use super::atlas::Atlas;
+use super::fit::{ViewFit, FIT_BYTES};
+use super::plan::Plan;
+use super::uniforms::IasmParams;
 use crate::technique::{NamedImage, TechniqueReport};
 use crate::techniques::pictures::depth_image;
 use crate::Gpu;
@@ -12,26 +15,35 @@ use crate::Gpu;
 /// Side of one tile in the pictures.
 const CELL: u32 = 128;
 
-pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
+/// The report of the frame planned as `plan` over the square `placement`, its tiles' depth in
+/// `atlas` (store=atlas) or `shadow`, the samples per texel in `counts`.
+pub(super) fn report(
+    gpu: &Gpu,
+    plan: &Plan,
+    placement: &Placement,
+    atlas: Option<&Atlas>,
+    fit: Option<&ViewFit>,
+    shadow: &wgpu::Buffer,
+    counts: &wgpu::Buffer,
+) -> TechniqueReport {
     let texels = core::texels(&THESIS_RESOLUTIONS);
-    let counts: Vec<u32> = gpu.read_buffer_as(&t.counts, texels as usize);
-    let plan = &t.plan;
-    let (shadow, bytes) = match &t.atlas {
-        None => (gpu.read_buffer_as(&t.shadow, texels as usize), texels * core::TEXEL_BYTES),
-        Some(a) => (atlas_as_buffer(t, a, gpu), a.texture.width() as u64 * a.texture.height() as u64 * 4),
+    let counts: Vec<u32> = gpu.read_buffer_as(counts, texels as usize);
+    let (shadow, bytes) = match atlas {
+        None => (gpu.read_buffer_as(shadow, texels as usize), texels * core::TEXEL_BYTES),
+        Some(a) => (atlas_as_buffer(plan, a, gpu), a.texture.width() as u64 * a.texture.height() as u64 * 4),
     };
     let mut r = TechniqueReport { shadow_data_bytes: bytes, sampling: Some(sampling_stats(&counts)), ..Default::default() };
     let c = &mut r.counters;
     c.insert("fetches_per_pixel".into(), 1.0);
     c.insert("shadow_buffer_texels".into(), texels as f64);
     // resolution, offset and the two planes per tile (the uniform), not counted above
-    c.insert("tile_metadata_bytes".into(), std::mem::size_of::<super::IasmParams>() as f64);
-    c.insert("square_side".into(), t.placement.size as f64);
-    c.insert("square_x0".into(), t.placement.origin.x as f64);
-    c.insert("square_y0".into(), t.placement.origin.y as f64);
-    if let Some(f) = &t.fit {
+    c.insert("tile_metadata_bytes".into(), std::mem::size_of::<IasmParams>() as f64);
+    c.insert("square_side".into(), placement.size as f64);
+    c.insert("square_x0".into(), placement.origin.x as f64);
+    c.insert("square_y0".into(), placement.origin.y as f64);
+    if let Some(f) = fit {
         c.insert("fit_source".into(), f.source as u32 as f64);
-        c.insert("fit_bytes".into(), super::FIT_BYTES as f64);
+        c.insert("fit_bytes".into(), FIT_BYTES as f64);
         if let Some(b) = f.bounds {
             c.insert("fit_samples".into(), b.samples as f64);
             for (k, v) in [("x0", b.lo.x), ("y0", b.lo.y), ("x1", b.hi.x), ("y1", b.hi.y)] {
@@ -61,17 +73,16 @@ pub fn report(t: &Iasm, gpu: &Gpu) -> TechniqueReport {
     c.insert("outside_samples".into(), outside);
     c.insert("outside_pct".into(), if inside + outside > 0.0 { 100.0 * outside / (inside + outside) } else { 0.0 });
     c.insert("triangles_drawn".into(), tris as f64);
-    r.images.push(mosaic(t, &shadow));
-    r.images.push(resolution_picture(t));
+    r.images.push(mosaic(plan, &shadow));
+    r.images.push(resolution_picture(plan));
     r
 }
 
 /// The atlas's tiles copied into the linear layout in the buffer's encoding (bits of 1 - z; 0 =
 /// nothing), for the same picture.
-fn atlas_as_buffer(t: &Iasm, a: &super::atlas::Atlas, gpu: &Gpu) -> Vec<u32> {
+fn atlas_as_buffer(plan: &Plan, a: &Atlas, gpu: &Gpu) -> Vec<u32> {
     let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&a.texture, 4));
     let w = a.texture.width();
-    let plan = &t.plan;
     let mut out = vec![0u32; core::texels(&THESIS_RESOLUTIONS) as usize];
     for (rank, &i) in plan.order.iter().enumerate() {
         let (r, [x0, y0]) = (plan.res[i], a.slots[rank]);
@@ -89,8 +100,7 @@ fn atlas_as_buffer(t: &Iasm, a: &super::atlas::Atlas, gpu: &Gpu) -> Vec<u32> {
 
 /// The tiles' stored depth in light-space units (comparable across tiles), each tile resampled
 /// to CELL x CELL, laid out as the 4x4 square; cleared texels and empty tiles are black.
-fn mosaic(t: &Iasm, shadow: &[u32]) -> NamedImage {
-    let plan = &t.plan;
+fn mosaic(plan: &Plan, shadow: &[u32]) -> NamedImage {
     let side = 4 * CELL;
     let mut world = vec![f32::NAN; (side * side) as usize];
     for i in 0..TILE_COUNT {
@@ -115,8 +125,7 @@ fn mosaic(t: &Iasm, shadow: &[u32]) -> NamedImage {
 
 /// Each tile filled by its resolution (brightness: log2 r from 16 to 1024) and importance share
 /// (red to yellow); empty tiles black; a grey grid between tiles.
-fn resolution_picture(t: &Iasm) -> NamedImage {
-    let plan = &t.plan;
+fn resolution_picture(plan: &Plan) -> NamedImage {
     let side = 4 * CELL;
     let total: f64 = plan.stats.importance.iter().sum::<f64>().max(1e-9);
     let mut rgba = vec![0u8; (side * side * 4) as usize];

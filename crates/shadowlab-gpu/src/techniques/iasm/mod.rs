@@ -10,154 +10,63 @@
 //! plane (nearest the light); the buffer stores the bits of 1 - z (cleared 0 reads z = 1), the
 //! atlas stores z (cleared to 1). A cleared texel is lit.
 //! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::techniques::iasm`.
+//! Stage names (timing keys): `iasm.fit` and `iasm.fit.readback` (fit=view), `iasm.importance`
+//! (analysis pass), `iasm.readback` (waiting for and mapping the 16 tiles' stats: the sync
+//! cost), `iasm.shadows.clear`, `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
+//!
+//! Files: `params.rs` the parameter table; `uniforms.rs` the structs shared with WGSL;
+//! construction in stages, `setup.rs` (the settings read and checked, the chunks' boxes) then
+//! `resources.rs` (buffers) then each pass's pipelines; `plan.rs` the per-frame plan; the
+//! passes `chunks.rs` (bounds, once), `fit.rs` (fit=view), `analysis.rs` (importance),
+//! `tiles.rs` (store=buffer) or `atlas.rs` (store=atlas), `eval.rs`, `probe.rs` (tests);
+//! `images.rs` the report.
 
+mod analysis;
 mod atlas;
 mod chunks;
+mod eval;
 mod fit;
-mod gpu;
 mod images;
+mod params;
 pub(crate) mod plan;
+mod probe;
+mod resources;
+mod setup;
+mod tiles;
+mod uniforms;
 
-use bytemuck::{Pod, Zeroable};
-use shadowlab_core::params::family;
-use shadowlab_core::params::{ParamDef, ParamSet, ParamTable};
-use shadowlab_core::techniques::iasm::Anchor;
+use shadowlab_core::light::Light;
+use shadowlab_core::params::{ParamSet, ParamTable};
+use shadowlab_core::techniques::iasm::{self as core, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
 
-use crate::shaders::{compose, compose_depth};
-use crate::technique::{compose_view, TechniqueInfo};
-
+use analysis::AnalysisPass;
+use atlas::{Atlas, AtlasPass};
+pub(crate) use chunks::BOUNDS_WGSL;
+use eval::EvalPass;
+use fit::ViewFit;
 pub use fit::{FitSource, FIT_BYTES};
-pub use gpu::Iasm;
+pub use params::*;
+use plan::{Plan, TileStats, STATS_WORDS};
+use resources::Resources;
+use setup::Setup;
+use tiles::TilePass;
+pub use uniforms::{IasmParams, TileParams};
 
-const PARAMS_WGSL: &str = include_str!("params.wgsl");
-const ANALYSIS_WGSL: &str = include_str!("analysis.wgsl");
-const RENDER_WGSL: &str = include_str!("render.wgsl");
-const EVAL_WGSL: &str = include_str!("eval.wgsl");
-pub(crate) const BOUNDS_WGSL: &str = include_str!("bounds.wgsl");
-const PROBE_WGSL: &str = include_str!("probe.wgsl");
-const ATLAS_WGSL: &str = include_str!("atlas.wgsl");
-const EVAL_ATLAS_WGSL: &str = include_str!("eval_atlas.wgsl");
-const EVAL_MAIN_WGSL: &str = include_str!("eval_main.wgsl");
-
-fn analysis_src() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{ANALYSIS_WGSL}"), false)
-}
-fn eval_src() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{EVAL_WGSL}{EVAL_MAIN_WGSL}"), false)
-}
-fn eval_atlas_src() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{EVAL_ATLAS_WGSL}{EVAL_MAIN_WGSL}"), false)
-}
-fn probe_src() -> String {
-    compose(&format!("{PARAMS_WGSL}{PROBE_WGSL}"), false)
-}
+use crate::record::Recorder;
+use crate::scene_gpu::GpuScene;
+use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::{Gpu, GpuError};
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
-        ("iasm/analysis.wgsl", analysis_src()),
-        ("iasm/render.wgsl", compose_depth(RENDER_WGSL)),
-        ("iasm/eval.wgsl", eval_src()),
-        ("iasm/bounds.wgsl", compose(BOUNDS_WGSL, true)),
-        ("iasm/probe.wgsl", probe_src()),
-        ("iasm/atlas.wgsl", compose_depth(ATLAS_WGSL)),
-        ("iasm/eval_atlas.wgsl", eval_atlas_src()),
+        ("iasm/analysis.wgsl", analysis::source()),
+        ("iasm/render.wgsl", tiles::source()),
+        ("iasm/eval.wgsl", eval::source()),
+        ("iasm/bounds.wgsl", chunks::source()),
+        ("iasm/probe.wgsl", probe::source()),
+        ("iasm/atlas.wgsl", atlas::source()),
+        ("iasm/eval_atlas.wgsl", eval::atlas_source()),
     ]
-}
-
-/// m of equation 3.1: a sample at the camera weighs 1 + m, one at w >= k weighs 1. The thesis
-/// gives no value. Too low: the ranking follows sample counts (wide far tiles win); too high:
-/// a few near pixels outrank a whole tile of mid-distance ground.
-pub const DEFAULT_M: f64 = 4.0;
-/// k of equation 3.1 in world units; 0 = half the light square's side (the distance from the
-/// camera to the square's centre). The thesis gives no value. Too low: every sample beyond k
-/// weighs the same; too high: distance hardly matters.
-pub const DEFAULT_K: f64 = 0.0;
-/// Square side in world units; 0 = the scene bounds' extent across the light (thesis 5: "the
-/// frustum sides have been empirically chosen to encompass all geometry in the scene").
-/// Too small: geometry ahead falls outside (lit); too large: coarse tiles.
-pub const DEFAULT_SIZE: f64 = 0.0;
-/// Constant bias in texels of the tile (as `sm`); 0.5 from `sm`'s sweep.
-pub const DEFAULT_BIAS: f64 = family::DEFAULT_BIAS;
-/// Normal offset in texels of the tile (as `sm`); 0.5 from `sm`'s sweep; low: acne at grazing
-/// light, high: shifted shadows.
-pub const DEFAULT_NORMAL_OFFSET: f64 = family::DEFAULT_NORMAL_OFFSET;
-/// Where the tiles' depth lives: 0 = buffer (the thesis's linear storage buffer, exactly the
-/// set's 6,860,800 bytes, fragments write by atomic max: no early depth test), 1 = atlas (the
-/// same tiles in a 2048 x 1024 Depth32Float atlas, 8,388,608 bytes, hardware depth test). The
-/// atlas rendered the tiles 1.4-3x faster on every measured setup (lavapipe, 2026-11-22,
-/// docs/bench/iasm.md), so it is the default, as issue 6 asks; results are the same.
-pub const DEFAULT_STORE: f64 = 1.0;
-/// Triangles per culling chunk (vertex order). Small: many draw calls and CPU culling work;
-/// large: loose bounds that pass every tile (the thesis's village worst case).
-pub const DEFAULT_CHUNK: f64 = 256.0;
-/// How the square is placed: 0 = fixed (the thesis's rule: ahead of the camera, side `size`),
-/// 1 = view (fitted to the light-space bounds of the evaluated samples, thesis 3.2 / ch. 5's
-/// suggestion; `size` and `anchor` unused). View is the default: chosen on courtyard and
-/// city_corner (0.20 / 0.12 % wrong against fixed's 0.35 / 1.74 at 1024x1024) and better than
-/// fixed on all four held-out views (city, sponza, warp-courtyard, foliage; BENCHMARKS.md
-/// "Issue 18: iasm fitted to the view").
-pub const DEFAULT_FIT: usize = 1;
-/// `fit=view`: fraction of the samples' larger light-space extent added on each side of the
-/// square (the side always holds two extra coarsest texels for snapping and the normal offset).
-/// Low: a sample the camera moves out of a delayed fit is lit; high: coarser tiles. 0.05 was
-/// the best of 0, 0.01, 0.02, 0.05, 0.1, 0.2 on courtyard + city_corner (mean 0.163 % wrong);
-/// the wrong % is not monotonic in it (where the tile borders fall moves with the side).
-pub const DEFAULT_MARGIN: f64 = 0.05;
-
-shadowlab_core::param_choice! {
-    /// `anchor`: where the camera sits on the fixed square (`shadowlab_core::techniques::iasm::Anchor`).
-    pub enum IasmAnchor { Circle = "circle", Tile = "tile" }
-}
-
-impl From<IasmAnchor> for Anchor {
-    fn from(a: IasmAnchor) -> Anchor {
-        match a {
-            IasmAnchor::Circle => Anchor::Circle,
-            IasmAnchor::Tile => Anchor::TileCentre,
-        }
-    }
-}
-
-shadowlab_core::param_choice! {
-    /// `store`: where the tiles' depth lives (see [`DEFAULT_STORE`]).
-    pub enum IasmStore { Buffer = "buffer", Atlas = "atlas" }
-}
-
-shadowlab_core::param_choice! {
-    /// `fit`: how the square is placed (see [`DEFAULT_FIT`]).
-    pub enum IasmFit { Fixed = "fixed", View = "view" }
-}
-
-shadowlab_core::param_set! {
-    /// `iasm`'s parameters.
-    pub struct IasmSettings {
-        pub m: f64 = ParamDef::number("m", DEFAULT_M, 0.0, 1000.0, "importance weight of near samples, p = 1 + m clamp(1 - w/k, 0, 1)", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
-        pub k: f64 = ParamDef::number("k", DEFAULT_K, 0.0, 1e6, "importance range (world units); 0 = half the light square's side", "seed 001 eq. 3.1 (no value given; shadowlab choice)"),
-        pub size: f64 = ParamDef::number("size", DEFAULT_SIZE, 0.0, 1e6, "side of the light square (world units); 0 = scene extent across the light", "seed 001 ch. 5: sides chosen to encompass all geometry"),
-        pub bias: f64 = family::BIAS.with_doc("constant depth bias, texels of the sample's tile; low: acne, high: peter-panning"),
-        pub normal_offset: f64 = family::NORMAL_OFFSET.with_doc("offset along the normal, texels of the sample's tile"),
-        pub delayed: bool = ParamDef::flag("delayed", false, "use the previous frame's importance and near/far planes (no readback stall)", "seed 001 4.3, deferred delayed IASM"),
-        pub snap: bool = ParamDef::flag("snap", true, "move the square in steps of the coarsest texel (tile/16) so texel grids do not shimmer", "shadowlab addition (not in seed 001)"),
-        pub anchor: IasmAnchor = ParamDef::choice("anchor", IasmAnchor::NAMES, 0, "circle: camera on the inscribed circle (Fig. 3.1); tile: then shifted so the camera sits at a tile centre (no four-tile corner at the camera)", "seed 001 3.2 / ch. 5 suggested fix"),
-        pub store: IasmStore = ParamDef::choice("store", IasmStore::NAMES, DEFAULT_STORE as usize, "buffer: one storage buffer, linear per-tile layout, atomic-max depth writes (thesis 3.5, exactly the set's texels); atlas: the tiles in a 2 r0 x r0 Depth32Float atlas, hardware depth test (conventional)", "seed 001 3.2/3.5; default = the faster on lavapipe (docs/bench/iasm.md)"),
-        pub fit: IasmFit = ParamDef::choice("fit", IasmFit::NAMES, DEFAULT_FIT, "fixed: the thesis's square of side `size` ahead of the camera (Fig. 3.1); view: centred on and sized to the light-space bounds of the evaluated view samples (one more reduction and 320-byte readback; `size`, `anchor` unused)", "seed 001 3.2 / ch. 5 (suggested: fit the frustum to the view); reduction from sdsm (Lauritzen et al. 2011)"),
-        pub margin: f64 = ParamDef::number("margin", DEFAULT_MARGIN, 0.0, 1.0, "fit=view: fraction of the samples' extent added on each side of the square", "shadowlab choice (BENCHMARKS.md, issue 18)"),
-        pub chunk: u32 = ParamDef::integer("chunk", DEFAULT_CHUNK, 1.0, 1e7, "triangles per culling chunk (vertex order)", "shadowlab choice; seed 001 4.3: culling decides the cost"),
-    }
-    rules {
-        // (with fit=view, `size` and `anchor` still place the square of a frame without
-        // evaluated samples, and `size` bounds the fitted side from below: not listed)
-        fn ineffective(&self) -> Vec<(&'static str, String)> {
-            let mut v = Vec::new();
-            if self.m == 0.0 {
-                v.push(("k", "it shapes the weight of near samples, and m=0 weighs every sample 1".to_string()));
-            }
-            if self.fit == IasmFit::Fixed {
-                v.push(("margin", "it widens the square fitted to the view, and fit=fixed places the thesis's square".to_string()));
-            }
-            v
-        }
-    }
 }
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -176,68 +85,194 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, &IasmSettings::from_values(p), light)?)),
 };
 
-/// WGSL `IasmParams` (params.wgsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct IasmParams {
-    pub right: [f32; 4],
-    pub up: [f32; 4],
-    pub dir: [f32; 4],
-    pub imp: [f32; 4],
-    pub res: [u32; 16],
-    pub off: [u32; 16],
-    pub near: [f32; 16],
-    pub far: [f32; 16],
-    /// store=atlas: top-left corner of each tile's square, x | y << 16.
-    pub slot: [u32; 16],
+pub struct Iasm {
+    /// The settings as read and what creation derived from them (setup.rs).
+    setup: Setup,
+    pub placement: Placement,
+    pub plan: Plan,
+    pub atlas: Option<Atlas>,
+    /// `fit=view`: the square from the view samples' bounds (None: the thesis's fixed rule).
+    fit: Option<ViewFit>,
+    /// Delayed: the analysis of the previous frame is in `stats_buf`, made over `analysed`.
+    pending: bool,
+    analysed: Placement,
+    /// Delayed: this frame's own placement, analysed after the shadows for the next frame.
+    current: Placement,
+    /// The parameters this frame was evaluated with (the analysis pass evaluates with them
+    /// again; delayed mode has overwritten the buffer for the next frame by then).
+    evaluated: Option<IasmParams>,
+    res: Resources,
+    tiles: TilePass,
+    analysis: AnalysisPass,
+    eval: EvalPass,
+    /// store=atlas: the atlas's tile passes and evaluation (beside `atlas`).
+    atlas_pass: Option<AtlasPass>,
 }
 
-/// WGSL `TileParams` (render.wgsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct TileParams {
-    pub view_proj: [[f32; 4]; 4],
-    pub tile: [u32; 4],
-}
-
-#[cfg(test)]
-mod tests {
-    use shadowlab_core::params::TechniqueSpec;
-
-    use super::*;
-    use crate::registry::{resolve, Resolved};
-    use crate::GpuError;
-
-    fn ok(spec: &str) -> Resolved {
-        resolve(&TechniqueSpec::parse(spec).unwrap(), None).unwrap_or_else(|e| panic!("{spec}: {e}"))
+impl Iasm {
+    /// In stages: the settings read and checked (setup.rs), the buffers (resources.rs) and the
+    /// atlas, then the passes' pipelines and bind groups.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &IasmSettings, light: &Light) -> Result<Iasm, GpuError> {
+        let setup = setup::plan(gpu, scene, p, light)?;
+        let res = Resources::new(gpu, &setup);
+        let atlas = setup.atlas.as_ref().map(|l| Atlas::new(gpu, l));
+        let tiles = TilePass::new(gpu, scene, &res.tile_buf, &res.shadow);
+        let analysis = AnalysisPass::new(gpu);
+        let eval = EvalPass::buffer(gpu);
+        let atlas_pass = atlas.is_some().then(|| AtlasPass::new(gpu, &[&tiles.layout, &scene.layout], scene.has_cutouts));
+        let fit = setup.fit_margin.map(|margin| ViewFit::new(gpu, setup.light_dir, margin, 1e-3 * setup.size, setup.snap, setup.delayed));
+        Ok(Iasm {
+            placement: setup.basis,
+            plan: Plan::default(),
+            atlas,
+            fit,
+            pending: false,
+            analysed: setup.basis,
+            current: setup.basis,
+            evaluated: None,
+            res,
+            tiles,
+            analysis,
+            eval,
+            atlas_pass,
+            setup,
+        })
     }
 
-    fn err(spec: &str) -> String {
-        match resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
-            Err(GpuError::Invalid(m)) => m,
-            other => panic!("{spec}: {other:?}"),
+    pub fn size(&self) -> f32 {
+        self.setup.size
+    }
+
+    /// The uniform of this frame (placement and plan).
+    pub fn params(&self) -> IasmParams {
+        let (s, p) = (&self.setup, &self.placement);
+        let k = if s.k > 0.0 { s.k } else { 0.5 * p.size };
+        let res = std::array::from_fn(|t| if self.plan.empty[t] { 0 } else { self.plan.res[t] });
+        let mut slot = [0; TILE_COUNT];
+        if let Some(a) = &self.atlas {
+            for (rank, &t) in self.plan.order.iter().enumerate() {
+                slot[t] = a.slots[rank][0] | a.slots[rank][1] << 16;
+            }
+        }
+        IasmParams {
+            right: p.right.extend(p.origin.x).into(),
+            up: p.up.extend(p.origin.y).into(),
+            dir: p.dir.extend(p.size).into(),
+            imp: [s.m, k, s.bias, s.normal_offset],
+            res,
+            off: self.plan.off,
+            near: self.plan.near,
+            far: self.plan.far,
+            slot,
         }
     }
 
-    #[test]
-    fn iasm_lists_its_keys_as_before_and_reads_them_typed() {
-        let keys: Vec<_> = IasmSettings::defs().iter().map(|d| d.key).collect();
-        assert_eq!(keys, ["m", "k", "size", "bias", "normal_offset", "delayed", "snap", "anchor", "store", "fit", "margin", "chunk"]);
-        let d = IasmSettings::defaults();
-        assert_eq!((d.store, d.fit, d.anchor, d.margin, d.chunk), (IasmStore::Atlas, IasmFit::View, IasmAnchor::Circle, 0.05, 256));
-        let s = IasmSettings::from_values(&ok("iasm:fit=fixed,size=200,anchor=tile,store=buffer").values);
-        assert_eq!((s.fit, s.size, Anchor::from(s.anchor), s.store), (IasmFit::Fixed, 200.0, Anchor::TileCentre, IasmStore::Buffer));
+    /// Ranks, assigns, lays out, sets planes and culls (thesis 3.4, 3.5) from `stats` (plan.rs).
+    pub fn make_plan(&mut self, stats: TileStats) {
+        let s = &self.setup;
+        self.plan = plan::make_plan(stats, &self.placement, &s.boxes, s.chunk, s.triangles);
     }
 
-    #[test]
-    fn iasm_rejects_keys_without_effect() {
-        let e = err("iasm:fit=fixed,margin=0.1");
-        assert!(e.contains("technique 'iasm': margin has no effect"), "{e}");
-        ok("iasm:fit=view,margin=0.1");
-        ok("iasm:margin=0.1");
-        assert!(err("iasm:m=0,k=3").contains("k has no effect"));
-        ok("iasm:m=2,k=3");
-        // size and anchor still place a fitted square's frames without samples
-        ok("iasm:fit=view,size=200,anchor=tile");
+    /// The GPU's texel index and tile (equations 3.2-3.5 in eval.wgsl) of buffer coordinates
+    /// `uvs` for resolutions `res` (offsets accumulated from them). For tests.
+    pub fn probe_indices(&self, gpu: &Gpu, res: &[u32; TILE_COUNT], uvs: &[glam::Vec2]) -> Vec<(u32, u32)> {
+        probe::probe_indices(gpu, self.params(), res, uvs)
+    }
+
+    /// Places the square for the camera of `f`: fitted to the view samples (`fit=view`, when
+    /// any was evaluated) or by the thesis's rule.
+    fn place(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        if let Some(p) = self.fit.as_mut().and_then(|v| v.place(gpu, f, rec)) {
+            self.placement = p;
+            return;
+        }
+        let (s, cam) = (&self.setup, &f.camera);
+        let forward = (cam.target - cam.position).normalize_or_zero();
+        let min_res = *THESIS_RESOLUTIONS.iter().min().unwrap_or(&16) as f32;
+        let step = s.snap.then_some(s.size / core::TILES_PER_SIDE as f32 / min_res);
+        self.placement = core::place(s.light_dir, cam.position, forward, s.size, step, s.anchor);
+    }
+
+    /// Dispatches the analysis of `f` with the current placement into the statistics.
+    fn analyse(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        self.analysis.record(gpu, f, rec, &self.params(), &self.res.params_buf, &self.res.stats_buf);
+    }
+
+    /// The evaluation of the store in use and its bind group.
+    fn eval_group(&self, gpu: &Gpu, f: &FrameInputs) -> (&EvalPass, wgpu::BindGroup) {
+        let (params, counts) = (&self.res.params_buf, &self.res.counts);
+        match (&self.atlas, &self.atlas_pass) {
+            (Some(a), Some(pass)) => (&pass.eval, pass.eval.group(gpu, f, params, wgpu::BindingResource::TextureView(&a.view), counts)),
+            _ => (&self.eval, self.eval.group(gpu, f, params, self.res.shadow.as_entire_binding(), counts)),
+        }
+    }
+}
+
+impl Technique for Iasm {
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.place(gpu, f, rec);
+        self.current = self.placement;
+        let delayed = self.setup.delayed;
+        if delayed && self.pending {
+            // the previous frame's analysis belongs to the previous frame's square: keep both
+            // together, so every tile's planes and resolution describe that tile's region
+            self.placement = self.analysed;
+        } else {
+            self.analyse(gpu, f, rec);
+        }
+        let stats = match self.res.delayed_read.take::<u32>(gpu, STATS_WORDS).filter(|_| delayed && self.pending) {
+            Some(words) => TileStats::parse(&words),
+            // this frame's analysis (or, delayed, one whose frame has not finished): a sync
+            None => analysis::read_stats(rec, &self.res.stats_buf),
+        };
+        self.make_plan(stats);
+        tiles::write_tiles(rec, &self.res.tile_buf, &self.placement, &self.plan);
+        rec.write_buffer(&self.res.params_buf, 0, bytemuck::bytes_of(&self.params()));
+        self.evaluated = Some(self.params());
+        Ok(())
+    }
+
+    /// The tiles into the atlas (atlas.rs) or the linear buffer (tiles.rs).
+    fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        match (&self.atlas, &self.atlas_pass) {
+            (Some(a), Some(pass)) => pass.render(rec, f, a, &self.plan, &self.tiles.groups),
+            _ => self.tiles.render(rec, f, &self.plan, &self.res.shadow, &self.res.dummy),
+        }
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        let (pass, group) = self.eval_group(gpu, f);
+        pass.evaluate(gpu, f, rec, &group);
+        if self.setup.delayed {
+            // this frame's analysis, over this frame's square, feeds the next frame (thesis 4.3:
+            // copied after the shadows)
+            self.placement = self.current;
+            self.analyse(gpu, f, rec);
+            self.res.delayed_read.record(rec, &self.res.stats_buf);
+            self.analysed = self.current;
+            self.pending = true;
+            if let Some(v) = self.fit.as_mut() {
+                v.record_for_next(gpu, f, rec);
+            }
+        }
+        Ok(())
+    }
+
+    /// The evaluation again with the view samples counted per texel. In delayed mode the tile
+    /// planes the frame was evaluated with are the previous analysis's: they are still set
+    /// (the next frame's are written in its `prepare`).
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        if let Some(p) = self.evaluated {
+            rec.write_buffer(&self.res.params_buf, 0, bytemuck::bytes_of(&p));
+        }
+        let (pass, group) = self.eval_group(gpu, f);
+        pass.count(gpu, f, rec, &group, &self.res.counts);
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        let atlas = self.atlas.as_ref();
+        images::report(gpu, &self.plan, &self.placement, atlas, self.fit.as_ref(), &self.res.shadow, &self.res.counts)
     }
 }

@@ -3,9 +3,11 @@
 //! chunk over the tile), culled draws, ranking, resolutions and offsets. The decisions
 //! themselves are `shadowlab_core::techniques::iasm`'s; this glues them to the GPU readback.
 
-use shadowlab_core::techniques::iasm::{self as core, THESIS_RESOLUTIONS, TILE_COUNT};
+use glam::Vec3;
+use shadowlab_core::techniques::iasm::{self as core, Placement, THESIS_RESOLUTIONS, TILE_COUNT};
 
-use super::gpu::Iasm;
+/// Words of the analysis's statistics (analysis.wgsl): 8 per tile, then the samples outside.
+pub(super) const STATS_WORDS: usize = TILE_COUNT * 8 + 1;
 
 /// What the analysis found per tile.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -18,6 +20,7 @@ pub struct TileStats {
     pub outside: u32,
 }
 
+/// The f32 of an ordered key (the atomics' encoding of analysis.wgsl and bounds.wgsl).
 pub(crate) fn unkey(k: u32) -> f32 {
     f32::from_bits(if k & 0x8000_0000 != 0 { k & 0x7fff_ffff } else { !k })
 }
@@ -51,36 +54,34 @@ pub struct Plan {
     pub draws: Vec<Vec<(u32, u32)>>,
 }
 
-impl Iasm {
-    /// Ranks, assigns, lays out, sets planes and culls (thesis 3.4, 3.5) from `stats`.
-    pub fn make_plan(&mut self, stats: TileStats) {
-        let p = self.placement;
-        let mut plan = Plan { stats, ..Default::default() };
-        let mut empty: [bool; TILE_COUNT] = std::array::from_fn(|t| stats.samples[t] == 0);
-        for (t, e) in empty.iter_mut().enumerate() {
-            if *e {
-                plan.draws.push(Vec::new());
-                continue;
-            }
-            let (mut near, far) = (stats.depth_min[t], stats.depth_max[t]);
-            // chunks over the tile that can cast onto its receivers (not wholly beyond them)
-            let culled: Vec<usize> = core::cull(&p, t, &self.boxes).into_iter().filter(|&c| self.boxes[c].0.z <= far).collect();
-            for &c in &culled {
-                near = near.min(self.boxes[c].0.z);
-            }
-            let tris = self.triangles;
-            let draws = core::runs(&culled).into_iter().map(|(a, b)| (a as u32 * self.chunk * 3, (b as u32 * self.chunk).min(tris) * 3));
-            *e = culled.is_empty();
-            let margin = 1e-3 * (far - near).abs().max(1e-3 * p.size);
-            plan.near[t] = near - margin;
-            plan.far[t] = far + margin;
-            plan.draws.push(if *e { Vec::new() } else { draws.collect() });
+/// Ranks, assigns, lays out, sets planes and culls (thesis 3.4, 3.5) from `stats` over the
+/// square `p`, with the light-space `boxes` of the chunks (`chunk` triangles each, `triangles`
+/// in all).
+pub(super) fn make_plan(stats: TileStats, p: &Placement, boxes: &[(Vec3, Vec3)], chunk: u32, triangles: u32) -> Plan {
+    let mut plan = Plan { stats, ..Default::default() };
+    let mut empty: [bool; TILE_COUNT] = std::array::from_fn(|t| stats.samples[t] == 0);
+    for (t, e) in empty.iter_mut().enumerate() {
+        if *e {
+            plan.draws.push(Vec::new());
+            continue;
         }
-        let imp: [f64; TILE_COUNT] = std::array::from_fn(|t| if empty[t] { 0.0 } else { stats.importance[t] });
-        plan.order = core::rank(&imp, &empty);
-        plan.res = core::assign(&plan.order, &THESIS_RESOLUTIONS);
-        plan.off = core::offsets(&plan.res);
-        plan.empty = empty;
-        self.plan = plan;
+        let (mut near, far) = (stats.depth_min[t], stats.depth_max[t]);
+        // chunks over the tile that can cast onto its receivers (not wholly beyond them)
+        let culled: Vec<usize> = core::cull(p, t, boxes).into_iter().filter(|&c| boxes[c].0.z <= far).collect();
+        for &c in &culled {
+            near = near.min(boxes[c].0.z);
+        }
+        let draws = core::runs(&culled).into_iter().map(|(a, b)| (a as u32 * chunk * 3, (b as u32 * chunk).min(triangles) * 3));
+        *e = culled.is_empty();
+        let margin = 1e-3 * (far - near).abs().max(1e-3 * p.size);
+        plan.near[t] = near - margin;
+        plan.far[t] = far + margin;
+        plan.draws.push(if *e { Vec::new() } else { draws.collect() });
     }
+    let imp: [f64; TILE_COUNT] = std::array::from_fn(|t| if empty[t] { 0.0 } else { stats.importance[t] });
+    plan.order = core::rank(&imp, &empty);
+    plan.res = core::assign(&plan.order, &THESIS_RESOLUTIONS);
+    plan.off = core::offsets(&plan.res);
+    plan.empty = empty;
+    plan
 }

@@ -8,7 +8,7 @@ use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::csm::{self as cascades, CascadeBox, Fit, ViewFrustum};
 use shadowlab_core::techniques::lt as leak;
 
-use super::{LevelU, LtParams};
+use super::uniforms::{LevelU, LtParams};
 use crate::technique::FrameInputs;
 use crate::GpuError;
 

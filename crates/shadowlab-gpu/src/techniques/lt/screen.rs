@@ -41,4 +41,19 @@ impl Screen {
             frames: 0,
         }
     }
+
+    /// The pixels listed for rays in the last frame (in list order).
+    pub fn ray_list(&self, gpu: &Gpu) -> Vec<u32> {
+        let words: Vec<u32> = gpu.read_buffer_as(&self.list, (self.width * self.height + 1) as usize);
+        words[1..1 + words[0] as usize].to_vec()
+    }
+
+    /// The temporal mask written in the last frame (`mask_bits` per pixel in the words): 3 bits
+    /// per pixel (`shadowlab_core::techniques::lt`).
+    pub fn mask(&self, gpu: &Gpu, mask_bits: u32) -> Vec<u32> {
+        let n = (self.width * self.height) as usize;
+        let per = (32 / mask_bits) as usize;
+        let words: Vec<u32> = gpu.read_buffer_as(&self.masks[((self.frames + 1) % 2) as usize], n.div_ceil(per));
+        (0..n).map(|i| (words[i / per] >> ((i % per) as u32 * mask_bits)) & 7).collect()
+    }
 }

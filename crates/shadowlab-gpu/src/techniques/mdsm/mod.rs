@@ -19,7 +19,7 @@ use shadowlab_core::techniques::mdsm::{max_distinct, pcf_width, search_width, Se
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::compose;
-use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::technique::{compose_view, counted_evaluation, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::techniques::pictures::{count_image, depth_image};
 use crate::techniques::sm::{self, DepthPass, SmParams};
 use crate::{binding, Gpu, GpuError};
@@ -237,13 +237,7 @@ impl Technique for MultiDepthMap {
         Ok(())
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.eval_pass(gpu, f, rec, false)
-    }
-
-    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.eval_pass(gpu, f, rec, true)
-    }
+    counted_evaluation!();
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
         let texels = (self.res * self.res) as usize;

@@ -20,10 +20,15 @@ pub(super) struct ChunkBounds {
     pipeline: wgpu::ComputePipeline,
 }
 
+/// Chunks of `chunk` triangles over `first..end` (at least one).
+pub(super) fn chunk_count(first: u32, end: u32, chunk: u32) -> u32 {
+    (end - first).div_ceil(chunk).max(1)
+}
+
 impl ChunkBounds {
     /// Chunks of `chunk` triangles over `first..end` of `scene` (at least one chunk).
     pub fn new(gpu: &Gpu, scene: &GpuScene, label: &str, first: u32, end: u32, chunk: u32) -> ChunkBounds {
-        let count = (end - first).div_ceil(chunk).max(1);
+        let count = chunk_count(first, end, chunk);
         let d = &gpu.device;
         let words: Vec<u32> = (0..count).flat_map(|_| [u32::MAX, u32::MAX, u32::MAX, 0, 0, 0]).collect();
         let init = gpu.buffer_init(label, bytemuck::cast_slice(&words), wgpu::BufferUsages::COPY_SRC);

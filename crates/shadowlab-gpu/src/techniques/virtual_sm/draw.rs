@@ -1,12 +1,23 @@
-//! Page drawing helpers of `virtual`: the culling chunks (triangle ranges with their
-//! light-coordinate rectangles), the chunks a page draws, the slot-clear pipeline and the
-//! static/dynamic split's copy pipeline.
+//! `virtual`'s culling chunks: triangle ranges with their light-coordinate rectangles, the
+//! static ones bounded once at creation, the moving ones every frame (bounds.rs), and the
+//! chunks a page draws.
 
 use glam::Vec2;
 use shadowlab_core::scene::Bounds;
 use shadowlab_core::techniques::virtual_sm::{Clipmap, PageKey};
 
-use crate::{binding, raster, Gpu};
+use super::bounds::ChunkBounds;
+use crate::scene_gpu::GpuScene;
+use crate::{Gpu, GpuError};
+
+/// Triangles per culling chunk (iasm's chunks): a page draws the chunks whose light-space
+/// rectangle overlaps it. Smaller: tighter culling, more draws per page.
+pub const CHUNK_TRIANGLES: u32 = 1024;
+
+/// Triangles per chunk of moving geometry: its swept boxes invalidate the pages under them
+/// every frame, so they are kept small (a long swaying cable in 1024-triangle chunks is one
+/// box over its whole length). Smaller: tighter invalidation, more boxes read back per frame.
+pub const DYNAMIC_CHUNK_TRIANGLES: u32 = 64;
 
 /// A chunk: triangle range and its rectangle in level-0 light coordinates per face
 /// (`Clipmap::light_rect`; unbounded where it spans the whole map; one face unless a cube).
@@ -48,61 +59,76 @@ pub(super) fn page_draws(chunks: &[Chunk], c: &Clipmap, k: &PageKey) -> Vec<(u32
     out
 }
 
-/// The slot clear: `vs_clear` at depth 1, depth test Always, no fragment stage.
-pub(super) fn clear_pipeline(gpu: &Gpu, source: &str, layouts: &[&wgpu::BindGroupLayout]) -> wgpu::RenderPipeline {
-    let module = gpu.shader("virtual.clear", source);
-    let layout = gpu.pipeline_layout("virtual.clear", layouts);
-    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("virtual.clear"),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_clear"), compilation_options: Default::default(), buffers: &[] },
-        primitive: Default::default(),
-        depth_stencil: Some(depth_always()),
-        multisample: Default::default(),
-        fragment: None,
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
 /// Whether a moving chunk (`chunks[moving0..]`) lies over page `k` now.
 pub(super) fn moving_over(chunks: &[Chunk], moving0: usize, c: &Clipmap, k: &PageKey) -> bool {
     !page_draws(&chunks[moving0..], c, k).is_empty()
 }
 
-/// The static/dynamic split's copy (copy.wgsl): its bind group layout (the static pool, the
-/// per-page offsets) and pipeline (depth test Always, `frag_depth` from the static copy).
-pub(super) fn copy_pipeline(gpu: &Gpu) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
-    let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
-    let layout = binding::layout(&gpu.device, "virtual.copy", stages, &[binding::texture_depth(), binding::storage(true)]);
-    let module = gpu.shader("virtual.copy", super::COPY_WGSL);
-    let pl = gpu.pipeline_layout("virtual.copy", &[&layout]);
-    let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("virtual.copy"),
-        layout: Some(&pl),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_copy"), compilation_options: Default::default(), buffers: &[] },
-        primitive: Default::default(),
-        depth_stencil: Some(depth_always()),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_copy"),
-            compilation_options: Default::default(),
-            targets: &[],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
-    (layout, pipeline)
+/// The culling chunks: static ones (`0..dynamic_first`) first, then the moving ones.
+pub(super) struct Chunks {
+    pub list: Vec<Chunk>,
+    /// Index of the first moving chunk in `list`.
+    pub moving0: usize,
+    /// The moving chunks' bounds, recomputed every frame (None: nothing moves).
+    pub dynamic: Option<ChunkBounds>,
+    /// The moving chunks' boxes of the last frame (None before the first).
+    boxes: Option<Vec<Bounds>>,
 }
 
-/// Depth written unconditionally (the slot clear and the static copy).
-fn depth_always() -> wgpu::DepthStencilState {
-    wgpu::DepthStencilState {
-        format: raster::DEPTH_FORMAT,
-        depth_write_enabled: Some(true),
-        depth_compare: Some(wgpu::CompareFunction::Always),
-        stencil: Default::default(),
-        bias: Default::default(),
+impl Chunks {
+    /// Static chunks bounded once here, on the GPU; moving ones get the scene's bounds until
+    /// the first frame bounds them. `proto`: the light's clipmap at creation.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, split: u32, proto: &Clipmap) -> Result<Chunks, GpuError> {
+        let mut list = Vec::new();
+        if split > 0 {
+            let b = ChunkBounds::new(gpu, scene, "virtual.static_bounds", 0, split, CHUNK_TRIANGLES);
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            b.record(&mut enc, scene);
+            gpu.submit(enc.finish());
+            gpu.take_error()?;
+            let boxes = ChunkBounds::parse(&gpu.read_buffer_as::<u32>(&b.boxes, b.count as usize * 6));
+            for (i, w) in boxes.iter().enumerate() {
+                let first = i as u32 * CHUNK_TRIANGLES;
+                list.push(Chunk::new(first, (first + CHUNK_TRIANGLES).min(split), w, proto));
+            }
+        }
+        let moving0 = list.len();
+        let dynamic = (split < scene.triangle_count)
+            .then(|| ChunkBounds::new(gpu, scene, "virtual.dynamic_bounds", split, scene.triangle_count, DYNAMIC_CHUNK_TRIANGLES));
+        if let Some(b) = &dynamic {
+            for i in 0..b.count {
+                let first = split + i * DYNAMIC_CHUNK_TRIANGLES;
+                list.push(Chunk::new(first, (first + DYNAMIC_CHUNK_TRIANGLES).min(scene.triangle_count), &scene.bounds, proto));
+            }
+        }
+        Ok(Chunks { list, moving0, dynamic, boxes: None })
+    }
+
+    /// Takes this frame's boxes of the moving chunks (`words`, read back with the requests) and
+    /// their rectangles in clipmap `c`; returns the box swept by each chunk that moved since the
+    /// last frame (old and new box), over which resident pages are stale. Nothing without moving
+    /// chunks.
+    pub fn update(&mut self, words: &[u32], c: &Clipmap) -> Vec<Bounds> {
+        if self.dynamic.is_none() {
+            return Vec::new();
+        }
+        let now = ChunkBounds::parse(words);
+        let mut swept = Vec::new();
+        if let Some(before) = &self.boxes {
+            for (a, b) in before.iter().zip(&now) {
+                if a != b {
+                    let mut s = *a;
+                    s.grow(b.min);
+                    s.grow(b.max);
+                    swept.push(s);
+                }
+            }
+        }
+        for (i, b) in now.iter().enumerate() {
+            let ch = &mut self.list[self.moving0 + i];
+            *ch = Chunk::new(ch.first, ch.end, b, c);
+        }
+        self.boxes = Some(now);
+        swept
     }
 }

@@ -21,51 +21,54 @@
 //! over also keeps a copy of its static geometry alone in a second, smaller atlas (the static
 //! pool, `static_share` of the pool). When the moving geometry sweeps over the page again it
 //! is rebuilt from that copy (copy.wgsl) plus the moving chunks, not from all its geometry.
+//!
+//! Files: `params.rs` the parameter table; `uniforms.rs` the struct shared with WGSL;
+//! construction in stages, `setup.rs` (the settings checked, the pool's shape) then
+//! `resources.rs` (textures and buffers) then each pass's pipelines, then the culling chunks
+//! (`draw.rs`, bounded on the GPU by `bounds.rs`); per frame `mark.rs` (marking and the
+//! readback), `allocate.rs` (the pages on the CPU), `render.rs` (the page passes), `eval.rs`;
+//! `report.rs` the report.
 
+mod allocate;
 mod bounds;
 mod draw;
-mod gpu;
+mod eval;
+mod mark;
 mod params;
 mod render;
 mod report;
+mod resources;
+mod setup;
+mod uniforms;
 
-use bytemuck::{Pod, Zeroable};
-pub use gpu::{VirtualShadows, CHUNK_TRIANGLES, DYNAMIC_CHUNK_TRIANGLES};
-pub use params::*;
+use shadowlab_core::light::Light;
 use shadowlab_core::params::{ParamSet, ParamTable};
+use shadowlab_core::scene::Bounds;
+use shadowlab_core::techniques::virtual_sm::{pixel_angle, Allocation, Build, Clipmap, PageCache, PageKey, StaticCopies};
 
-use crate::shaders::compose_depth;
-use crate::technique::{compose_view, TechniqueInfo};
-use crate::techniques::cube::FACES_WGSL;
+use allocate::Pages;
+use draw::Chunks;
+pub use draw::{CHUNK_TRIANGLES, DYNAMIC_CHUNK_TRIANGLES};
+use eval::EvalPass;
+use mark::MarkPass;
+pub use params::*;
+use render::PagePass;
+use resources::Resources;
+use setup::Setup;
+pub use uniforms::{VirtualParams, MAX_LEVELS};
 
-const PAGES_WGSL: &str = include_str!("pages.wgsl");
-const MARK_WGSL: &str = include_str!("mark.wgsl");
-const EVAL_WGSL: &str = include_str!("eval.wgsl");
-const PAGE_WGSL: &str = include_str!("page.wgsl");
-const COPY_WGSL: &str = include_str!("copy.wgsl");
-
-/// Levels the uniform holds (WGSL `origins`).
-pub const MAX_LEVELS: usize = 24;
+use crate::record::Recorder;
+use crate::scene_gpu::GpuScene;
+use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
+use crate::{Gpu, GpuError};
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
-        ("virtual_sm/mark.wgsl", mark_source()),
-        ("virtual_sm/eval.wgsl", eval_source()),
-        ("virtual_sm/page.wgsl", page_source()),
-        ("virtual_sm/copy.wgsl", COPY_WGSL.to_string()),
+        ("virtual_sm/mark.wgsl", mark::source()),
+        ("virtual_sm/eval.wgsl", eval::source()),
+        ("virtual_sm/page.wgsl", render::page_source()),
+        ("virtual_sm/copy.wgsl", render::COPY_WGSL.to_string()),
     ]
-}
-
-fn mark_source() -> String {
-    compose_view(&format!("{FACES_WGSL}{PAGES_WGSL}{MARK_WGSL}"), false)
-}
-
-fn eval_source() -> String {
-    compose_view(&format!("{FACES_WGSL}{PAGES_WGSL}{}{EVAL_WGSL}", crate::techniques::sm::BIAS_WGSL), false)
-}
-
-fn page_source() -> String {
-    compose_depth(PAGE_WGSL)
 }
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -83,28 +86,121 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create: |gpu, scene, p, light| Ok(Box::new(VirtualShadows::new(gpu, scene, &VirtualSettings::from_values(p), light)?)),
 };
 
-/// WGSL `VirtualParams` (pages.wgsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct VirtualParams {
-    /// xyz: light x axis; w: world size of a level-0 texel (spot: per unit of light depth).
-    pub right: [f32; 4],
-    /// xyz: light y axis; w: level-0 texels per world unit.
-    pub up: [f32; 4],
-    /// xyz: light direction; w: light depth of depth 0.
-    pub dir: [f32; 4],
-    /// x: light depth of depth 1, y: pixel angle, z: 2^resolution_bias, w: marking reach (texels).
-    pub view: [f32; 4],
-    /// levels, pages per side, page side, atlas columns.
-    pub dims: [u32; 4],
-    /// bias, slope_bias, normal_offset, max_slope.
-    pub bias: [f32; 4],
-    /// x: PCF width, y: projection (0 orthographic, 1 spot, 2 cube), z: mips per face, w: faces.
-    pub pcf: [u32; 4],
-    /// Spot, cube: xyz position, w tan(half-angle) (1 for a cube face).
-    pub spot: [f32; 4],
-    /// Cube: each face's right, up and travel direction (`Clipmap::axes`), 3 per face.
-    pub face_axes: [[f32; 4]; 18],
-    /// xy: window origins per level (pages).
-    pub origins: [[i32; 4]; MAX_LEVELS],
+pub struct VirtualShadows {
+    /// What creation planned (setup.rs): the light, the page geometry, the pool's shape.
+    setup: Setup,
+    /// The uniform: its fixed part from creation, this frame's placement from `prepare`.
+    params: VirtualParams,
+    /// The pages on the CPU: the last frame's clipmap, the pool, the allocation, the counters.
+    pages: Pages,
+    /// The culling chunks, the moving ones bounded every frame.
+    chunks: Chunks,
+    res: Resources,
+    mark: MarkPass,
+    render: PagePass,
+    eval: EvalPass,
+}
+
+impl VirtualShadows {
+    /// In stages: the settings checked and the pool planned (setup.rs; settings that break
+    /// [`VirtualSettings`]'s rules are an error), the textures and buffers (resources.rs), the
+    /// passes' pipelines and bind groups, the culling chunks (bounded on the GPU).
+    pub fn new(gpu: &Gpu, scene: &GpuScene, p: &VirtualSettings, light: &Light) -> Result<VirtualShadows, GpuError> {
+        let setup = setup::plan(gpu, scene, p, light)?;
+        let params = VirtualParams::zeroed_for(p, &setup.proto, setup.pages_per_side, setup.page_res, setup.pool.cols);
+        let res = Resources::new(gpu, &setup, &params);
+        let render = PagePass::new(gpu, scene, setup.page_res, &res);
+        let mark = MarkPass::new(gpu);
+        let eval = EvalPass::new(gpu);
+        let chunks = Chunks::new(gpu, scene, setup.split, &setup.proto)?;
+        Ok(VirtualShadows { pages: Pages::new(&setup), setup, params, chunks, res, mark, render, eval })
+    }
+
+    /// The clipmap of the last frame.
+    pub fn clipmap(&self) -> Option<&Clipmap> {
+        self.pages.clipmap.as_ref()
+    }
+
+    /// The last frame's allocation (mapped, rendered, cached, fallen-back pages).
+    pub fn allocation(&self) -> &Allocation {
+        &self.pages.alloc
+    }
+
+    /// How each page of the last frame's `allocation().render` was built (drawn whole, or from
+    /// a static copy).
+    pub fn builds(&self) -> &[Build] {
+        &self.pages.builds
+    }
+
+    /// The static copies of pages under moving geometry.
+    pub fn statics(&self) -> &StaticCopies {
+        &self.pages.statics
+    }
+
+    /// The page pool and its resident pages.
+    pub fn cache(&self) -> &PageCache {
+        &self.pages.cache
+    }
+
+    /// Resident pages the last frame dropped because a moving chunk swept over them.
+    pub fn invalidated(&self) -> usize {
+        self.pages.invalidated
+    }
+
+    /// The pages requested in the last frame (priority order, from the GPU's marks).
+    pub fn requested(&self) -> &[PageKey] {
+        &self.pages.requested
+    }
+
+    /// Forgets the pages over world box `b` at every level (moving geometry); returns how many
+    /// resident pages were dropped.
+    pub fn invalidate_box(&mut self, b: &Bounds) -> usize {
+        self.pages.invalidate_box(self.setup.levels, b)
+    }
+}
+
+impl Technique for VirtualShadows {
+    /// Marking on the GPU and one readback (mark.rs), the allocation and page table on the CPU
+    /// (allocate.rs).
+    fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        let s = &self.setup;
+        let c = Clipmap::for_light(&s.light, &f.scene.bounds, f.camera.position, s.levels_param, s.virtual_res, s.page_res, s.extent0);
+        self.params.place(&c, pixel_angle(f.camera.fov_y_deg, f.gbuffer.height), s.bias_scale, s.reach);
+        rec.write_buffer(&self.res.uniform, 0, bytemuck::bytes_of(&self.params));
+        let probe = self.mark.record(gpu, f, rec, &self.res, &c, self.chunks.dynamic.as_ref());
+        let t0 = std::time::Instant::now();
+        let (flags, boxes) = probe.split_at(c.table_len());
+        // a chunk that moved invalidates the resident pages its old and new boxes cover
+        let swept = self.chunks.update(boxes, &c);
+        self.pages.invalidate_swept(&c, &swept);
+        let w = self.pages.allocate(&self.setup, &c, flags, &self.chunks);
+        rec.write_buffer(&self.res.page_table, 0, bytemuck::cast_slice(&w.table));
+        rec.write_buffer(&self.res.page_mats, 0, bytemuck::cast_slice(&w.mats));
+        if !w.offsets.is_empty() {
+            rec.write_buffer(&self.res.copy_offsets, 0, bytemuck::cast_slice(&w.offsets));
+        }
+        self.pages.finish(c);
+        rec.cpu("virtual.allocate", t0.elapsed().as_secs_f64() * 1e3);
+        Ok(())
+    }
+
+    /// The new pages (render.rs).
+    fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.pages.triangles_drawn = self.render.render(f, rec, &self.pages, &self.chunks, &self.res, &self.setup.pool);
+        Ok(())
+    }
+
+    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval.record(gpu, f, rec, &self.res, false);
+        Ok(())
+    }
+
+    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        self.eval.record(gpu, f, rec, &self.res, true);
+        Ok(())
+    }
+
+    fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
+        report::report(gpu, &self.setup, &self.pages, &self.res.counts)
+    }
 }

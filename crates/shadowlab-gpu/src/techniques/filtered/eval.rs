@@ -1,0 +1,53 @@
+//! The evaluation (`<name>.evaluate`, eval.wgsl): each sample biased, projected and its depth
+//! compared with the map through the representation's upper bound (2x2 bilinear, sd: one
+//! gather; with mips trilinear at the pixel's footprint); the analysis variant counts the view
+//! samples per texel.
+
+use super::{Filtered, MOMENTS_WGSL, PARAMS_WGSL};
+use crate::record::Recorder;
+use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
+use crate::{binding, Gpu, GpuError};
+
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+
+pub(super) fn source() -> String {
+    compose_view(&format!("{MOMENTS_WGSL}{PARAMS_WGSL}{EVAL_WGSL}"), false)
+}
+
+/// The evaluation layout (the view, the uniform, the map, its sampler, the counts), the
+/// evaluation with its analysis variant, and the map's clamped sampler.
+pub(super) fn pipelines(gpu: &Gpu, name: &str) -> (wgpu::BindGroupLayout, EvalPipelines, wgpu::Sampler) {
+    let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering);
+    let layout =
+        view_layout(gpu, &format!("{name}.eval"), &[binding::uniform(), binding::texture_float(), sampler_type, binding::storage(false)]);
+    let eval = EvalPipelines::new(gpu, &format!("{name}.evaluate"), &source(), &layout, &[]);
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("filtered.gather"),
+        address_mode_u: wgpu::AddressMode::ClampToEdge,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        ..Default::default()
+    });
+    (layout, eval, sampler)
+}
+
+impl Filtered {
+    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
+    pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        let name = self.kind.name();
+        let map_view = self.map.create_view(&Default::default());
+        let group = f.view_group(
+            gpu,
+            &format!("{name}.eval"),
+            &self.eval_layout,
+            &[
+                self.uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&map_view),
+                wgpu::BindingResource::Sampler(&self.sampler),
+                self.counts.as_entire_binding(),
+            ],
+        );
+        let label = format!("{name}.evaluate");
+        self.eval.record(gpu, rec, &label, &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
+        Ok(())
+    }
+}

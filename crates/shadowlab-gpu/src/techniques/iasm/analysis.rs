@@ -1,0 +1,59 @@
+//! `iasm`'s importance pass `iasm.importance` (analysis.wgsl): per tile of the square, the view
+//! samples' importance (equation 3.1), count and light-depth range, and the samples outside the
+//! square; read back for the plan (`iasm.readback`, the sync).
+
+use shadowlab_core::techniques::iasm::TILE_COUNT;
+
+use super::plan::{TileStats, STATS_WORDS};
+use super::uniforms::{IasmParams, PARAMS_WGSL};
+use crate::record::Recorder;
+use crate::technique::{compose_view, view_layout, FrameInputs};
+use crate::{binding, Gpu};
+
+const ANALYSIS_WGSL: &str = include_str!("analysis.wgsl");
+
+pub(super) fn source() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{ANALYSIS_WGSL}"), false)
+}
+
+pub(super) struct AnalysisPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl AnalysisPass {
+    pub fn new(gpu: &Gpu) -> AnalysisPass {
+        let layout = view_layout(gpu, "iasm.analysis", &[binding::uniform(), binding::storage(false)]);
+        let pipeline = gpu.compute_pipeline("iasm.analysis", &source(), "main", &[&layout]);
+        AnalysisPass { layout, pipeline }
+    }
+
+    /// Dispatches the analysis of `f` over the square of `params` (written to `params_buf`) into
+    /// `stats_buf`.
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        f: &FrameInputs,
+        rec: &mut Recorder,
+        params: &IasmParams,
+        params_buf: &wgpu::Buffer,
+        stats_buf: &wgpu::Buffer,
+    ) {
+        rec.write_buffer(params_buf, 0, bytemuck::bytes_of(params));
+        let mut init: Vec<u32> = (0..TILE_COUNT).flat_map(|_| [0, 0, 0, u32::MAX, 0, 0, 0, 0]).collect();
+        init.push(0);
+        rec.write_buffer(stats_buf, 0, bytemuck::cast_slice(&init));
+        let group = f.view_group(gpu, "iasm.analysis", &self.layout, &[params_buf.as_entire_binding(), stats_buf.as_entire_binding()]);
+        rec.stage("iasm.importance", |enc| {
+            gpu.dispatch_2d(enc, "iasm.importance", &self.pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
+        });
+    }
+}
+
+/// The statistics in `stats_buf`, read back now (the sync `iasm.readback`).
+pub(super) fn read_stats(rec: &mut Recorder, stats_buf: &wgpu::Buffer) -> TileStats {
+    let t0 = std::time::Instant::now();
+    let words: Vec<u32> = rec.read_buffer_as(stats_buf, STATS_WORDS, "iasm.readback");
+    rec.cpu("iasm.readback", t0.elapsed().as_secs_f64() * 1e3);
+    TileStats::parse(&words)
+}

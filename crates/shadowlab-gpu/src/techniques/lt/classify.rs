@@ -1,0 +1,76 @@
+//! Leak tracing's `<name>.classify` pass (classify.wgsl): every evaluated pixel's test (LTT on
+//! the filterable bound, or hybrid-pcf's unanimous 2x2), the temporal mask read from last
+//! frame's reprojected pixel, and the pixels needing a ray appended to the list (atomic append).
+
+use super::resources::Resources;
+use super::screen::Screen;
+use crate::record::Recorder;
+use crate::technique::{compose_view, view_layout, FrameInputs};
+use crate::techniques::filtered::MOMENTS_WGSL;
+use crate::{binding, Gpu};
+
+const CLASSIFY_WGSL: &str = include_str!("classify.wgsl");
+
+pub(super) fn source() -> String {
+    compose_view(&format!("{MOMENTS_WGSL}{CLASSIFY_WGSL}"), false)
+}
+
+pub(super) struct ClassifyPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl ClassifyPass {
+    pub fn new(gpu: &Gpu, name: &str) -> ClassifyPass {
+        let nf = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering);
+        let (ro, rw, tex) = (binding::storage(true), binding::storage(false), binding::texture_float());
+        let arr = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        };
+        let layout = view_layout(gpu, &format!("{name}.classify"), &[binding::uniform(), arr, arr, nf, tex, ro, rw, ro, rw, rw]);
+        let pipeline = gpu.compute_pipeline(&format!("{name}.classify"), &source(), "main", &[&layout]);
+        ClassifyPass { layout, pipeline }
+    }
+
+    /// The bind group of the frame `s` is at: both maps (the static one again without a dynamic
+    /// map), the motion vectors, last frame's mask and history (read), this frame's (written)
+    /// and the ray list.
+    pub fn group(&self, gpu: &Gpu, f: &FrameInputs, name: &str, r: &Resources, s: &Screen) -> wgpu::BindGroup {
+        let (cur, prev) = ((s.frames % 2) as usize, ((s.frames + 1) % 2) as usize);
+        let array = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
+        let static_view = r.static_map.create_view(&array);
+        let dynamic_view = r.dynamic_map.as_ref().unwrap_or(&r.static_map).create_view(&array);
+        let motion_view = f.gbuffer.motion.create_view(&Default::default());
+        use wgpu::BindingResource as R;
+        f.view_group(
+            gpu,
+            &format!("{name}.classify"),
+            &self.layout,
+            &[
+                r.uniform.as_entire_binding(),
+                R::TextureView(&static_view),
+                R::TextureView(&dynamic_view),
+                R::Sampler(&r.sampler),
+                R::TextureView(&motion_view),
+                s.masks[prev].as_entire_binding(),
+                s.masks[cur].as_entire_binding(),
+                s.history[prev].as_entire_binding(),
+                s.history[cur].as_entire_binding(),
+                s.list.as_entire_binding(),
+            ],
+        )
+    }
+
+    /// Stage `<name>.classify`: this frame's mask and the list's count cleared, then every pixel.
+    pub fn record(&self, gpu: &Gpu, rec: &mut Recorder, name: &str, group: &wgpu::BindGroup, s: &Screen) {
+        let cur = (s.frames % 2) as usize;
+        let label = format!("{name}.classify");
+        rec.stage(&label, |enc| {
+            enc.clear_buffer(&s.masks[cur], 0, None);
+            enc.clear_buffer(&s.list, 0, Some(4));
+            gpu.dispatch_2d(enc, &label, &self.pipeline, &[group], s.width, s.height);
+        });
+    }
+}

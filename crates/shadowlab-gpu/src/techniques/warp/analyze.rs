@@ -1,0 +1,130 @@
+//! The analysis of the view before the shadow map (`prepare`, analyze.wgsl): the desired view
+//! reduced from the view samples, then (`notw`, `rtw`) the count or importance map over the
+//! cropped map and the warps built from it: NoTW's row warps, the count map rebuilt through
+//! them and the column warps; RTW's 1D collapse, blur and offsets.
+
+use super::{Variant, Warped, PARAMS_WGSL, SMOOTH_BLOCK};
+use crate::prefix_sum::ScanParams;
+use crate::record::Recorder;
+use crate::technique::{compose_view, view_layout, FrameInputs};
+use crate::{binding, Gpu};
+
+const ANALYZE_WGSL: &str = include_str!("analyze.wgsl");
+
+pub(super) fn source() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{ANALYZE_WGSL}"), false)
+}
+
+/// The entry points a variant dispatches.
+fn entries(variant: Variant) -> &'static [&'static str] {
+    match variant {
+        Variant::Notw => {
+            &["dv_reduce", "count", "blur_rows", "offsets_rows", "smooth_rows", "rebuild", "blur_cols", "offsets_cols", "smooth_cols"]
+        }
+        Variant::Rtw => &["dv_reduce", "count", "rtw_collapse", "rtw_blur", "rtw_offsets"],
+        Variant::Dv => &["dv_reduce"],
+    }
+}
+
+/// The analysis layout (the view, then the uniform, the DV bounds, the two work buffers, the two
+/// warps written and the occluder pyramid) and a pipeline per entry point of `variant`.
+pub(super) fn pipelines(gpu: &Gpu, name: &str, variant: Variant) -> (wgpu::BindGroupLayout, Vec<(&'static str, wgpu::ComputePipeline)>) {
+    let (ro, rw) = (binding::storage(true), binding::storage(false));
+    let store = wgpu::BindingType::StorageTexture {
+        access: wgpu::StorageTextureAccess::WriteOnly,
+        format: wgpu::TextureFormat::R32Float,
+        view_dimension: wgpu::TextureViewDimension::D2,
+    };
+    let layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store, ro]);
+    let src = source();
+    let constants = [("SMOOTH_BLOCK", SMOOTH_BLOCK as f64)];
+    let pipelines =
+        entries(variant).iter().map(|&e| (e, gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout], &constants))).collect();
+    (layout, pipelines)
+}
+
+impl Warped {
+    fn pipeline(&self, entry: &str) -> &wgpu::ComputePipeline {
+        &self.analyze.iter().find(|(e, _)| *e == entry).expect("entry point created for this variant").1
+    }
+
+    /// This frame's desired view and warps (stages `desired_view`, with `edge_importance` the
+    /// `occluders` of the crop, and `importance_map`).
+    pub(super) fn fit_warps(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        let name = self.name();
+        let (w, h) = (f.gbuffer.width, f.gbuffer.height);
+        let (xv, yv) = self.warp_views();
+        let group = f.view_group(
+            gpu,
+            &format!("{name}.analyze"),
+            &self.analyze_layout,
+            &[
+                self.uniform.as_entire_binding(),
+                self.dv.as_entire_binding(),
+                self.work.as_entire_binding(),
+                self.fwork.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&xv),
+                wgpu::BindingResource::TextureView(&yv),
+                // the occluder pyramid (`edge_importance`), or a stand-in never read
+                self.occluders.as_ref().map_or(&self.counts, |o| &o.hzb).as_entire_binding(),
+            ],
+        );
+        rec.write_buffer(&self.dv, 0, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
+        rec.stage(&format!("{name}.desired_view"), |enc| {
+            gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
+        });
+        if self.variant == Variant::Dv {
+            return;
+        }
+        // `edge_importance`: the occluder map of this frame's DV crop before the count map
+        // (render then reuses it for `cull_hidden`)
+        if let (Some(o), true) = (&self.occluders, self.params.edge_importance > 0) {
+            let depth_group = self.depth_group(gpu, &xv, &yv);
+            rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, &depth_group, f.scene));
+        }
+        rec.stage(&format!("{name}.importance_map"), |enc| {
+            enc.clear_buffer(&self.work, 0, None);
+            gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
+            match self.variant {
+                Variant::Notw => self.notw_warps(gpu, enc, &group, w, h),
+                _ => self.rtw_warps(gpu, enc, &group),
+            }
+        });
+    }
+
+    /// NoTW after the count map: per direction blur, prefix sums, offsets and smoothing, the count
+    /// map rebuilt through the row warps in between (`w x h`: the view).
+    fn notw_warps(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, group: &wgpu::BindGroup, w: u32, h: u32) {
+        let res = self.res;
+        let n = res * res;
+        gpu.dispatch_2d(enc, "notw.blur_rows", self.pipeline("blur_rows"), &[group], res, res);
+        let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::rows(res, res) };
+        self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
+        gpu.dispatch_2d(enc, "notw.offsets_rows", self.pipeline("offsets_rows"), &[group], res, res);
+        gpu.dispatch_2d(enc, "notw.smooth_rows", self.pipeline("smooth_rows"), &[group], res, res.div_ceil(SMOOTH_BLOCK));
+        gpu.dispatch_2d(enc, "notw.rebuild", self.pipeline("rebuild"), &[group], w, h);
+        gpu.dispatch_2d(enc, "notw.blur_cols", self.pipeline("blur_cols"), &[group], res, res);
+        let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::columns(res, res) };
+        self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
+        gpu.dispatch_2d(enc, "notw.offsets_cols", self.pipeline("offsets_cols"), &[group], res, res);
+        gpu.dispatch_2d(enc, "notw.smooth_cols", self.pipeline("smooth_cols"), &[group], res, res.div_ceil(SMOOTH_BLOCK));
+    }
+
+    /// RTW after the importance map: the max-collapse to two 1D functions, their blur, one
+    /// prefix sum over both, the offsets.
+    fn rtw_warps(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, group: &wgpu::BindGroup) {
+        let res = self.res;
+        let n = res * res;
+        let one_d = |enc: &mut wgpu::CommandEncoder, e: &str| {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(e), timestamp_writes: None });
+            pass.set_pipeline(self.pipeline(e));
+            pass.set_bind_group(0, group, &[]);
+            pass.dispatch_workgroups((2 * res).div_ceil(64), 1, 1);
+        };
+        one_d(enc, "rtw_collapse");
+        one_d(enc, "rtw_blur");
+        let scan = ScanParams { in_base: 3 * n, input_f32: 1, ..ScanParams::rows(res, 2) };
+        self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
+        one_d(enc, "rtw_offsets");
+    }
+}

@@ -1,0 +1,344 @@
+//! Making a [`Warped`], in four stages a constructor calls in order: the knobs and the scene
+//! checked into a [`Plan`] (plain data: sizes, capacities, the uniform; errors are returned
+//! here), the [`Resources`] the plan sizes (textures and buffers), the [`Pipelines`] of the
+//! passes (each made by its pass's file), and the map assembled from the three.
+
+use shadowlab_core::light::Light;
+use shadowlab_core::lightspace;
+use shadowlab_core::techniques::dpsm::Hemisphere;
+
+use super::{analyze, depth, eval, occluders, subdiv};
+use super::{Knobs, Projection, SubdivScratch, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
+use crate::prefix_sum::PrefixSum;
+use crate::scene_gpu::GpuScene;
+use crate::technique::EvalPipelines;
+use crate::{raster, Gpu, GpuError};
+
+impl Warped {
+    /// A planar warped map of a directional or spot light, with the knobs of `rtw`, `notw` or
+    /// `notw-dv` ([`Knobs::rtw`], [`Knobs::notw`], [`Knobs::dv`]).
+    pub fn new(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light) -> Result<Warped, GpuError> {
+        Warped::new_sharing(gpu, scene, k, light, None)
+    }
+
+    /// `new`, borrowing `shared`'s subdivision buffers when they are large enough.
+    pub fn new_sharing(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light, shared: Option<&SubdivScratch>) -> Result<Warped, GpuError> {
+        let name = k.variant.name();
+        let res = k.res;
+        gpu.check_size(res, res, "shadow map")?;
+        let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
+            GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
+        })?;
+        let mut w = Warped::with_projection(gpu, scene, k, Projection::Planar(lp), name)?;
+        if let Some(s) = shared {
+            w.borrow_subdiv(s);
+        }
+        Ok(w)
+    }
+
+    /// A warped map over `proj`, labelled `name` (wgpu labels, stage names `{name}.<stage>`),
+    /// with knobs made for that kind of projection (a paraboloid's: [`Knobs::dpsm`],
+    /// [`Knobs::dpsm_notw`]). The knobs also say whether the map is cropped to the desired view:
+    /// `dpsm`'s is not (the plain, unwarped paraboloid map, rendered with subdivision). The
+    /// caller has checked `res`.
+    pub fn with_projection(gpu: &Gpu, scene: &GpuScene, k: &Knobs, proj: Projection, name: &'static str) -> Result<Warped, GpuError> {
+        let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size)?;
+        let resources = Resources::new(gpu, &plan);
+        let pipelines = Pipelines::new(gpu, scene, &plan);
+        Ok(Warped::assemble(plan, resources, pipelines))
+    }
+
+    fn assemble(plan: Plan, r: Resources, p: Pipelines) -> Warped {
+        Warped {
+            variant: plan.variant,
+            label: plan.name,
+            res: plan.res,
+            pcf: plan.pcf,
+            params: plan.params,
+            uniform: r.uniform,
+            dv: r.dv,
+            work: r.work,
+            fwork: r.fwork,
+            warp_x: r.warp_x,
+            warp_y: r.warp_y,
+            map: r.map,
+            counts: r.counts,
+            pieces: r.pieces,
+            counters: r.counters,
+            queues: r.queues,
+            owns_subdiv: true,
+            dispatch: r.dispatch,
+            level_uniforms: r.level_uniforms,
+            prefix: p.prefix,
+            analyze_layout: p.analyze_layout,
+            analyze: p.analyze,
+            lookup_layout: p.lookup_layout,
+            depth_pipeline: p.depth_pipeline,
+            occluders: p.occluders,
+            split_layout: p.split_layout,
+            split: p.split,
+            eval_layout: p.eval_layout,
+            eval: p.eval,
+            sampler: p.sampler,
+        }
+    }
+}
+
+/// What one warped map needs, checked: no GPU object yet.
+struct Plan {
+    variant: Variant,
+    name: &'static str,
+    res: u32,
+    pcf: u32,
+    /// The uniform, as every pass reads it.
+    params: WarpParams,
+    /// Subdivision on; pieces it may add beyond the triangles; entries of each level queue.
+    subdiv: bool,
+    extra: u32,
+    queue: u32,
+    /// The depth pass writes the exact depth (depth_exact.wgsl).
+    exact_depth: bool,
+    /// The occluder map and its pyramid (`cull_hidden`, `edge_importance`).
+    occluders: bool,
+}
+
+impl Plan {
+    /// `k` for `proj` over `tris` triangles, on a device whose storage bindings hold at most
+    /// `max_binding` bytes. Errors: subdivision queues beyond that limit.
+    fn new(k: &Knobs, proj: Projection, name: &'static str, tris: u32, max_binding: u64) -> Result<Plan, GpuError> {
+        let base = BaseProjection::of(proj, k.res);
+        assert_eq!(k.paraboloid, base.kind != 0, "{name}: knobs made for another projection");
+        let (subdiv, extra, queue) = subdivision_capacity(k, name, tris, max_binding)?;
+        let params = uniform(k, &base, tris, extra);
+        let occluders = k.cull_hidden || k.edge_importance > 0;
+        Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, exact_depth: k.exact_depth, occluders })
+    }
+
+    /// Texels of the two warp textures: NoTW one function per row and per column, RTW one 1D
+    /// function each way, the DV crop none (a stand-in texel).
+    fn warp_sizes(&self) -> [(u32, u32); 2] {
+        let res = self.res;
+        match self.variant {
+            Variant::Notw => [(res, res), (res, res)],
+            Variant::Rtw => [(res, 1), (1, res)],
+            Variant::Dv => [(1, 1), (1, 1)],
+        }
+    }
+}
+
+/// The world -> base map projection as the uniform holds it.
+struct BaseProjection {
+    view_proj: glam::Mat4,
+    /// World size of a texel of the uncropped map (perspective: per unit of depth).
+    texel: f32,
+    perspective: bool,
+    /// `WarpParams::projection`: 0 planar, 1 + [`Hemisphere`] index.
+    kind: u32,
+}
+
+impl BaseProjection {
+    fn of(proj: Projection, res: u32) -> BaseProjection {
+        let (view_proj, texel, perspective, kind) = match proj {
+            Projection::Planar(lp) => (lp.view_proj, lp.texel, lp.perspective, 0),
+            // 2/res of the map plane per texel: 2 (1 + n.z) / res radians (core techniques::dpsm)
+            Projection::Paraboloid { view, hemisphere } => (view, 2.0 / res as f32, false, 1 + (hemisphere == Hemisphere::Back) as u32),
+        };
+        BaseProjection { view_proj, texel, perspective, kind }
+    }
+}
+
+/// (on, extra pieces, queue entries) of the subdivision of `tris` triangles within the device's
+/// storage binding limit; an error when the queues cannot hold the triangles.
+fn subdivision_capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64) -> Result<(bool, u32, u32), GpuError> {
+    let limit = max_binding / 16;
+    let on = k.subdiv > 0.0;
+    let auto = (8 * tris as u64).max(1 << 21);
+    let wanted = if k.subdiv_capacity > 0 { k.subdiv_capacity as u64 } else { auto };
+    // at least one per triangle: the root finishes up to one extra piece per triangle (the
+    // second half of a triangle cut by the near plane) before any level can check
+    let extra = if on { wanted.max(tris as u64).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
+    // the root queues up to two pieces per triangle (a triangle cut by the near plane); the
+    // triangle index keeps 3 bits free for the split mask
+    let queue = if on { (2 * tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
+    if on && (2 * tris as u64 > queue as u64 || tris >= 1 << 29) {
+        return Err(GpuError::Invalid(format!(
+            "{name}: {tris} triangles need subdivision queues of {} entries, over this device's storage binding limit",
+            2 * tris as u64
+        )));
+    }
+    Ok((on, extra, queue))
+}
+
+/// The uniform of the knobs over `base`, with the subdivision's triangles and extra pieces.
+fn uniform(k: &Knobs, base: &BaseProjection, tris: u32, extra: u32) -> WarpParams {
+    WarpParams {
+        light_view_proj: base.view_proj.to_cols_array_2d(),
+        texel_world: base.texel,
+        perspective: base.perspective as u32 as f32,
+        res: k.res as f32,
+        pcf: k.pcf as f32,
+        bias: k.bias[0],
+        slope_bias: k.bias[1],
+        normal_offset: k.bias[2],
+        max_slope: k.bias[3],
+        dv_margin: k.dv_margin,
+        dv_mode: match (k.crop, k.close_cracks) {
+            (false, _) => 0.0,
+            (true, false) => DV_CROP,
+            (true, true) => DV_CROP_CLOSED,
+        },
+        warped: (k.variant != Variant::Dv) as u32 as f32,
+        window: k.window as f32,
+        w_dv: k.w_dv,
+        w_eye: k.w_eye,
+        blur: k.blur as f32,
+        subdiv: k.subdiv,
+        triangles: tris,
+        subdiv_levels: k.subdiv_levels,
+        extra_capacity: extra,
+        rtw_importance: (k.variant == Variant::Rtw) as u32,
+        interp: k.interp as u32,
+        mix: k.mix,
+        exact_depth: k.exact_depth as u32,
+        projection: base.kind,
+        strength: k.strength,
+        bias_mode: k.bias_mode as f32,
+        footprint_cap: k.footprint_cap,
+        depth_clamp: k.depth_clamp as f32,
+        min_piece: k.min_piece,
+        exact_inverse: if k.exact_inverse { 1.0 } else { 0.0 },
+        cull_hidden: if k.cull_hidden { 1.0 } else { 0.0 },
+        tent: if k.tent { 1.0 } else { 0.0 },
+        edge_importance: k.edge_importance,
+        pad0: 0,
+        pad1: 0,
+        pad2: 0,
+    }
+}
+
+/// The textures and buffers of a plan.
+struct Resources {
+    warp_x: wgpu::Texture,
+    warp_y: wgpu::Texture,
+    map: wgpu::Texture,
+    work: wgpu::Buffer,
+    fwork: wgpu::Buffer,
+    pieces: wgpu::Buffer,
+    queues: [wgpu::Buffer; 2],
+    counters: wgpu::Buffer,
+    level_uniforms: Vec<wgpu::Buffer>,
+    uniform: wgpu::Buffer,
+    dv: wgpu::Buffer,
+    counts: wgpu::Buffer,
+    dispatch: wgpu::Buffer,
+}
+
+impl Resources {
+    fn new(gpu: &Gpu, plan: &Plan) -> Resources {
+        let (name, res, queue) = (plan.name, plan.res, plan.queue);
+        let n = res as u64 * res as u64;
+        let [wx, wy] = plan.warp_sizes();
+        // the DV crop alone has no count map, warps or smoothing to keep
+        let scratch = plan.variant != Variant::Dv;
+        let tris = plan.params.triangles as u64;
+        let levels = plan.params.subdiv_levels;
+        Resources {
+            warp_x: r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1),
+            warp_y: r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1),
+            map: depth_map(gpu, &format!("{name}.map"), res),
+            work: gpu.storage(&format!("{name}.work"), if scratch { (3 * n + 2 * res as u64) * 4 } else { 4 }),
+            fwork: gpu.storage(&format!("{name}.fwork"), if scratch { (3 * n + 3 * res as u64) * 4 } else { 4 }),
+            pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
+            queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16)),
+            counters: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{name}.counters")),
+                size: 1048 * 4,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            level_uniforms: (1..=levels)
+                .map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue]))
+                .collect(),
+            uniform: gpu.uniform(&format!("{name}.params"), &plan.params),
+            dv: gpu.storage(&format!("{name}.dv"), 32),
+            counts: gpu.storage(&format!("{name}.counts"), n * 4),
+            dispatch: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{name}.dispatch")),
+                size: 12,
+                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        }
+    }
+}
+
+fn r32_texture(gpu: &Gpu, label: &str, w: u32, h: u32) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// The warped shadow map: `res x res` depth, rendered, sampled and read back.
+fn depth_map(gpu: &Gpu, label: &str, res: u32) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: raster::DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// Every pass's layouts and pipelines, in the order the passes run.
+struct Pipelines {
+    analyze_layout: wgpu::BindGroupLayout,
+    analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
+    lookup_layout: wgpu::BindGroupLayout,
+    depth_pipeline: wgpu::RenderPipeline,
+    occluders: Option<occluders::Occluders>,
+    split_layout: wgpu::BindGroupLayout,
+    split: [wgpu::ComputePipeline; 4],
+    eval_layout: wgpu::BindGroupLayout,
+    eval: EvalPipelines,
+    sampler: wgpu::Sampler,
+    prefix: PrefixSum,
+}
+
+impl Pipelines {
+    fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan) -> Pipelines {
+        let name = plan.name;
+        let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant);
+        let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, plan.exact_depth);
+        let occluders = plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &lookup_layout, scene));
+        let (split_layout, split) = subdiv::pipelines(gpu, name, scene);
+        let (eval_layout, eval) = eval::pipelines(gpu, name);
+        let sampler = eval::sampler(gpu);
+        let prefix = PrefixSum::new(gpu);
+        Pipelines {
+            analyze_layout,
+            analyze,
+            lookup_layout,
+            depth_pipeline,
+            occluders,
+            split_layout,
+            split,
+            eval_layout,
+            eval,
+            sampler,
+            prefix,
+        }
+    }
+}

@@ -1,0 +1,93 @@
+//! The warped depth pass (`render`'s `shadow_map` stage, depth.wgsl): the scene, or the
+//! subdivision's pieces, drawn with the warp applied per vertex; the fragment stage writes the
+//! interpolated depth (depth_plain.wgsl) or, with `exact_depth`, the triangle's depth at the
+//! warp's preimage of the fragment (depth_exact.wgsl). Its lookup bindings (the uniform, the DV
+//! bounds, the warps) are shared with the occluder and subdivision passes.
+
+use super::{compose, layout_at, Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use crate::record::Recorder;
+use crate::scene_gpu::GpuScene;
+use crate::technique::FrameInputs;
+use crate::{binding, raster, Gpu};
+
+const DEPTH_WGSL: &str = include_str!("depth.wgsl");
+const DEPTH_PLAIN_WGSL: &str = include_str!("depth_plain.wgsl");
+const DEPTH_EXACT_WGSL: &str = include_str!("depth_exact.wgsl");
+
+/// The depth pass; `exact`: the fragment stage writes the plane's depth at the inverted warp.
+pub(super) fn source(exact: bool) -> String {
+    let fs = if exact { DEPTH_EXACT_WGSL } else { DEPTH_PLAIN_WGSL };
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{DEPTH_WGSL}{fs}"), true)
+}
+
+/// lookup.wgsl's bindings 6-9: the uniform, the DV bounds, the two warps.
+pub(super) fn lookup_entries() -> [(u32, wgpu::BindingType); 4] {
+    let tex = binding::texture_float();
+    [(6, binding::uniform()), (7, binding::storage(true)), (8, tex), (9, tex)]
+}
+
+/// The lookup layout (bindings 6-9, the pieces at 10) and the warped depth pipeline.
+pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, exact: bool) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
+    let look = lookup_entries();
+    let layout = layout_at(
+        gpu,
+        &format!("{name}.depth"),
+        wgpu::ShaderStages::VERTEX_FRAGMENT,
+        &[look[0], look[1], look[2], look[3], (10, binding::storage(true))],
+    );
+    let pipeline = raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &source(exact), &[&layout, &scene.layout], &[]);
+    (layout, pipeline)
+}
+
+impl Warped {
+    /// Views of the two warp textures.
+    pub(super) fn warp_views(&self) -> (wgpu::TextureView, wgpu::TextureView) {
+        (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()))
+    }
+
+    pub(super) fn lookup_resources<'a>(&'a self, xv: &'a wgpu::TextureView, yv: &'a wgpu::TextureView) -> [wgpu::BindingResource<'a>; 4] {
+        [
+            self.uniform.as_entire_binding(),
+            self.dv.as_entire_binding(),
+            wgpu::BindingResource::TextureView(xv),
+            wgpu::BindingResource::TextureView(yv),
+        ]
+    }
+
+    /// The depth pass's bindings: the lookup resources and the pieces (binding 10).
+    pub(super) fn depth_entries<'a>(&'a self, xv: &'a wgpu::TextureView, yv: &'a wgpu::TextureView) -> Vec<wgpu::BindGroupEntry<'a>> {
+        let pieces = if self.params.subdiv > 0.0 { &self.pieces } else { &self.counters };
+        let look = self.lookup_resources(xv, yv);
+        let mut entries: Vec<wgpu::BindGroupEntry> =
+            look.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: 6 + i as u32, resource: r.clone() }).collect();
+        entries.push(wgpu::BindGroupEntry { binding: 10, resource: pieces.as_entire_binding() });
+        entries
+    }
+
+    pub(super) fn depth_group(&self, gpu: &Gpu, xv: &wgpu::TextureView, yv: &wgpu::TextureView) -> wgpu::BindGroup {
+        let entries = self.depth_entries(xv, yv);
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.name()),
+            layout: &self.lookup_layout,
+            entries: &entries,
+        })
+    }
+
+    /// The `shadow_map` stage: the pieces the subdivision left (drawn indirectly), or the scene.
+    pub(super) fn draw_shadow_map(&self, f: &FrameInputs, rec: &mut Recorder, depth_group: &wgpu::BindGroup) {
+        let name = self.name();
+        let subdiv = self.params.subdiv > 0.0;
+        let map_view = self.map.create_view(&Default::default());
+        rec.stage(&format!("{name}.shadow_map"), |enc| {
+            let mut pass = raster::begin_pass(enc, &format!("{name}.shadow_map"), &[], &map_view);
+            pass.set_pipeline(&self.depth_pipeline);
+            pass.set_bind_group(0, depth_group, &[]);
+            pass.set_bind_group(1, &f.scene.group, &[]);
+            if subdiv {
+                pass.draw_indirect(&self.counters, 16);
+            } else {
+                pass.draw(0..f.scene.triangle_count * 3, 0..1);
+            }
+        });
+    }
+}

@@ -1,0 +1,60 @@
+//! The evaluation (`final_pass`, eval.wgsl): each evaluated sample offset by the bias in world
+//! units of one warped texel (its size from the warp's Jacobian, `bias_mode`), projected,
+//! cropped, warped like the depth pass and compared NxN with the warped map (`close_cracks`:
+//! with the nearest depth of 3x3 texels per tap); the analysis variant also counts the samples
+//! per warped texel.
+
+use super::{Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use crate::record::Recorder;
+use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
+use crate::{binding, Gpu, GpuError};
+
+const EVAL_WGSL: &str = include_str!("eval.wgsl");
+
+pub(super) fn source() -> String {
+    compose_view(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{EVAL_WGSL}"), false)
+}
+
+/// The evaluation layout (the view, the lookup, the map, its comparison sampler, the counts) and
+/// the evaluation with its analysis variant.
+pub(super) fn pipelines(gpu: &Gpu, name: &str) -> (wgpu::BindGroupLayout, EvalPipelines) {
+    let (ro, rw, tex) = (binding::storage(true), binding::storage(false), binding::texture_float());
+    let layout = view_layout(
+        gpu,
+        &format!("{name}.final_pass"),
+        &[binding::uniform(), ro, tex, tex, binding::texture_depth(), binding::comparison_sampler(), rw],
+    );
+    let eval = EvalPipelines::new(gpu, &format!("{name}.final_pass"), &source(), &layout, &[]);
+    (layout, eval)
+}
+
+/// The evaluation's depth comparison, nearest texel (the PCF taps are explicit).
+pub(super) fn sampler(gpu: &Gpu) -> wgpu::Sampler {
+    gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("warp.cmp"),
+        compare: Some(wgpu::CompareFunction::LessEqual),
+        mag_filter: wgpu::FilterMode::Nearest,
+        min_filter: wgpu::FilterMode::Nearest,
+        address_mode_u: wgpu::AddressMode::ClampToEdge,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        ..Default::default()
+    })
+}
+
+impl Warped {
+    /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
+    pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        let name = self.name();
+        let (xv, yv) = self.warp_views();
+        let map_view = self.map.create_view(&Default::default());
+        let mut extra: Vec<wgpu::BindingResource> = self.lookup_resources(&xv, &yv).to_vec();
+        extra.extend([
+            wgpu::BindingResource::TextureView(&map_view),
+            wgpu::BindingResource::Sampler(&self.sampler),
+            self.counts.as_entire_binding(),
+        ]);
+        let group = f.view_group(gpu, &format!("{name}.final_pass"), &self.eval_layout, &extra);
+        self.eval.record(gpu, rec, &format!("{name}.final_pass"), &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
+        Ok(())
+    }
+}
