@@ -74,7 +74,7 @@ fn every_technique_twice_on_the_stress_scenes() {
                 // subdividing maps with a small piece capacity and 256^2 maps, so that this test
                 // stays within the suite's time: it then also exercises the deterministic cut on
                 // a real dense scene. At their defaults the same runs were measured bit-equal too
-                // (BENCHMARKS.md "Issue 18"), but cube-notw alone took 774 s for the two.
+                // (docs/bench/stress.md), but cube-notw alone took 774 s for the two.
                 let cut = info.params().iter().any(|p| p.key == "subdiv_capacity");
                 let spec = if cut { format!("{}:subdiv_capacity={STRESS_CAPACITY},res=256", info.name) } else { info.name.to_string() };
                 let r = registry::resolve(&TechniqueSpec::parse(&spec).unwrap(), Some(&v.light)).unwrap();

@@ -10,7 +10,7 @@
 //! - `lt`: leak tracing's LTT test, temporal mask bits and cascades
 //! - `mdsm`: multiple-depth selection and PCF(k,n)
 //! - `min_sm`: rotating calipers and the minimal shadow frustum (MSF)
-//! - `sdsm`: sample-distribution splits and boxes fitted to the samples (`sdsm`, GPU half in `csm/`)
+//! - `sdsm`: sample-distribution splits and boxes fitted to the samples (`sdsm`, GPU half in `techniques/sdsm/`, sharing `csm/`'s passes)
 //! - `sv`: silhouette edges of closed meshes for shadow volumes
 //! - `virtual_sm`: clipmap pages, level choice and page pool of `virtual`
 //! - `warp`: RTW and NoTW warping functions

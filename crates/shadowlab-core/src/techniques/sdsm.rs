@@ -1,7 +1,7 @@
 //! Sample distribution shadow maps (`sdsm`, Lauritzen, Salvi and Lefohn, I3D 2011), the CPU
 //! half: split distances from the view samples' [min, max] depth, logarithmic between them,
 //! and each cascade's light-space box fitted to the samples that fall into it. The GPU half
-//! (shadowlab-gpu `techniques/csm/sdsm.rs`, sharing `csm`'s maps, passes and evaluation)
+//! (shadowlab-gpu `techniques/sdsm/`, sharing `csm`'s maps, passes and evaluation)
 //! reduces the samples to per-cascade light-space bounds and mirrors [`sample_splits`] in WGSL.
 //!
 //! The light view is `csm`'s ([`light_view`]): fixed in the world, so a texel grid in light

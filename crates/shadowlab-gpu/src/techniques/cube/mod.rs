@@ -128,7 +128,7 @@ pub const DEFAULT_NOTW_BIAS_MODE: f64 = 0.0;
 /// with the tent in a later run, against 4.13 M recorded for the box); checked on four views not used to choose it (512x512, default parameters
 /// otherwise; wrong % box -> tent, pieces): room light 1 0.247 -> 0.223, 895 k -> 427 k;
 /// courtyard lantern 0.171 -> 0.161, 4.33 M -> 1.29 M; conference light 1 0.252 -> 0.240,
-/// 2.32 M -> 1.00 M; eaves light 0 0.334 -> 0.312, 8.61 M -> 5.98 M (BENCHMARKS.md, issue 18).
+/// 2.32 M -> 1.00 M; eaves light 0 0.334 -> 0.312, 8.61 M -> 5.98 M (docs/bench/stress.md).
 pub const DEFAULT_NOTW_WINDOW_TENT: f64 = 1.0;
 
 /// cube-notw's shadow-edge importance (`edge_importance`, warp::EDGE_IMPORTANCE): a view
@@ -139,7 +139,7 @@ pub const DEFAULT_NOTW_WINDOW_TENT: f64 = 1.0;
 /// sibenik 1.92 M at 0 to 2.79 M at 8 and 3.49 M at 16, so 8 rather than 16). Checked on three
 /// views not used to choose it, k = 0 -> 8: conference light 1 0.240 -> 0.181, courtyard lantern
 /// 0.161 -> 0.138, eaves light 0 0.312 -> 0.179 (eaves then fills the piece capacity on two
-/// faces: flagged degraded, deterministic) (BENCHMARKS.md, issue 18).
+/// faces: flagged degraded, deterministic) (docs/bench/stress.md).
 pub const DEFAULT_NOTW_EDGE_IMPORTANCE: f64 = 8.0;
 
 const THREE_SETUPS: &str =
@@ -160,11 +160,11 @@ shadowlab_core::param_set! {
             .with(w::BIAS_MODE.with_default(DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS))
             .with(w::WINDOW_TENT.with_default(
                 DEFAULT_NOTW_WINDOW_TENT,
-                "shadowlab: chosen on sibenik, checked on room, courtyard lantern, conference and eaves point lights (BENCHMARKS.md, issue 18)",
+                "shadowlab: chosen on sibenik, checked on room, courtyard lantern, conference and eaves point lights (docs/bench/stress.md)",
             ))
             .with(w::EDGE_IMPORTANCE.with_default(
                 DEFAULT_NOTW_EDGE_IMPORTANCE,
-                "shadowlab: chosen on room and sibenik, checked on conference, courtyard lantern and eaves point lights (BENCHMARKS.md, issue 18)",
+                "shadowlab: chosen on room and sibenik, checked on conference, courtyard lantern and eaves point lights (docs/bench/stress.md)",
             )),
     }
     rules {

@@ -219,7 +219,7 @@ pub const EXACT_INVERSE: ParamDef = ParamDef::flag(
 /// Subdivision leaves an edge unsplit when an unwarped occluder map (the scene drawn into the
 /// DV-cropped map, res x res, then a pyramid of maxima) is nearer than the edge all around it:
 /// the bend of a hidden edge cannot show. Planar maps (`notw`, `cube-notw`'s faces); see
-/// warp/occluders.rs and BENCHMARKS.md (bounded cost, issue 18). Off: the occluder map is
+/// warp/occluders.rs and docs/bench/stress.md (bounded cost). Off: the occluder map is
 /// point-sampled at res, and where the warp magnifies a grazing wall that is a sliver of base
 /// texels its edges look hidden: `notw` on the built-in city went 1.138 -> 2.251 % wrong (false
 /// shadows on lit walls); cube-notw kept its quality on five point-light views (38-40 % fewer
