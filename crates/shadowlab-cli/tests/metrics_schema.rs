@@ -5,8 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 #[path = "../src/metrics/mod.rs"]
 #[allow(dead_code, unused_imports)]

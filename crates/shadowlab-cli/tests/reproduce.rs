@@ -5,8 +5,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 const CLAIMS: &str = include_str!("../src/reproduce/claims.toml");
 

@@ -3,8 +3,7 @@
 
 use std::path::PathBuf;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 #[test]
 fn tune_chooses_on_train_and_judges_on_validate() {

@@ -14,11 +14,10 @@ use shadowlab_view::render::{Look, Pose, RefStatus, Renderer, Right, Show};
 use shadowlab_view::session;
 use shadowlab_view::widgets::resolve_text;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = common::tmp(name);
+    let d = crate::common::tmp(name);
     std::fs::create_dir_all(&d).unwrap();
     d
 }

@@ -12,8 +12,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::scene::{Material, Scene};
 use shadowlab_gpu::lab::{Lab, View};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// GPU `rt` at time `t` against the CPU tracer over `scene.at_time(t)` on the same samples.
 fn rt_matches_cpu_at(lab: &Lab, scene: &Scene, light: usize, t: f32) -> (View, Vec<f32>) {

@@ -7,8 +7,7 @@ use shadowlab_core::techniques::csm::{depth_range, practical_splits};
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::reduce::MinMax;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn spec(s: &str) -> TechniqueSpec {
     TechniqueSpec::parse(s).unwrap()

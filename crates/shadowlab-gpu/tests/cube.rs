@@ -12,8 +12,7 @@ use shadowlab_gpu::technique::submit_frame;
 use shadowlab_gpu::techniques::cube::{CubeMap, CubeSettings};
 use shadowlab_gpu::GpuError;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn spec(s: &str) -> TechniqueSpec {
     TechniqueSpec::parse(s).unwrap()

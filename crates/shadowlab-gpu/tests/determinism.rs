@@ -2,14 +2,13 @@
 //! maps' subdivision, given too few pieces, draws a level unsplit (coarser, flagged as
 //! degraded) instead of dropping whichever pieces lose the race of the atomics.
 
-mod common;
 
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, Run};
 use shadowlab_gpu::registry;
 
-use common::*;
+use crate::common::*;
 
 /// `spec` created twice, fresh, on `scene`'s light `light` at 96x96.
 fn twice(gpu: &shadowlab_gpu::Gpu, scene: &str, light: usize, spec: &str) -> (Run, Run) {

@@ -9,8 +9,7 @@ use shadowlab_core::params::TechniqueSpec;
 use shadowlab_core::scene::{Material, Scene};
 use shadowlab_gpu::lab::Lab;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// planebox (10 m plane, 1 m box) lit by a point light 2.5 m above the floor, beside the box:
 /// the shadow is a known, exact shape for `rt`.

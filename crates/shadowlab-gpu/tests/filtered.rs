@@ -6,8 +6,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, Run};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn run(lab: &Lab, v: &shadowlab_gpu::lab::View, spec: &str) -> Run {
     lab.run(v, &TechniqueSpec::parse(spec).unwrap(), 1).unwrap_or_else(|e| panic!("{spec}: {e}"))

@@ -7,8 +7,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 #[test]
 fn rt_gpu_matches_cpu_on_every_builtin_scene_and_light() {

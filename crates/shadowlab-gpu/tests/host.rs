@@ -1,7 +1,6 @@
 //! The library seam: `examples/host_app.rs` (its own device, its own depth/normal pass, `sm`
 //! and `lt` recorded into its encoder, one submit per frame) agrees with the lab on the same view.
 
-mod common;
 #[allow(dead_code)]
 #[path = "../examples/host_app.rs"]
 mod host_app;
@@ -13,7 +12,7 @@ use shadowlab_gpu::lab::Lab;
 
 #[test]
 fn host_app_matches_the_lab_with_one_submit_per_frame() {
-    let Some(lab_gpu) = common::gpu() else { return };
+    let Some(lab_gpu) = crate::common::gpu() else { return };
     let gpu = host_app::open_device().expect("host device");
     let scene = builtin("courtyard").unwrap();
     let frames = 3;

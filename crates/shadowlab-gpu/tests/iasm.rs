@@ -8,8 +8,7 @@ use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::registry;
 use shadowlab_gpu::techniques::iasm::{Iasm, IasmSettings, IasmStore};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 #[test]
 fn iasm_buffer_matches_rt_on_planebox_and_memory_is_exact() {

@@ -8,8 +8,7 @@ use shadowlab_gpu::lab::{Lab, Run, View};
 use shadowlab_gpu::registry;
 use shadowlab_gpu::techniques::iasm::IasmSettings;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// The square the run used, from its counters.
 fn square(run: &Run, v: &View) -> Placement {

@@ -14,8 +14,7 @@ use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::{submit_frame, Technique};
 use shadowlab_gpu::techniques::lt::{HybridSettings, LeakTracing, LtSettings, LttSettings, Variant};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn make(lab: &Lab, spec: &str, light: &shadowlab_core::light::Light) -> LeakTracing {
     let spec = TechniqueSpec::parse(spec).unwrap();

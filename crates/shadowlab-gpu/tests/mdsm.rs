@@ -11,8 +11,7 @@ use shadowlab_gpu::technique::submit_frame;
 use shadowlab_gpu::techniques::mdsm::{MdsmSettings, MultiDepthMap, INFO};
 use shadowlab_gpu::Gpu;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn spec(s: &str) -> TechniqueSpec {
     TechniqueSpec::parse(s).unwrap()

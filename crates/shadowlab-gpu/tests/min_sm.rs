@@ -7,8 +7,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, Run, View};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn spec(s: &str) -> TechniqueSpec {
     TechniqueSpec::parse(s).unwrap()

@@ -5,7 +5,6 @@
 //! a box) `height=-1` lights every evaluated pixel and `height=100` none, and `rt`'s shadowed
 //! pixels are exactly the first one's false-lit pixels.
 
-mod common;
 
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::metrics::compare;
@@ -16,7 +15,7 @@ use shadowlab_gpu::registry::Resolved;
 use shadowlab_gpu::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use shadowlab_gpu::{Gpu, GpuError};
 
-use common::*;
+use crate::common::*;
 
 shadowlab_core::param_set! {
     /// `threshold`'s one parameter.

@@ -2,14 +2,13 @@
 //! stalls is one submit, and the lab's analysis passes (outside the timed frame) leave the
 //! visibility bit for bit as the timed frame wrote it.
 
-mod common;
 
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::params::ParamValues;
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::registry::REGISTRY;
 
-use common::*;
+use crate::common::*;
 
 /// Every technique on every light of planebox (directional) and room (spot, point) that it
 /// supports, at 96x96: one timed frame with a warm-up.
@@ -53,7 +52,7 @@ fn analysis_passes_leave_the_visibility_bit_equal_and_a_frame_is_one_submit_unle
         }
         checked += 1;
     });
-    if common::gpu().is_some() {
+    if crate::common::gpu().is_some() {
         assert!(checked >= REGISTRY.len(), "only {checked} technique runs checked");
     }
 }

@@ -13,8 +13,7 @@ use shadowlab_core::techniques::sdsm::sample_splits;
 use shadowlab_gpu::lab::{Instance, Lab, Run, View};
 use shadowlab_gpu::registry;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn spec(s: &str) -> TechniqueSpec {
     TechniqueSpec::parse(s).unwrap()

@@ -6,8 +6,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 #[test]
 fn sv_agrees_with_rt_on_every_opaque_builtin_scene_and_light() {

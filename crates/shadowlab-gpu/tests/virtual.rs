@@ -13,8 +13,7 @@ use shadowlab_gpu::registry;
 use shadowlab_gpu::technique::submit_frame;
 use shadowlab_gpu::techniques::virtual_sm::{VirtualSettings, VirtualShadows, DYNAMIC_CHUNK_TRIANGLES};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn make(lab: &Lab, v: &View, spec: &str) -> VirtualShadows {
     let spec = TechniqueSpec::parse(spec).unwrap();

@@ -13,8 +13,7 @@ use shadowlab_gpu::technique;
 use shadowlab_gpu::techniques::warp::{DvSettings, Knobs, NotwSettings, RtwSettings, Variant, Warped};
 use wgpu::BufferUsages;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn lcg(seed: &mut u64) -> u32 {
     *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);

@@ -5,8 +5,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Warp strength 0 makes the warp the identity: `notw` through its own pipeline (analysis,
 /// subdivision, warped depth pass, warped lookup) must then be `notw-dv` (the same crop, bias

@@ -9,8 +9,7 @@ use shadowlab_gpu::registry;
 use shadowlab_gpu::technique;
 use shadowlab_gpu::techniques::warp::{Knobs, NotwSettings, Warped};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn run_direct(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str) -> Warped {
     let resolved = registry::resolve(&TechniqueSpec::parse(spec).unwrap(), Some(&v.light)).unwrap();

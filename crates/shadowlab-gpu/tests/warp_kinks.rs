@@ -8,8 +8,7 @@ use shadowlab_core::metrics::compare;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::Lab;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// The city's street view under a sun 12 degrees high behind the camera (setups/kinks-city.toml's
 /// light 0), at 512x512: the lit street ahead shows lines of false-shadow specks with the
