@@ -16,7 +16,8 @@ fn tables_are_well_formed_and_resolve_at_their_defaults() {
         let mut keys = BTreeSet::new();
         for p in t.params() {
             assert!(keys.insert(p.key), "{}: '{}' declared twice", t.name, p.key);
-            assert!(p.min <= p.default && p.default <= p.max, "{}: {} default {} outside [{}, {}]", t.name, p.key, p.default, p.min, p.max);
+            let auto = p.kind == Kind::AutoNumber && p.default.is_nan();
+            assert!(auto || (p.min <= p.default && p.default <= p.max), "{}: {} default {} outside [{}, {}]", t.name, p.key, p.default, p.min, p.max);
             assert!(!p.doc.is_empty() && !p.source.is_empty(), "{}: {} needs a doc and a source", t.name, p.key);
             if let Kind::Choice(names) = p.kind {
                 assert!((p.default as usize) < names.len(), "{}: {}", t.name, p.key);
@@ -64,7 +65,8 @@ fn other_value(p: &shadowlab_core::params::ParamDef) -> String {
         Kind::Flag => (p.default == 0.0).to_string(),
         Kind::Choice(names) => names[(p.default as usize + 1) % names.len()].to_string(),
         Kind::Integer => (if p.default < p.max { p.default + 1.0 } else { p.default - 1.0 }).to_string(),
-        Kind::Number => {
+        Kind::AutoNumber if p.default.is_nan() => p.min.max(0.0).min(p.max).to_string(),
+        Kind::AutoNumber | Kind::Number => {
             let x = if p.default < p.max { (p.default + (p.max - p.default).min(1.0) * 0.5).min(p.max) } else { p.min };
             x.to_string()
         }

@@ -55,7 +55,7 @@ fn marking_equals_the_cpu_computation() {
     let scene = builtin("planebox").unwrap();
     let lab = Lab::new(&gpu, &scene).unwrap();
     let v = view(&lab, &scene, 0, 192);
-    let mut t = make(&lab, &v, "virtual:pcf=3");
+    let mut t = make(&lab, &v, "virtual:pcf=3,resolution_bias=0");
     frame(&lab, &mut t, &v);
     let gpu_set: BTreeSet<PageKey> = t.requested().iter().copied().collect();
     let c = t.clipmap().unwrap().clone();
@@ -151,6 +151,34 @@ fn a_tiny_pool_falls_back_counted_and_deterministic() {
     let a = t.allocation();
     let coarsest_fallen = a.fallen_back.iter().map(|p| p.level).max().unwrap();
     assert!(a.mapped.iter().all(|(p, _)| p.level >= coarsest_fallen));
+}
+
+/// `resolution_bias=auto` (the default) takes the finest bias, from -1.5 in quarter steps,
+/// whose pages fit the pool: a pool too small for -1.5 is not overfilled (nothing falls back,
+/// nothing is flagged), the frame marked again for each step, and the result is bit for bit
+/// that of the fixed bias it chose. The fixed -1.5 in the same pool falls back, flagged.
+#[test]
+fn auto_takes_the_finest_bias_whose_pages_fit() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 128);
+    let run = |s: &str| lab.run(&v, &TechniqueSpec::parse(s).unwrap(), 1).unwrap();
+    let auto = run("virtual:pool_mib=1");
+    let c = &auto.report.counters;
+    let bias = c["resolution_bias"];
+    assert!(bias > -1.5 && bias <= 2.0 && (bias * 4.0).fract() == 0.0, "a coarser quarter step: {bias}");
+    assert!(c["pages_marked"] <= c["pool_pages"], "the pages fit: {c:?}");
+    assert!(auto.report.degraded.is_empty() && c["pages_fallen_back"] == 0.0, "{:?}", auto.report.degraded);
+    let fixed = run(&format!("virtual:pool_mib=1,resolution_bias={bias}"));
+    assert!(auto.visibility.iter().zip(&fixed.visibility).all(|(x, y)| x.to_bits() == y.to_bits()), "auto = its chosen fixed bias");
+    // one quarter finer does not fit (else auto would have taken it)
+    let finer = run(&format!("virtual:pool_mib=1,resolution_bias={}", bias - 0.25));
+    assert!(finer.report.counters["pages_marked"] > c["pool_pages"], "{:?}", finer.report.counters);
+    assert!(!finer.report.degraded.is_empty(), "a fixed bias that overfills the pool is flagged");
+    // a roomy pool: the finest bias, one marking pass
+    let roomy = run("virtual:pool_mib=64");
+    assert_eq!((roomy.report.counters["resolution_bias"], roomy.report.counters["resolution_bias_marks"]), (-1.5, 1.0));
 }
 
 /// A pool far too small for the view (16 pages of 128^2, a few times fewer than asked for) falls

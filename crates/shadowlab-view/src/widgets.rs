@@ -4,7 +4,7 @@
 //! same parser as `-t`, so what the viewer runs is what a saved setup reproduces.
 
 use eframe::egui;
-use shadowlab_core::params::{Kind, ParamDef, ParamValues, TechniqueSpec, Value};
+use shadowlab_core::params::{Kind, ParamDef, ParamValues, TechniqueSpec, Value, AUTO};
 use shadowlab_gpu::registry::{self, Resolved};
 use shadowlab_gpu::GpuError;
 
@@ -25,6 +25,11 @@ pub enum Widget {
     },
     Checkbox,
     Dropdown(&'static [&'static str]),
+    /// An `auto` checkbox, and a slider for the number when it is off.
+    AutoSlider {
+        min: f64,
+        max: f64,
+    },
 }
 
 /// The widget for `def`.
@@ -37,6 +42,7 @@ pub fn widget(def: &ParamDef) -> Widget {
         }
         Kind::Flag => Widget::Checkbox,
         Kind::Choice(names) => Widget::Dropdown(names),
+        Kind::AutoNumber => Widget::AutoSlider { min: def.min, max: def.max },
     }
 }
 
@@ -88,6 +94,24 @@ pub fn edit(ui: &mut egui::Ui, def: &ParamDef, value: &mut Value) -> egui::Respo
             let r = ui.checkbox(&mut b, def.key);
             if r.changed() {
                 *value = Value::Flag(b);
+            }
+            r
+        }
+        (Widget::AutoSlider { min, max }, v) => {
+            let (mut auto, mut x) = match v {
+                Value::Number(x) => (false, x),
+                _ => (true, (min.max(0.0_f64.min(max))).clamp(min, max)),
+            };
+            let before = (auto, x);
+            let mut r = ui
+                .horizontal(|ui| {
+                    ui.checkbox(&mut auto, AUTO);
+                    ui.add_enabled(!auto, egui::Slider::new(&mut x, min..=max).text(def.key));
+                })
+                .response;
+            if (auto, x) != before {
+                *value = if auto { Value::Choice(AUTO.to_string()) } else { Value::Number(x) };
+                r.mark_changed();
             }
             r
         }
@@ -183,6 +207,7 @@ mod tests {
                     }
                     (Widget::Checkbox, Value::Flag(_)) => {}
                     (Widget::Dropdown(names), Value::Choice(c)) => assert!(names.contains(&c.as_str()), "{}.{}", t.name, d.key),
+                    (Widget::AutoSlider { min, max }, Value::Choice(c)) => assert!(c == AUTO && min < max, "{}.{}", t.name, d.key),
                     (w, v) => panic!("{}.{}: widget {w:?} does not edit {v:?}", t.name, d.key),
                 }
             }

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 pub mod family;
 mod set;
 
-pub use set::{check_table, declare_choice, read_choice, Block, Field, ParamSet, ParamTable};
+pub use set::{check_table, declare_choice, read_choice, Auto, Block, Field, ParamSet, ParamTable};
 
 /// What values a parameter takes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -27,7 +27,13 @@ pub enum Kind {
     Flag,
     /// One of the names (its index accepted too); `default` is the index of the default name.
     Choice(&'static [&'static str]),
+    /// `auto` (the technique chooses, per frame) or a number in `[min, max]`; `default` is NaN
+    /// for `auto`.
+    AutoNumber,
 }
+
+/// The word an [`Kind::AutoNumber`] parameter takes for "the technique chooses".
+pub const AUTO: &str = "auto";
 
 /// One documented parameter of a technique.
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -52,6 +58,10 @@ impl ParamDef {
     /// A whole number in `[min, max]`.
     pub const fn integer(key: &'static str, default: f64, min: f64, max: f64, doc: &'static str, source: &'static str) -> ParamDef {
         ParamDef { key, kind: Kind::Integer, default, min, max, doc, source }
+    }
+    /// `auto` by default, or a number in `[min, max]` ([`Kind::AutoNumber`]).
+    pub const fn auto_number(key: &'static str, min: f64, max: f64, doc: &'static str, source: &'static str) -> ParamDef {
+        ParamDef { key, kind: Kind::AutoNumber, default: f64::NAN, min, max, doc, source }
     }
     /// An on/off switch.
     pub const fn flag(key: &'static str, default: bool, doc: &'static str, source: &'static str) -> ParamDef {
@@ -88,6 +98,8 @@ impl ParamDef {
             Kind::Integer => Value::Integer(self.default as i64),
             Kind::Flag => Value::Flag(self.default != 0.0),
             Kind::Choice(names) => Value::Choice(names[self.default as usize].to_string()),
+            Kind::AutoNumber if self.default.is_nan() => Value::Choice(AUTO.to_string()),
+            Kind::AutoNumber => Value::Number(self.default),
         }
     }
 
@@ -103,6 +115,7 @@ impl ParamDef {
             Kind::Integer => format!("{}..{}, whole", self.min, self.max),
             Kind::Flag => "true|false".into(),
             Kind::Choice(names) => names.join("|"),
+            Kind::AutoNumber => format!("{AUTO} or {}..{}", self.min, self.max),
         }
     }
 
@@ -120,12 +133,16 @@ impl ParamDef {
                 let idx = idx.ok_or_else(|| format!("technique '{technique}': {k}={text} is not one of {}", names.join(", ")))?;
                 Ok(Value::Choice(names[idx].to_string()))
             }
-            Kind::Number | Kind::Integer => {
+            Kind::AutoNumber if text == AUTO => Ok(Value::Choice(AUTO.to_string())),
+            Kind::Number | Kind::Integer | Kind::AutoNumber => {
                 let x: f64 = text
                     .parse()
                     .ok()
                     .filter(|x: &f64| x.is_finite())
-                    .ok_or_else(|| format!("technique '{technique}': {k}={text} is not a number"))?;
+                    .ok_or_else(|| {
+                        let auto = if self.kind == Kind::AutoNumber { " (or auto)" } else { "" };
+                        format!("technique '{technique}': {k}={text} is not a number{auto}")
+                    })?;
                 let integer = self.kind == Kind::Integer;
                 if integer && x.fract() != 0.0 {
                     return Err(format!("technique '{technique}': {k}={text} must be a whole number"));

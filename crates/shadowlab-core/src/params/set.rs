@@ -121,6 +121,27 @@ impl Field for bool {
     }
 }
 
+/// An [`Kind::AutoNumber`] value: the technique chooses (`auto`), or the number given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Auto {
+    Auto,
+    Fixed(f64),
+}
+
+impl Field for Auto {
+    type Decl = ParamDef;
+    fn declare(d: ParamDef, field: &'static str, out: &mut Vec<ParamDef>) {
+        single(d, field, d.kind == Kind::AutoNumber, "Auto", out)
+    }
+    fn read(v: &ParamValues, field: &'static str) -> Auto {
+        match value(v, field) {
+            Value::Choice(s) if s == super::AUTO => Auto::Auto,
+            Value::Number(x) => Auto::Fixed(*x),
+            x => panic!("parameter '{field}' is {x:?}, not auto or a number"),
+        }
+    }
+}
+
 /// For [`param_choice!`]: declares a choice field whose names must be the enum's.
 pub fn declare_choice(d: ParamDef, names: &'static [&'static str], field: &'static str, out: &mut Vec<ParamDef>) {
     let fits = matches!(d.kind, Kind::Choice(n) if n == names);
@@ -167,7 +188,8 @@ impl Block {
 pub fn check_table(set: &str, rows: &[ParamDef]) {
     for (i, d) in rows.iter().enumerate() {
         assert!(rows[..i].iter().all(|o| o.key != d.key), "{set}: '{}' declared twice", d.key);
-        assert!(d.min <= d.default && d.default <= d.max, "{set}: {} default {} outside [{}, {}]", d.key, d.default, d.min, d.max);
+        let auto = d.kind == Kind::AutoNumber && d.default.is_nan();
+        assert!(auto || (d.min <= d.default && d.default <= d.max), "{set}: {} default {} outside [{}, {}]", d.key, d.default, d.min, d.max);
         assert!(!d.doc.is_empty() && !d.source.is_empty(), "{set}: {} needs a doc and a source", d.key);
     }
 }
@@ -346,6 +368,22 @@ mod tests {
         assert!(e.contains("window has no effect: mode=fast"), "{e}");
         // not given, so not reported
         assert!(resolve("x:mode=fast").is_ok());
+    }
+
+    crate::param_set! {
+        /// a number the technique may choose
+        pub struct WithAuto { pub lod: Auto = ParamDef::auto_number("lod", -2.0, 2.0, "lod bias", "test") }
+    }
+
+    #[test]
+    fn an_auto_number_is_auto_or_a_number_in_range() {
+        let read = |spec: &str| TechniqueSpec::parse(spec).unwrap().resolve(WithAuto::defs()).map(|v| WithAuto::from_values(&v).lod);
+        assert_eq!(read("x"), Ok(Auto::Auto));
+        assert_eq!(read("x:lod=auto"), Ok(Auto::Auto));
+        assert_eq!(read("x:lod=-1.5"), Ok(Auto::Fixed(-1.5)));
+        assert!(read("x:lod=3").unwrap_err().contains("out of range"));
+        assert!(read("x:lod=fine").unwrap_err().contains("is not a number (or auto)"));
+        assert_eq!((WithAuto::defs()[0].default_text(), WithAuto::defs()[0].range_text()), ("auto".into(), "auto or -2..2".into()));
     }
 
     crate::param_set! {

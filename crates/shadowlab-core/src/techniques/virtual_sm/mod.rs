@@ -17,9 +17,11 @@
 
 mod alloc;
 mod cube;
+mod lod;
 mod spot;
 mod statics;
 pub use alloc::{with_fallbacks, Allocation, Demand, PageCache, PageKey};
+pub use lod::{AutoLod, AUTO_COARSEST, AUTO_FINEST, AUTO_STEP};
 pub use spot::{spot_levels, Projection};
 pub use statics::{Build, StaticCopies};
 

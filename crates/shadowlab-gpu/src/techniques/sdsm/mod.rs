@@ -38,7 +38,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls: "with delayed=false (default): sdsm.readback, the depth range, splits and per-cascade sample bounds read back before the fit; delayed=true (the previous frame's, frame 0 the frustum-slice fit) records without a stall",
     needs: "",
     // not in the default compare set (its cost is csm's, but the set's time is documented)
-    compare: &[],
+    compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Sdsm::new(gpu, scene, &SdsmSettings::from_values(p), light)?)),
 };

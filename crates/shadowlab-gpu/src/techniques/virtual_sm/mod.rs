@@ -42,9 +42,9 @@ mod setup;
 mod uniforms;
 
 use shadowlab_core::light::Light;
-use shadowlab_core::params::{ParamSet, ParamTable};
+use shadowlab_core::params::{Auto, ParamSet, ParamTable};
 use shadowlab_core::scene::Bounds;
-use shadowlab_core::techniques::virtual_sm::{pixel_angle, Allocation, Build, Clipmap, PageCache, PageKey, StaticCopies};
+use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, Allocation, AutoLod, Build, Clipmap, PageCache, PageKey, StaticCopies};
 
 use allocate::Pages;
 use draw::Chunks;
@@ -75,13 +75,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "virtual",
     summary: "virtual shadow maps: clipmap levels (spot: one map's mip chain; point: six faces' chains) of 16K virtual texels in 128^2 pages; only the pages view samples need are rendered, cached across frames",
     cost: "a marking pass, one readback (a sync), per new page one atlas viewport with culled chunks; N^2 page-table lookups per pixel",
-    quality: "about one texel per pixel everywhere (resolution_bias); a full pool makes fine pages fall back to coarser ones (reported)",
+    quality: "about one texel per pixel everywhere (resolution_bias); auto picks the finest bias whose pages fit the pool each frame; a fixed bias that overfills the pool falls back to coarser pages (reported)",
     source: "Epic Games, Unreal Engine 5 virtual shadow maps (2021); clipmaps: Tanner, Migdal, Jones 1998",
     lights: &["directional", "spot", "point"],
     params: ParamTable::of::<VirtualSettings>(),
-    stalls: "virtual.readback: the page requests read back for the CPU allocation (every frame)",
+    stalls: "virtual.readback: the page requests read back for the CPU allocation (every frame; with resolution_bias=auto once more per quarter step coarser while the pages do not fit the pool)",
     needs: "",
-    compare: &[],
+    compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(VirtualShadows::new(gpu, scene, &VirtualSettings::from_values(p), light)?)),
 };
@@ -99,6 +99,10 @@ pub struct VirtualShadows {
     mark: MarkPass,
     render: PagePass,
     eval: EvalPass,
+    /// `resolution_bias=auto`'s state across frames.
+    auto: AutoLod,
+    /// The bias the last frame used and its marking passes.
+    last_lod: (f32, u32),
 }
 
 impl VirtualShadows {
@@ -113,7 +117,8 @@ impl VirtualShadows {
         let mark = MarkPass::new(gpu);
         let eval = EvalPass::new(gpu);
         let chunks = Chunks::new(gpu, scene, setup.split, &setup.proto)?;
-        Ok(VirtualShadows { pages: Pages::new(&setup), setup, params, chunks, res, mark, render, eval })
+        let last_lod = (0.0, 0);
+        Ok(VirtualShadows { pages: Pages::new(&setup), setup, params, chunks, res, mark, render, eval, auto: AutoLod::default(), last_lod })
     }
 
     /// The clipmap of the last frame.
@@ -152,6 +157,32 @@ impl VirtualShadows {
         &self.pages.requested
     }
 
+    /// Marks the pages at resolution bias `bias` and reads them back (mark.rs).
+    fn mark_at(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, c: &Clipmap, bias: f32) -> Vec<u32> {
+        let angle = pixel_angle(f.camera.fov_y_deg, f.gbuffer.height);
+        self.params.place(c, angle, bias_scale(bias), self.setup.reach);
+        rec.write_buffer(&self.res.uniform, 0, bytemuck::bytes_of(&self.params));
+        self.mark.record(gpu, f, rec, &self.res, c, self.chunks.dynamic.as_ref())
+    }
+
+    /// `resolution_bias=auto`: marks from the bias [`AutoLod`] starts at, one quarter step
+    /// coarser each time the requested pages do not fit the pool.
+    fn mark_auto(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, c: &Clipmap) -> Vec<u32> {
+        let slots = self.pages.cache.slots() as usize;
+        let requested = |probe: &[u32]| probe[..c.table_len()].iter().filter(|w| **w & 1 != 0).count();
+        let mut bias = self.auto.first();
+        let mut probe = self.mark_at(gpu, f, rec, c, bias);
+        let mut marks = 1;
+        while let Some(coarser) = AutoLod::after(bias, requested(&probe), slots) {
+            bias = coarser;
+            probe = self.mark_at(gpu, f, rec, c, bias);
+            marks += 1;
+        }
+        self.auto.chose(bias, requested(&probe), slots);
+        self.last_lod = (bias, marks);
+        probe
+    }
+
     /// Forgets the pages over world box `b` at every level (moving geometry); returns how many
     /// resident pages were dropped.
     pub fn invalidate_box(&mut self, b: &Bounds) -> usize {
@@ -165,9 +196,13 @@ impl Technique for VirtualShadows {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let s = &self.setup;
         let c = Clipmap::for_light(&s.light, &f.scene.bounds, f.camera.position, s.levels_param, s.virtual_res, s.page_res, s.extent0);
-        self.params.place(&c, pixel_angle(f.camera.fov_y_deg, f.gbuffer.height), s.bias_scale, s.reach);
-        rec.write_buffer(&self.res.uniform, 0, bytemuck::bytes_of(&self.params));
-        let probe = self.mark.record(gpu, f, rec, &self.res, &c, self.chunks.dynamic.as_ref());
+        let probe = match s.lod {
+            Auto::Fixed(b) => {
+                self.last_lod = (b as f32, 1);
+                self.mark_at(gpu, f, rec, &c, b as f32)
+            }
+            Auto::Auto => self.mark_auto(gpu, f, rec, &c),
+        };
         let t0 = std::time::Instant::now();
         let (flags, boxes) = probe.split_at(c.table_len());
         // a chunk that moved invalidates the resident pages its old and new boxes cover
@@ -201,6 +236,9 @@ impl Technique for VirtualShadows {
     }
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
-        report::report(gpu, &self.setup, &self.pages, &self.res.counts)
+        let mut r = report::report(gpu, &self.setup, &self.pages, &self.res.counts);
+        r.counters.insert("resolution_bias".into(), self.last_lod.0 as f64);
+        r.counters.insert("resolution_bias_marks".into(), self.last_lod.1 as f64);
+        r
     }
 }

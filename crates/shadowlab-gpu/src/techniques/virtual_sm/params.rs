@@ -2,7 +2,7 @@
 //! `sm`'s PCF and bias family (biases in texels of the level a sample uses).
 
 use shadowlab_core::params::family::{Bias, PCF};
-use shadowlab_core::params::{Block, ParamDef};
+use shadowlab_core::params::{Auto, Block, ParamDef};
 
 /// Virtual texels per level side: UE5's 16K virtual maps. Lower: coarser levels sooner (more
 /// levels needed); higher: more pages per level (bigger page table and request buffer).
@@ -17,9 +17,11 @@ pub const DEFAULT_LEVELS: f64 = 16.0;
 /// World side of level 0: UE5's first clipmap level 6 (radius 2^6 cm, so 1.28 m across) in
 /// scene units taken as metres. Too large: near samples get coarser texels than their pixels.
 pub const DEFAULT_LEVEL0_EXTENT: f64 = 1.28;
-/// Resolution (LOD) bias: 0 = the level whose texel is the first at least as large as the
-/// pixel's footprint. Negative: finer (more pages); positive: coarser.
-pub const DEFAULT_RESOLUTION_BIAS: f64 = 0.0;
+// Resolution (LOD) bias: `auto` by default, the finest bias from -1.5 (the best fixed setting
+// measured under suns at equal memory) whose pages fit the pool, chosen per frame
+// (shadowlab_core::techniques::virtual_sm::AutoLod). A number: 0 = the level whose texel is the
+// first at least as large as the pixel's footprint; negative: finer (more pages); positive:
+// coarser; a pool it overfills falls back level by level (flagged degraded).
 /// Physical pool: 12 MiB, the memory of `csm`'s default 3 x 1024^2 maps (issue 17's
 /// equal-memory comparison): 192 pages of 128^2.
 pub const DEFAULT_POOL_MIB: f64 = 12.0;
@@ -58,13 +60,12 @@ shadowlab_core::param_set! {
             "world side of clipmap level 0 (scene units; directional lights only)",
             "UE5 r.Shadow.Virtual.Clipmap.FirstLevel = 6 (radius 2^6 cm)",
         ),
-        pub resolution_bias: f64 = ParamDef::number(
+        pub resolution_bias: Auto = ParamDef::auto_number(
             "resolution_bias",
-            DEFAULT_RESOLUTION_BIAS,
             -8.0,
             8.0,
-            "level = ceil(log2(pixel footprint / level-0 texel at the sample) + bias); negative: finer texels, more pages",
-            "UE5 r.Shadow.Virtual.ResolutionLodBiasDirectional (spot: ...ResolutionLodBiasLocal)",
+            "level = ceil(log2(pixel footprint / level-0 texel at the sample) + bias); negative: finer texels, more pages; auto: the finest bias from -1.5 in quarter steps (up to +2) whose pages fit the pool, chosen per frame (marking again when they do not), with hysteresis",
+            "UE5 r.Shadow.Virtual.ResolutionLodBiasDirectional and DynamicRes (pool budget); auto's start -1.5: shadowlab, docs/bench/virtual.md",
         ),
         pub pool_mib: f64 = ParamDef::number(
             "pool_mib",

@@ -5,7 +5,8 @@
 
 use shadowlab_core::light::Light;
 use shadowlab_core::params::ParamSet;
-use shadowlab_core::techniques::virtual_sm::{bias_scale, Clipmap};
+use shadowlab_core::params::Auto;
+use shadowlab_core::techniques::virtual_sm::Clipmap;
 
 use super::bounds::chunk_count;
 use super::draw::DYNAMIC_CHUNK_TRIANGLES;
@@ -34,7 +35,8 @@ pub(super) struct Setup {
     pub virtual_res: u32,
     pub page_res: u32,
     pub extent0: f32,
-    pub bias_scale: f32,
+    /// `resolution_bias`: a fixed bias, or `auto` (chosen per frame).
+    pub lod: Auto,
     /// Texels marked around a sample: the kernel, the normal offset's sideways shift, one texel
     /// of rounding.
     pub reach: f32,
@@ -71,7 +73,7 @@ pub(super) fn plan(gpu: &Gpu, scene: &GpuScene, p: &VirtualSettings, light: &Lig
         virtual_res,
         page_res,
         extent0,
-        bias_scale: bias_scale(p.resolution_bias as f32),
+        lod: p.resolution_bias,
         reach: kernel_half + p.bias.normal_offset as f32 + 1.0,
         pages_per_side,
         table_len: (proto.levels * pages_per_side * pages_per_side) as u64,
