@@ -67,8 +67,6 @@ pub const NORMAL_OFFSET: ParamDef = ParamDef::number(
     "Holbert 2011 (normal offset shadows); value from the shadowlab sweep",
 );
 
-/// The whole bias family at its shared defaults, in listing order.
-pub const BIAS_FAMILY: [ParamDef; 4] = [BIAS, SLOPE_BIAS, MAX_SLOPE, NORMAL_OFFSET];
 
 crate::param_set! {
     /// The bias family as one block: constant, slope-scaled (with its clamp) and normal offset,
