@@ -12,7 +12,7 @@ pub const DEFAULT_RES: f64 = 512.0;
 // res 512, 512x512 output) on courtyard, room, foliage and sponza, 2026-11-22: (0.5, 0, 0.5) was
 // within 0.1 point of the best wrong-pixel rate on every scene; any slope bias added light leaks
 // under ledges (sponza 1.62 % -> 2.58 % with slope 1) because the normal offset already grows
-// with the slope. See BENCHMARKS.md.
+// with the slope. See docs/bench/sm.md ("Bias defaults").
 /// Constant bias (texels along the light). Too low: acne on lit surfaces; too high: peter-panning.
 pub const DEFAULT_BIAS: f64 = 0.5;
 /// Slope-scaled bias (texels x tan of the light angle, clamped at `max_slope`). Off by default:
@@ -40,7 +40,7 @@ pub const BIAS: ParamDef = ParamDef::number(
     0.0,
     100.0,
     "constant depth bias, texels; low: acne, high: peter-panning",
-    "shadowlab sweep 2026-11-22 (BENCHMARKS.md)",
+    "shadowlab sweep 2026-11-22 (docs/bench/sm.md)",
 );
 pub const SLOPE_BIAS: ParamDef = ParamDef::number(
     "slope_bias",
