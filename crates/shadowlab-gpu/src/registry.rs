@@ -131,3 +131,30 @@ pub fn default_compare() -> Vec<String> {
     }
     v
 }
+
+/// Spec checks for the techniques' unit tests (no GPU).
+#[cfg(test)]
+pub(crate) mod testing {
+    use shadowlab_core::params::{ParamDef, TechniqueSpec};
+
+    use super::{resolve, Resolved};
+    use crate::GpuError;
+
+    /// `spec`, which must resolve.
+    pub fn ok(spec: &str) -> Resolved {
+        resolve(&TechniqueSpec::parse(spec).unwrap(), None).unwrap_or_else(|e| panic!("{spec}: {e}"))
+    }
+
+    /// The error of `spec`, which must not resolve.
+    pub fn err(spec: &str) -> String {
+        match resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
+            Err(GpuError::Invalid(m)) => m,
+            other => panic!("{spec}: {other:?}"),
+        }
+    }
+
+    /// A table's keys, in listing order.
+    pub fn keys(defs: &[ParamDef]) -> Vec<&'static str> {
+        defs.iter().map(|d| d.key).collect()
+    }
+}

@@ -161,26 +161,10 @@ impl CsmSettings {
 
 #[cfg(test)]
 mod tests {
-    use shadowlab_core::params::{ParamSet, TechniqueSpec};
+    use shadowlab_core::params::ParamSet;
 
     use super::*;
-    use crate::registry::{resolve, Resolved};
-    use crate::GpuError;
-
-    fn keys(defs: &[ParamDef]) -> Vec<&'static str> {
-        defs.iter().map(|d| d.key).collect()
-    }
-
-    fn ok(spec: &str) -> Resolved {
-        resolve(&TechniqueSpec::parse(spec).unwrap(), None).unwrap_or_else(|e| panic!("{spec}: {e}"))
-    }
-
-    fn err(spec: &str) -> String {
-        match resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
-            Err(GpuError::Invalid(m)) => m,
-            other => panic!("{spec}: {other:?}"),
-        }
-    }
+    use crate::registry::testing::{err, ok, keys};
 
     #[test]
     fn csm_lists_its_keys_as_before() {

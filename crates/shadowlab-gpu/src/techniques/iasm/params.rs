@@ -102,22 +102,10 @@ shadowlab_core::param_set! {
 
 #[cfg(test)]
 mod tests {
-    use shadowlab_core::params::{ParamSet, TechniqueSpec};
+    use shadowlab_core::params::ParamSet;
 
     use super::*;
-    use crate::registry::{resolve, Resolved};
-    use crate::GpuError;
-
-    fn ok(spec: &str) -> Resolved {
-        resolve(&TechniqueSpec::parse(spec).unwrap(), None).unwrap_or_else(|e| panic!("{spec}: {e}"))
-    }
-
-    fn err(spec: &str) -> String {
-        match resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
-            Err(GpuError::Invalid(m)) => m,
-            other => panic!("{spec}: {other:?}"),
-        }
-    }
+    use crate::registry::testing::{err, ok};
 
     #[test]
     fn iasm_lists_its_keys_as_before_and_reads_them_typed() {
