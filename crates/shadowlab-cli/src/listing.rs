@@ -33,7 +33,8 @@ pub fn techniques() -> Result<()> {
         println!("  source:  {}", t.source);
         println!("  stalls:  {}", if t.stalls.is_empty() { "none: a frame records into one submit" } else { t.stalls });
         println!("  needs:   {}", if t.needs.is_empty() { "WebGPU's default features and limits" } else { t.needs });
-        let runs: Vec<String> = t.compare.iter().map(|a| if a.is_empty() { t.name.to_string() } else { format!("{}:{a}", t.name) }).collect();
+        let runs: Vec<String> =
+            t.compare.iter().map(|a| if a.is_empty() { t.name.to_string() } else { format!("{}:{a}", t.name) }).collect();
         println!("  compare: {}", if runs.is_empty() { "not in the default set".to_string() } else { runs.join(", ") });
         if t.params().is_empty() {
             println!("  parameters: none");

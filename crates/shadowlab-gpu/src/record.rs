@@ -270,7 +270,12 @@ pub struct Driven {
 /// Records one frame with `record` into a fresh encoder labelled `label`, submits it once and
 /// waits. The commands are submitted even when `record` fails part way (what it recorded is
 /// valid), and then its error is returned.
-pub fn drive(gpu: &Gpu, label: &str, clock: Clock, record: impl FnOnce(&mut Recorder) -> Result<(), crate::GpuError>) -> Result<Driven, crate::GpuError> {
+pub fn drive(
+    gpu: &Gpu,
+    label: &str,
+    clock: Clock,
+    record: impl FnOnce(&mut Recorder) -> Result<(), crate::GpuError>,
+) -> Result<Driven, crate::GpuError> {
     let t0 = Instant::now();
     let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
     let mut rec = match clock {

@@ -2,7 +2,6 @@
 //! maps' subdivision, given too few pieces, draws a level unsplit (coarser, flagged as
 //! degraded) instead of dropping whichever pieces lose the race of the atomics.
 
-
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::params::TechniqueSpec;
 use shadowlab_gpu::lab::{Lab, Run};

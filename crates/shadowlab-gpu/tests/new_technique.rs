@@ -5,7 +5,6 @@
 //! a box) `height=-1` lights every evaluated pixel and `height=100` none, and `rt`'s shadowed
 //! pixels are exactly the first one's false-lit pixels.
 
-
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::metrics::compare;
 use shadowlab_core::params::{ParamDef, ParamSet, ParamTable, TechniqueSpec};

@@ -17,7 +17,15 @@ fn tables_are_well_formed_and_resolve_at_their_defaults() {
         for p in t.params() {
             assert!(keys.insert(p.key), "{}: '{}' declared twice", t.name, p.key);
             let auto = p.kind == Kind::AutoNumber && p.default.is_nan();
-            assert!(auto || (p.min <= p.default && p.default <= p.max), "{}: {} default {} outside [{}, {}]", t.name, p.key, p.default, p.min, p.max);
+            assert!(
+                auto || (p.min <= p.default && p.default <= p.max),
+                "{}: {} default {} outside [{}, {}]",
+                t.name,
+                p.key,
+                p.default,
+                p.min,
+                p.max
+            );
             assert!(!p.doc.is_empty() && !p.source.is_empty(), "{}: {} needs a doc and a source", t.name, p.key);
             if let Kind::Choice(names) = p.kind {
                 assert!((p.default as usize) < names.len(), "{}: {}", t.name, p.key);
@@ -121,7 +129,8 @@ fn no_technique_reads_values_by_key() {
 fn every_technique_folder_is_in_the_registry() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut defined: Vec<(String, String)> = Vec::new();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("techniques")).unwrap().map(|e| e.unwrap().path()).filter(|p| p.is_dir()).collect();
+    let mut dirs: Vec<PathBuf> =
+        std::fs::read_dir(root.join("techniques")).unwrap().map(|e| e.unwrap().path()).filter(|p| p.is_dir()).collect();
     dirs.push(root.join("reference"));
     for dir in dirs {
         for f in sources(&dir) {

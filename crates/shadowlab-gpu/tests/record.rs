@@ -2,7 +2,6 @@
 //! stalls is one submit, and the lab's analysis passes (outside the timed frame) leave the
 //! visibility bit for bit as the timed frame wrote it.
 
-
 use shadowlab_core::builtin::builtin;
 use shadowlab_core::params::ParamValues;
 use shadowlab_gpu::lab::Lab;

@@ -25,7 +25,14 @@ pub fn summary(m: &Metrics) {
     for t in &m.techniques {
         println!(
             "{:<28} {:>8.3} {:>9.3} {:>9.3} {:>8.4} {:>7.4} {:>10.2} {:>12}",
-            t.label, t.quality.wrong_pct, t.quality.false_lit_pct, t.quality.false_shadow_pct, t.quality.mae, t.flip_mean, t.total_ms, t.shadow_data_bytes
+            t.label,
+            t.quality.wrong_pct,
+            t.quality.false_lit_pct,
+            t.quality.false_shadow_pct,
+            t.quality.mae,
+            t.flip_mean,
+            t.total_ms,
+            t.shadow_data_bytes
         );
     }
     println!("times: median of {} frames, {}", m.repeat, m.timer);

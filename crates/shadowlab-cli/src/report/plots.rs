@@ -107,7 +107,8 @@ mod tests {
 pub fn tradeoff_charts(metrics: &Metrics) -> Result<Vec<(String, String, Vec<String>)>> {
     use super::scatter::{svg, Point};
     type Cost = (&'static str, fn(&crate::metrics::Technique) -> Option<f64>);
-    let costs: [Cost; 2] = [("total ms (timed frame)", |t| Some(t.total_ms)), ("texel fetches per pixel", |t| t.counters.get("fetches_per_pixel").copied())];
+    let costs: [Cost; 2] =
+        [("total ms (timed frame)", |t| Some(t.total_ms)), ("texel fetches per pixel", |t| t.counters.get("fetches_per_pixel").copied())];
     let mut out = Vec::new();
     for (name, cost) in costs {
         let (mut points, mut missing) = (Vec::new(), Vec::new());

@@ -6,7 +6,6 @@
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 
-
 /// Indices of the points (cost, quality) on the Pareto front, both minimised: no other point
 /// is at most as costly and at most as wrong, and better in one. Sorted by cost, then quality;
 /// equal points are all on the front; non-finite points are never on it.

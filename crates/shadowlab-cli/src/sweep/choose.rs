@@ -203,7 +203,6 @@ mod tests {
         assert_eq!((a[1].label.as_str(), a[1].setups, a[1].mean_wrong_pct), ("lt", 1, 1.0));
     }
 
-
     fn aggs() -> Vec<Aggregate> {
         let rows = vec![
             row("a", "cheap", 5.0, 2.0, 1 << 20),

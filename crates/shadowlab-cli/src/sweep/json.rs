@@ -52,4 +52,3 @@ impl Sweep {
         serde_json::to_string_pretty(&serde_json::to_value(self)?)
     }
 }
-

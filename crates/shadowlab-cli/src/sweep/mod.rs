@@ -29,8 +29,8 @@ use shadowlab_gpu::Gpu;
 use args::{SweepArgs, SweepCli, SweepCommand};
 use cache::SweepDir;
 use choose::{aggregate, recommend, Budget};
-use plan::{Common, SetupInput};
 use json::Sweep;
+use plan::{Common, SetupInput};
 use record::{PlanEntry, PointFile, Row, SetupInfo, Shard, SCHEMA_VERSION};
 
 /// `shadowlab sweep` and `shadowlab sweep merge`.

@@ -8,7 +8,6 @@ use serde::{Deserialize, Serialize};
 use shadowlab_core::metrics::ErrorMetrics;
 use shadowlab_core::params::ParamValues;
 
-
 /// Version of sweep.json's and the point files' layout; raised with any change to it.
 /// 2: `flip_mean` in rows, `mean_flip_mean`/`worst_flip_mean` in aggregates.
 pub const SCHEMA_VERSION: u32 = 2;
@@ -187,7 +186,13 @@ pub mod tests {
             label: label.into(),
             technique: label.split(':').next().unwrap().into(),
             params: ParamValues::default(),
-            quality: ErrorMetrics { wrong_pct: wrong, false_lit_pct: wrong / 2.0, false_shadow_pct: wrong / 2.0, mae: wrong / 100.0, evaluated_pixels: 100 },
+            quality: ErrorMetrics {
+                wrong_pct: wrong,
+                false_lit_pct: wrong / 2.0,
+                false_shadow_pct: wrong / 2.0,
+                mae: wrong / 100.0,
+                evaluated_pixels: 100,
+            },
             flip_mean: wrong / 20.0,
             flicker_pct: None,
             total_ms: ms,

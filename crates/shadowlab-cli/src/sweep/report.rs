@@ -7,9 +7,9 @@ use anyhow::Result;
 use minijinja::context;
 
 use super::choose::Aggregate;
-use crate::report::scatter::pareto_front;
 use super::json::Sweep;
 use super::record::Row;
+use crate::report::scatter::pareto_front;
 use crate::report::scatter::{self, Point};
 
 const TEMPLATE: &str = include_str!("sweep.html.j2");

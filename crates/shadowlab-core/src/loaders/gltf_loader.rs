@@ -142,7 +142,8 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
             let data = match cache.entry(key) {
                 Entry::Occupied(e) => e.into_mut(),
                 Entry::Vacant(e) => e.insert(
-                    read_primitive(&prim, &buffers).map_err(|e| fail(format!("meshes[{}].primitives[{}]: {e}", mesh.index(), prim.index())))?,
+                    read_primitive(&prim, &buffers)
+                        .map_err(|e| fail(format!("meshes[{}].primitives[{}]: {e}", mesh.index(), prim.index())))?,
                 ),
             };
             let material = match prim.material().index() {
@@ -463,8 +464,9 @@ fn read_components<T: Copy + Default>(acc: &gltf::Accessor, buffers: &[Vec<u8>],
 }
 
 fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Vec<u8>]) -> Result<&'b [u8], String> {
-    let buf =
-        buffers.get(view.buffer().index()).ok_or_else(|| format!("bufferViews[{}]: no buffers[{}]", view.index(), view.buffer().index()))?;
+    let buf = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("bufferViews[{}]: no buffers[{}]", view.index(), view.buffer().index()))?;
     let end = view.offset().checked_add(view.length());
     match end {
         Some(end) if end <= buf.len() => Ok(&buf[view.offset()..end]),

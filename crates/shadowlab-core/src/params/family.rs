@@ -67,7 +67,6 @@ pub const NORMAL_OFFSET: ParamDef = ParamDef::number(
     "Holbert 2011 (normal offset shadows); value from the shadowlab sweep",
 );
 
-
 crate::param_set! {
     /// The bias family as one block: constant, slope-scaled (with its clamp) and normal offset,
     /// in texels of the technique's map.

@@ -135,14 +135,10 @@ impl ParamDef {
             }
             Kind::AutoNumber if text == AUTO => Ok(Value::Choice(AUTO.to_string())),
             Kind::Number | Kind::Integer | Kind::AutoNumber => {
-                let x: f64 = text
-                    .parse()
-                    .ok()
-                    .filter(|x: &f64| x.is_finite())
-                    .ok_or_else(|| {
-                        let auto = if self.kind == Kind::AutoNumber { " (or auto)" } else { "" };
-                        format!("technique '{technique}': {k}={text} is not a number{auto}")
-                    })?;
+                let x: f64 = text.parse().ok().filter(|x: &f64| x.is_finite()).ok_or_else(|| {
+                    let auto = if self.kind == Kind::AutoNumber { " (or auto)" } else { "" };
+                    format!("technique '{technique}': {k}={text} is not a number{auto}")
+                })?;
                 let integer = self.kind == Kind::Integer;
                 if integer && x.fract() != 0.0 {
                     return Err(format!("technique '{technique}': {k}={text} must be a whole number"));

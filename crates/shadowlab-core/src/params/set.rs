@@ -151,7 +151,9 @@ pub fn declare_choice(d: ParamDef, names: &'static [&'static str], field: &'stat
 /// For [`param_choice!`]: the index of the chosen name.
 pub fn read_choice(v: &ParamValues, names: &[&str], field: &'static str) -> usize {
     match value(v, field) {
-        Value::Choice(s) => names.iter().position(|n| n == s).unwrap_or_else(|| panic!("parameter '{field}': '{s}' is not one of {names:?}")),
+        Value::Choice(s) => {
+            names.iter().position(|n| n == s).unwrap_or_else(|| panic!("parameter '{field}': '{s}' is not one of {names:?}"))
+        }
         x => panic!("parameter '{field}' is {x:?}, not a choice"),
     }
 }
@@ -189,7 +191,14 @@ pub fn check_table(set: &str, rows: &[ParamDef]) {
     for (i, d) in rows.iter().enumerate() {
         assert!(rows[..i].iter().all(|o| o.key != d.key), "{set}: '{}' declared twice", d.key);
         let auto = d.kind == Kind::AutoNumber && d.default.is_nan();
-        assert!(auto || (d.min <= d.default && d.default <= d.max), "{set}: {} default {} outside [{}, {}]", d.key, d.default, d.min, d.max);
+        assert!(
+            auto || (d.min <= d.default && d.default <= d.max),
+            "{set}: {} default {} outside [{}, {}]",
+            d.key,
+            d.default,
+            d.min,
+            d.max
+        );
         assert!(!d.doc.is_empty() && !d.source.is_empty(), "{set}: {} needs a doc and a source", d.key);
     }
 }

@@ -82,7 +82,13 @@ mod tests {
     fn rec(frame: usize, wrong: f64, ms: f64, flicker: Option<f64>) -> FrameRecord {
         FrameRecord {
             frame,
-            quality: ErrorMetrics { wrong_pct: wrong, false_lit_pct: wrong, false_shadow_pct: 0.0, mae: wrong / 100.0, evaluated_pixels: 100 },
+            quality: ErrorMetrics {
+                wrong_pct: wrong,
+                false_lit_pct: wrong,
+                false_shadow_pct: 0.0,
+                mae: wrong / 100.0,
+                evaluated_pixels: 100,
+            },
             flip_mean: wrong / 10.0,
             rays_traced: None,
             edge_pixels: 3,

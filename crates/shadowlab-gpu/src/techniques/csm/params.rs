@@ -164,7 +164,7 @@ mod tests {
     use shadowlab_core::params::ParamSet;
 
     use super::*;
-    use crate::registry::testing::{err, ok, keys};
+    use crate::registry::testing::{err, keys, ok};
 
     #[test]
     fn csm_lists_its_keys_as_before() {

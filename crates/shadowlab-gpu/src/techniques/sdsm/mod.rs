@@ -119,7 +119,7 @@ mod tests {
     use shadowlab_core::params::ParamSet;
 
     use super::SdsmSettings;
-    use crate::registry::testing::{err, ok, keys};
+    use crate::registry::testing::{err, keys, ok};
 
     #[test]
     fn sdsm_lists_its_keys_as_before() {

@@ -44,7 +44,9 @@ mod uniforms;
 use shadowlab_core::light::Light;
 use shadowlab_core::params::{Auto, ParamSet, ParamTable};
 use shadowlab_core::scene::Bounds;
-use shadowlab_core::techniques::virtual_sm::{bias_scale, pixel_angle, Allocation, AutoLod, Build, Clipmap, PageCache, PageKey, StaticCopies};
+use shadowlab_core::techniques::virtual_sm::{
+    bias_scale, pixel_angle, Allocation, AutoLod, Build, Clipmap, PageCache, PageKey, StaticCopies,
+};
 
 use allocate::Pages;
 use draw::Chunks;

@@ -4,8 +4,8 @@
 //! chunks of moving triangles. The errors of creation are returned here.
 
 use shadowlab_core::light::Light;
-use shadowlab_core::params::ParamSet;
 use shadowlab_core::params::Auto;
+use shadowlab_core::params::ParamSet;
 use shadowlab_core::techniques::virtual_sm::Clipmap;
 
 use super::bounds::chunk_count;
