@@ -135,7 +135,7 @@ pub fn default_compare() -> Vec<String> {
 /// Spec checks for the techniques' unit tests (no GPU).
 #[cfg(test)]
 pub(crate) mod testing {
-    use shadowlab_core::params::{ParamDef, TechniqueSpec};
+    use shadowlab_core::params::{ParamDef, ParamSet, TechniqueSpec};
 
     use super::{resolve, Resolved};
     use crate::GpuError;
@@ -156,5 +156,24 @@ pub(crate) mod testing {
     /// A table's keys, in listing order.
     pub fn keys(defs: &[ParamDef]) -> Vec<&'static str> {
         defs.iter().map(|d| d.key).collect()
+    }
+
+    /// The keys of `P`'s table, in listing order.
+    pub fn set_keys<P: ParamSet>() -> Vec<&'static str> {
+        keys(P::defs())
+    }
+
+    /// `spec` resolved (the rules applied), or its error text.
+    pub fn check(spec: &str) -> Result<(), String> {
+        match resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
+            Ok(_) => Ok(()),
+            Err(GpuError::Invalid(m)) => Err(m),
+            Err(e) => panic!("{spec}: {e:?}"),
+        }
+    }
+
+    /// [`check`]'s error for `spec`, or "" when it resolves.
+    pub fn error(spec: &str) -> String {
+        check(spec).err().unwrap_or_default()
     }
 }

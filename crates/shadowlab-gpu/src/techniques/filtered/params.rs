@@ -167,14 +167,8 @@ shadowlab_core::param_set! {
 
 #[cfg(test)]
 mod tests {
-    use shadowlab_core::params::{ParamSet, TechniqueSpec};
-
     use super::{EsmSettings, EvsmSettings, MsmSettings, VsmSettings};
-    use crate::GpuError;
-
-    fn keys<P: ParamSet>() -> Vec<&'static str> {
-        P::defs().iter().map(|d| d.key).collect()
-    }
+    use crate::registry::testing::{check as resolve, set_keys as keys};
 
     /// The tables as listed before the typed sets (`shadowlab techniques`).
     #[test]
@@ -183,14 +177,6 @@ mod tests {
         assert_eq!(keys::<EsmSettings>(), ["res", "blur", "sd", "mips", "bias", "normal_offset", "c"]);
         assert_eq!(keys::<EvsmSettings>(), ["res", "blur", "sd", "mips", "bias", "normal_offset", "min_variance", "c_pos", "c_neg"]);
         assert_eq!(keys::<MsmSettings>(), ["res", "blur", "sd", "mips", "bias", "normal_offset", "moment_bias"]);
-    }
-
-    fn resolve(spec: &str) -> Result<(), String> {
-        match crate::registry::resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
-            Ok(_) => Ok(()),
-            Err(GpuError::Invalid(msg)) => Err(msg),
-            Err(e) => panic!("{spec}: {e:?}"),
-        }
     }
 
     #[test]

@@ -290,14 +290,8 @@ impl Variant {
 
 #[cfg(test)]
 mod tests {
-    use shadowlab_core::params::{ParamSet, TechniqueSpec};
-
     use super::{HybridSettings, LtSettings, LttSettings};
-    use crate::GpuError;
-
-    fn keys<P: ParamSet>() -> Vec<&'static str> {
-        P::defs().iter().map(|d| d.key).collect()
-    }
+    use crate::registry::testing::{check as resolve, set_keys as keys};
 
     /// The tables as listed before the typed sets (`shadowlab techniques`).
     #[test]
@@ -340,14 +334,6 @@ mod tests {
         ];
         assert_eq!(keys::<LttSettings>(), ltt);
         assert_eq!(keys::<HybridSettings>(), ["res", "cascades", "lambda", "enlarge", "reuse", "force_all", "bias", "normal_offset"]);
-    }
-
-    fn resolve(spec: &str) -> Result<(), String> {
-        match crate::registry::resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
-            Ok(_) => Ok(()),
-            Err(GpuError::Invalid(msg)) => Err(msg),
-            Err(e) => panic!("{spec}: {e:?}"),
-        }
     }
 
     #[test]

@@ -245,7 +245,7 @@ impl Resources {
         Resources {
             warp_x: r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1),
             warp_y: r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1),
-            map: depth_map(gpu, &format!("{name}.map"), res),
+            map: raster::depth_target(gpu, &format!("{name}.map"), res, res, 1, wgpu::TextureUsages::empty()),
             work: gpu.storage(&format!("{name}.work"), if scratch { (3 * n + 2 * res as u64) * 4 } else { 4 }),
             fwork: gpu.storage(&format!("{name}.fwork"), if scratch { (3 * n + 3 * res as u64) * 4 } else { 4 }),
             pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
@@ -284,20 +284,6 @@ fn r32_texture(gpu: &Gpu, label: &str, w: u32, h: u32) -> wgpu::Texture {
         dimension: wgpu::TextureDimension::D2,
         format: wgpu::TextureFormat::R32Float,
         usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
-}
-
-/// The warped shadow map: `res x res` depth, rendered, sampled and read back.
-fn depth_map(gpu: &Gpu, label: &str, res: u32) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: raster::DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
 }

@@ -199,24 +199,8 @@ shadowlab_core::param_set! {
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use shadowlab_core::params::{ParamSet, TechniqueSpec};
-
     use super::*;
-    use crate::GpuError;
-
-    /// The keys of `P`'s table, in listing order.
-    pub(crate) fn keys<P: ParamSet>() -> Vec<&'static str> {
-        P::defs().iter().map(|d| d.key).collect()
-    }
-
-    /// `registry::resolve`'s error for `spec` (which applies the rules), or "" if it resolves.
-    pub(crate) fn error(spec: &str) -> String {
-        match crate::registry::resolve(&TechniqueSpec::parse(spec).unwrap(), None) {
-            Ok(_) => String::new(),
-            Err(GpuError::Invalid(m)) => m,
-            Err(e) => panic!("{spec}: {e}"),
-        }
-    }
+    pub(crate) use crate::registry::testing::{error, set_keys as keys};
 
     #[test]
     fn the_tables_keep_their_keys_in_order() {
