@@ -3,8 +3,8 @@
 //! that `rt.wgsl` traverses, plus the CPU traversal of the same nodes that cross-checks the GPU.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec2, Vec3, Vec3A};
-use obvhs::{bvh2::builder::build_bvh2_from_tris, triangle::Triangle, BvhBuildParams};
+use glam::{Vec2, Vec3};
+use obvhs::{aabb::Aabb, bvh2::builder::build_bvh2, bvh2::Bvh2, BvhBuildParams};
 use rayon::prelude::*;
 
 use crate::light::Light;
@@ -46,30 +46,29 @@ impl Bvh {
     }
 
     /// BVH over `tris`; triangle `k` gets primitive index `first + k`.
+    ///
+    /// Triangles with bit-identical bounding boxes (duplicated faces, zero-area triangles at one
+    /// point), more than [`LEAF_PRIMS`] of them, are one primitive of the `obvhs` build: its
+    /// PLOC clustering merges one pair of equal boxes per pass, so thousands of copies made the
+    /// build quadratic and the tree as deep as the copies. Each such group is spread afterwards
+    /// over a balanced subtree with leaves of at most [`LEAF_PRIMS`] ([`expand`]). Without such
+    /// repeats the tree is the plain `obvhs` build, node for node.
     pub fn from_triangles(tris: &[[Vec3; 3]], first: u32) -> Result<Bvh, String> {
         let t0 = std::time::Instant::now();
-        let tris: Vec<Triangle> =
-            tris.iter().map(|[a, b, c]| Triangle { v0: Vec3A::from(*a), v1: Vec3A::from(*b), v2: Vec3A::from(*c) }).collect();
         if tris.is_empty() {
             return Err("scene has no triangles".into());
         }
+        let boxes: Vec<Aabb> = tris.iter().map(|&[a, b, c]| Aabb::from_points(&[a.into(), b.into(), c.into()])).collect();
+        let groups = Groups::of(&boxes);
         let mut core = std::time::Duration::ZERO;
-        let b = build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut core);
-        let nodes: Vec<BvhNode> = b
-            .nodes
-            .iter()
-            .map(|n| BvhNode {
-                min: Vec3::from(n.aabb.min).into(),
-                prim_count: n.prim_count,
-                max: Vec3::from(n.aabb.max).into(),
-                first_index: n.first_index,
-            })
-            .collect();
+        let reps: Vec<Aabb> = groups.starts.iter().map(|&s| boxes[groups.members[s as usize] as usize]).collect();
+        let b = build_bvh2(&reps, BvhBuildParams::medium_build(), &mut core);
+        let (nodes, local) = expand(&b, &groups, &boxes);
         let depth = tree_depth(&nodes);
         if depth >= MAX_DEPTH {
             return Err(format!("BVH depth {depth} exceeds the traversal stack ({MAX_DEPTH})"));
         }
-        let prim_indices = b.primitive_indices.iter().map(|i| i + first).collect();
+        let prim_indices = local.iter().map(|i| i + first).collect();
         Ok(Bvh { nodes, prim_indices, depth, build_ms: t0.elapsed().as_secs_f64() * 1e3 })
     }
 
@@ -102,6 +101,110 @@ impl Bvh {
     pub fn bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<BvhNode>() + self.prim_indices.len() * 4
     }
+}
+
+/// Most primitives in a leaf made by [`expand`] (the `obvhs` build's own limit).
+pub const LEAF_PRIMS: usize = 8;
+
+/// Triangles grouped for the `obvhs` build, in order of first appearance: a bounding box that
+/// more than [`LEAF_PRIMS`] triangles share bit for bit is one group, every other triangle is a
+/// group of its own (the two halves of a quad share a box; a handful of copies does not hurt
+/// the build). Group `g` is `members[starts[g] .. starts[g + 1]]` (triangle indices, ascending).
+struct Groups {
+    starts: Vec<u32>,
+    members: Vec<u32>,
+}
+
+impl Groups {
+    fn of(boxes: &[Aabb]) -> Groups {
+        let key = |b: &Aabb| {
+            let (lo, hi) = (b.min.to_array(), b.max.to_array());
+            [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(f32::to_bits)
+        };
+        // per repeated box: (copies, its group once given)
+        let mut shared: std::collections::HashMap<[u32; 6], (usize, u32)> = std::collections::HashMap::new();
+        for b in boxes {
+            shared.entry(key(b)).or_insert((0, u32::MAX)).0 += 1;
+        }
+        shared.retain(|_, (n, _)| *n > LEAF_PRIMS);
+        let mut count = 0u32;
+        let group: Vec<u32> = boxes
+            .iter()
+            .map(|b| {
+                let g = match shared.get_mut(&key(b)) {
+                    Some((_, g)) if *g != u32::MAX => return *g,
+                    Some((_, g)) => {
+                        *g = count;
+                        count
+                    }
+                    None => count,
+                };
+                count += 1;
+                g
+            })
+            .collect();
+        // counting sort of the triangles by group (stable: ascending within a group)
+        let groups = count as usize;
+        let mut starts = vec![0u32; groups + 1];
+        for &g in &group {
+            starts[g as usize + 1] += 1;
+        }
+        for g in 0..groups {
+            starts[g + 1] += starts[g];
+        }
+        let mut next = starts.clone();
+        let mut members = vec![0u32; boxes.len()];
+        for (t, &g) in group.iter().enumerate() {
+            members[next[g as usize] as usize] = t as u32;
+            next[g as usize] += 1;
+        }
+        starts.pop();
+        Groups { starts, members }
+    }
+
+    fn members(&self, g: u32) -> &[u32] {
+        let s = self.starts[g as usize] as usize;
+        let e = self.starts.get(g as usize + 1).map_or(self.members.len(), |&e| e as usize);
+        &self.members[s..e]
+    }
+}
+
+/// The `obvhs` tree over group representatives as [`BvhNode`]s over triangles, node for node
+/// in the same order: a leaf whose groups hold at most [`LEAF_PRIMS`] triangles in all stays a
+/// leaf; a larger one becomes a balanced subtree over its triangles (halved by count, so its
+/// depth grows with the log of the copies), its nodes appended. Returns the nodes and the
+/// triangles in leaf order (without repeated boxes: exactly the `obvhs` tree and order).
+fn expand(b: &Bvh2, groups: &Groups, boxes: &[Aabb]) -> (Vec<BvhNode>, Vec<u32>) {
+    let node = |aabb: &Aabb, prim_count: u32, first_index: u32| BvhNode {
+        min: Vec3::from(aabb.min).into(),
+        prim_count,
+        max: Vec3::from(aabb.max).into(),
+        first_index,
+    };
+    let mut nodes: Vec<BvhNode> = b.nodes.iter().map(|n| node(&n.aabb, n.prim_count, n.first_index)).collect();
+    let mut leaves: Vec<usize> = (0..b.nodes.len()).filter(|&i| b.nodes[i].prim_count > 0).collect();
+    leaves.sort_by_key(|&i| b.nodes[i].first_index);
+    let mut prims: Vec<u32> = Vec::with_capacity(boxes.len());
+    for leaf in leaves {
+        let n = &b.nodes[leaf];
+        let reps = &b.primitive_indices[n.first_index as usize..(n.first_index + n.prim_count) as usize];
+        let mut work = vec![(leaf, reps.iter().flat_map(|&g| groups.members(g)).copied().collect::<Vec<u32>>())];
+        while let Some((slot, mut tris)) = work.pop() {
+            let aabb = tris.iter().fold(Aabb::empty(), |a, &t| a.union(&boxes[t as usize]));
+            if tris.len() <= LEAF_PRIMS {
+                nodes[slot] = node(&aabb, tris.len() as u32, prims.len() as u32);
+                prims.extend(&tris);
+                continue;
+            }
+            let c = nodes.len();
+            nodes.extend([BvhNode::default(); 2]);
+            nodes[slot] = node(&aabb, 0, c as u32);
+            let right = tris.split_off(tris.len() / 2);
+            work.push((c + 1, right));
+            work.push((c, tris));
+        }
+    }
+    (nodes, prims)
 }
 
 fn tree_depth(nodes: &[BvhNode]) -> usize {
@@ -328,5 +431,106 @@ mod tests {
             disagreements += (brute != occluded(&bvh, &s, &r)) as u32;
         }
         assert_eq!(disagreements, 0);
+    }
+
+    fn copies(tri: [Vec3; 3], n: usize) -> Vec<[Vec3; 3]> {
+        vec![tri; n]
+    }
+
+    fn is_permutation(prims: &[u32], first: u32, n: usize) -> bool {
+        let mut p = prims.to_vec();
+        p.sort_unstable();
+        p.iter().copied().eq(first..first + n as u32)
+    }
+
+    #[test]
+    fn without_repeated_boxes_the_tree_is_obvhs_own() {
+        let s = builtin("courtyard").unwrap();
+        let tris: Vec<[Vec3; 3]> = (0..s.triangle_count()).map(|i| s.triangle(i)).collect();
+        let ours = Bvh::from_triangles(&tris, 5).unwrap();
+        let plain: Vec<obvhs::triangle::Triangle> =
+            tris.iter().map(|[a, b, c]| obvhs::triangle::Triangle { v0: (*a).into(), v1: (*b).into(), v2: (*c).into() }).collect();
+        let b = obvhs::bvh2::builder::build_bvh2_from_tris(&plain, BvhBuildParams::medium_build(), &mut Default::default());
+        assert_eq!(ours.nodes.len(), b.nodes.len());
+        for (o, n) in ours.nodes.iter().zip(&b.nodes) {
+            assert_eq!((o.prim_count, o.first_index), (n.prim_count, n.first_index));
+            assert_eq!((o.min, o.max), (Vec3::from(n.aabb.min).into(), Vec3::from(n.aabb.max).into()));
+        }
+        assert!(ours.prim_indices.iter().copied().eq(b.primitive_indices.iter().map(|i| i + 5)));
+    }
+
+    #[test]
+    fn coincident_triangles_build_a_balanced_tree() {
+        // 100,000 copies of one triangle (a duplicated face): the plain PLOC build merged one
+        // pair per pass (quadratic, and as deep as the copies)
+        let n = 100_000;
+        let tri = [Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0)];
+        let bvh = Bvh::from_triangles(&copies(tri, n), 0).unwrap();
+        // a balanced tree over n / LEAF_PRIMS leaves: 14 levels, plus the root
+        let balanced = (n as f64 / LEAF_PRIMS as f64).log2().ceil() as usize + 1;
+        assert!(bvh.depth <= balanced + 1, "depth {} for {n} copies", bvh.depth);
+        assert!(bvh.nodes.len() <= Bvh::max_nodes(n));
+        assert!(is_permutation(&bvh.prim_indices, 0, n));
+        assert!(bvh.nodes.iter().all(|b| b.prim_count as usize <= LEAF_PRIMS));
+    }
+
+    #[test]
+    fn zero_area_and_mixed_repeats_build() {
+        // zero-area triangles at one point and along one segment, repeated groups beside
+        // distinct triangles: every triangle in exactly one leaf, boxes hold their triangles
+        let mut tris = Vec::new();
+        let p = Vec3::new(2.0, 0.5, -1.0);
+        tris.extend(copies([p, p, p], 20_000));
+        tris.extend(copies([p, p + Vec3::X, p + Vec3::X * 0.5], 20_000));
+        for i in 0..2_000u32 {
+            let h = |k: u32| crate::builtin::hash01(i * 5 + k);
+            let o = Vec3::new(h(1), h(2), h(3)) * 10.0;
+            let t = [o, o + Vec3::new(0.3, 0.0, 0.1), o + Vec3::new(0.0, 0.2, 0.3)];
+            tris.extend(copies(t, 1 + (i % 7) as usize));
+        }
+        let bvh = Bvh::from_triangles(&tris, 3).unwrap();
+        assert!(bvh.depth < 40, "depth {}", bvh.depth);
+        assert!(is_permutation(&bvh.prim_indices, 3, tris.len()));
+        for n in bvh.nodes.iter().filter(|n| n.prim_count > 0) {
+            for &p in &bvh.prim_indices[n.first_index as usize..(n.first_index + n.prim_count) as usize] {
+                for v in tris[(p - 3) as usize] {
+                    assert!(Vec3::from(n.min).cmple(v).all() && v.cmple(Vec3::from(n.max)).all());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn coincident_scene_agrees_with_brute_force() {
+        // planebox with its box's top face repeated 3,000 times and 500 zero-area triangles
+        let mut s = builtin("planebox").unwrap();
+        let top = (0..s.triangle_count()).find(|&t| s.triangle(t).iter().all(|v| v.y == 1.0)).unwrap();
+        let face = s.vertices[3 * top..3 * top + 3].to_vec();
+        for _ in 0..3_000 {
+            s.vertices.extend_from_slice(&face);
+        }
+        let mut point = face.clone();
+        for v in &mut point {
+            v.pos = [0.9, 0.6, 0.8];
+        }
+        for _ in 0..500 {
+            s.vertices.extend_from_slice(&point);
+        }
+        let bvh = Bvh::build(&s).unwrap();
+        let l = s.lights[0];
+        let (mut hits, mut disagreements) = (0, 0);
+        for i in 0..600u32 {
+            let h = |k: u32| crate::builtin::hash01(i * 7 + k);
+            let p = Vec3::new(h(1) * 4.0 - 2.0, 0.0, h(2) * 4.0 - 2.0);
+            let r = shadow_ray(&l, p, Vec3::Y, 1e-4);
+            let brute = (0..s.triangle_count()).any(|t| {
+                let [a, b, c] = s.triangle(t);
+                intersect_triangle(&r, a, b, c).is_some()
+            });
+            hits += brute as u32;
+            disagreements += (brute != occluded(&bvh, &s, &r)) as u32;
+        }
+        assert_eq!(disagreements, 0);
+        assert!(hits > 30, "{hits} occluded rays");
     }
 }
