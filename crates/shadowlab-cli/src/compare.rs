@@ -125,6 +125,7 @@ pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
         },
         techniques,
         peak_rss_mib: crate::bench::peak_rss_mib(),
+        warnings: crate::metrics::run_warnings(&path.reference),
     };
     std::fs::write(dir.path("metrics.json"), metrics.to_json()?)?;
     std::fs::write(dir.path("metrics.csv"), crate::metrics::csv(&metrics))?;

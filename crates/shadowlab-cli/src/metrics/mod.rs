@@ -23,7 +23,8 @@ pub use text::{summary, warnings};
 /// raised when a field is renamed, removed or changes meaning; added fields raise it too, since
 /// the schema is strict.
 /// 2: `flip_mean` per technique and frame, `images.flip`.
-pub const SCHEMA_VERSION: u32 = 2;
+/// 3: `warnings` (a view with no evaluated pixels says so).
+pub const SCHEMA_VERSION: u32 = 3;
 
 /// Milliseconds per named stage (`<technique>.<stage>`).
 pub type StagesMs = BTreeMap<String, f64>;
@@ -65,6 +66,26 @@ pub struct Metrics {
     pub techniques: Vec<Technique>,
     /// Peak resident memory of the process (MiB; null where /proc is unavailable).
     pub peak_rss_mib: Option<f64>,
+    /// What makes the figures mean less than they seem (frames with no evaluated pixels);
+    /// printed as `warning:` lines too.
+    pub warnings: Vec<String>,
+}
+
+/// The run's warnings: frames whose view has no evaluated pixels (nothing lit and in view, so
+/// every quality figure of that frame compares nothing).
+pub fn run_warnings(reference: &[ReferenceFrame]) -> Vec<String> {
+    let empty: Vec<usize> = reference.iter().filter(|f| f.evaluated_pixels == 0).map(|f| f.frame).collect();
+    let what = "no evaluated pixels (no geometry in view faces the light, or it is outside the spot cone)";
+    match empty.len() {
+        0 => vec![],
+        n if n == reference.len() && n == 1 => vec![format!("the view has {what}: every quality figure compares nothing")],
+        n if n == reference.len() => vec![format!("all {n} frames have {what}: every quality figure compares nothing")],
+        n => {
+            let shown: Vec<String> = empty.iter().take(8).map(|f| f.to_string()).collect();
+            let more = if n > 8 { ", ..." } else { "" };
+            vec![format!("{n} of {} frames have {what} (frames {}{more}); the means count them as 0 %", reference.len(), shown.join(", "))]
+        }
+    }
 }
 
 /// Moving objects: how many triangles move (0 = a still scene), which, how, and the times.

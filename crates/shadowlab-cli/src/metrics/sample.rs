@@ -80,6 +80,7 @@ pub fn metrics(frames: usize) -> Metrics {
         },
         techniques: vec![technique("sm:pcf=3"), technique("vsm:blur=5")],
         peak_rss_mib: Some(12.5),
+        warnings: vec![],
     }
 }
 

@@ -4,6 +4,9 @@ use super::Metrics;
 
 /// One line on stderr per degraded result (printed with `--quiet` too).
 pub fn warnings(m: &Metrics) {
+    for w in &m.warnings {
+        eprintln!("warning: {w}");
+    }
     for t in &m.techniques {
         for d in &t.degraded {
             eprintln!("warning: {} is degraded: {d}", t.label);
