@@ -6,6 +6,7 @@
 mod common;
 
 mod cli;
+mod long_runs;
 mod metrics_schema;
 mod reproduce;
 mod sweep;

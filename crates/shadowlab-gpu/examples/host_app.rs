@@ -100,7 +100,12 @@ pub fn run(gpu: &Gpu, scene: &Scene, size: u32, frames: usize) -> Result<HostRes
     cam[..16].copy_from_slice(&camera.view_proj(size, size).to_cols_array());
     cam[16..19].copy_from_slice(&camera.position.to_array());
     let ub = gpu.uniform("host.camera", &cam);
-    let module = gpu.shader("host.gbuffer", HOST_WGSL);
+    // the host's own pass, compiled by wgpu as the host would (not through shadowlab's
+    // `Gpu::shader`, which adapts uniform buffers to the adapter: shadowlab_gpu::quirks)
+    let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("host.gbuffer"),
+        source: wgpu::ShaderSource::Wgsl(HOST_WGSL.into()),
+    });
     let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("host.camera"),
         entries: &[wgpu::BindGroupLayoutEntry {

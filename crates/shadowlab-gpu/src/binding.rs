@@ -35,12 +35,20 @@ pub fn comparison_sampler() -> BindingType {
     BindingType::Sampler(wgpu::SamplerBindingType::Comparison)
 }
 
+/// The layout of `types`, numbered 0.., all visible to `vis` (uniform buffers as the adapter
+/// binds them, [`crate::quirks`]).
 pub fn layout(device: &wgpu::Device, label: &str, vis: ShaderStages, types: &[BindingType]) -> wgpu::BindGroupLayout {
     let entries: Vec<_> = types
         .iter()
         .enumerate()
         .map(|(i, ty)| wgpu::BindGroupLayoutEntry { binding: i as u32, visibility: vis, ty: *ty, count: None })
         .collect();
+    entries_layout(device, label, &entries)
+}
+
+/// The layout of explicit `entries` (uniform buffers as the adapter binds them, [`crate::quirks`]).
+pub fn entries_layout(device: &wgpu::Device, label: &str, entries: &[wgpu::BindGroupLayoutEntry]) -> wgpu::BindGroupLayout {
+    let entries = crate::quirks::entries(device, entries);
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
 }
 

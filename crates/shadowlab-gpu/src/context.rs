@@ -24,6 +24,8 @@ pub struct Gpu {
     pub limits: wgpu::Limits,
     /// Stage times come from GPU timestamps (else wall clock with a device wait); see `timing`.
     pub gpu_timestamps: bool,
+    /// Uniform buffers are bound as read-only storage buffers on this adapter ([`crate::quirks`]).
+    pub uniforms_as_storage: bool,
     errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
     /// Queue submissions made through [`Gpu::submit`] (tests count a frame's submits).
     submits: std::sync::atomic::AtomicU64,
@@ -76,7 +78,8 @@ impl Gpu {
         let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(e.to_string())));
-        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors, submits: Default::default() })
+        let uniforms_as_storage = crate::quirks::uniforms_as_storage(&info);
+        Ok(Gpu { device, queue, info, limits, gpu_timestamps, uniforms_as_storage, errors, submits: Default::default() })
     }
 
     /// Submits one command buffer (every submit of shadowlab goes through here and is counted).
@@ -147,7 +150,9 @@ impl Gpu {
     }
 
     pub fn uniform<T: bytemuck::Pod>(&self, label: &str, value: &T) -> wgpu::Buffer {
-        self.buffer_init(label, bytemuck::bytes_of(value), wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)
+        // STORAGE: bound as read-only storage on lavapipe (crate::quirks)
+        let usage = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        self.buffer_init(label, bytemuck::bytes_of(value), usage)
     }
 
     pub fn wait(&self) {
@@ -222,9 +227,10 @@ impl Gpu {
         data
     }
 
+    /// A WGSL module (uniform buffers declared as the adapter binds them, [`crate::quirks`]).
     pub fn shader(&self, label: &str, source: &str) -> wgpu::ShaderModule {
-        self.device
-            .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) })
+        let source = crate::quirks::wgsl(source, self.uniforms_as_storage);
+        self.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source) })
     }
 
     /// A compute pipeline with explicit bind group layouts.

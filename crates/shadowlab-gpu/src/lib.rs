@@ -14,6 +14,7 @@ pub mod gbuffer;
 pub mod host;
 pub mod lab;
 pub mod prefix_sum;
+pub mod quirks;
 pub mod raster;
 pub mod record;
 pub mod reduce;

@@ -54,13 +54,11 @@ pub fn view_layout(gpu: &Gpu, label: &str, extra: &[wgpu::BindingType]) -> wgpu:
 impl FrameInputs<'_> {
     /// Bind group for [`view_layout`]: the view inputs, then `extra` from binding 6.
     pub fn view_group(&self, gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource]) -> wgpu::BindGroup {
-        let pv = self.gbuffer.position.create_view(&Default::default());
-        let nv = self.gbuffer.normal.create_view(&Default::default());
         let mut res = vec![
             self.frame.as_entire_binding(),
             self.light_buf.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&pv),
-            wgpu::BindingResource::TextureView(&nv),
+            wgpu::BindingResource::TextureView(&self.gbuffer.position_view),
+            wgpu::BindingResource::TextureView(&self.gbuffer.normal_view),
             self.gbuffer.mask.as_entire_binding(),
             self.visibility.as_entire_binding(),
         ];

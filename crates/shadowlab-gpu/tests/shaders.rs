@@ -28,6 +28,28 @@ fn every_shader_validates() {
 }
 
 #[test]
+fn every_shader_validates_with_its_uniforms_as_storage() {
+    // lavapipe binds uniform buffers as read-only storage (shadowlab_gpu::quirks): the same
+    // shaders must validate that way, and every such buffer keep its size and layout
+    let mut rewritten = 0;
+    for (name, src) in shadowlab_gpu::registry::shaders() {
+        let as_storage = shadowlab_gpu::quirks::wgsl(&src, true);
+        let (a, b) = (parse(&name, &src), parse(&name, &as_storage));
+        let (mut la, mut lb) = (naga::proc::Layouter::default(), naga::proc::Layouter::default());
+        la.update(a.to_ctx()).unwrap();
+        lb.update(b.to_ctx()).unwrap();
+        for (_, g) in a.global_variables.iter().filter(|(_, g)| g.space == naga::AddressSpace::Uniform) {
+            let (_, h) = b.global_variables.iter().find(|(_, h)| h.name == g.name).unwrap();
+            assert_eq!(h.space, naga::AddressSpace::Storage { access: naga::StorageAccess::LOAD }, "{name}: {:?}", g.name);
+            assert_eq!(la[g.ty].size, lb[h.ty].size, "{name}: {:?} changes size", g.name);
+            assert_eq!(a.types[g.ty].inner, b.types[h.ty].inner, "{name}: {:?} changes type", g.name);
+            rewritten += 1;
+        }
+    }
+    assert!(rewritten > 20, "only {rewritten} uniform buffers seen");
+}
+
+#[test]
 fn every_wgsl_file_is_composed_somewhere() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let composed: String = shadowlab_gpu::registry::shaders().into_iter().map(|(_, s)| s).collect();

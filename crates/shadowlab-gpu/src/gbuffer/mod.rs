@@ -33,16 +33,22 @@ pub struct GBuffer {
     pub depth: wgpu::Texture,
     /// u32 per pixel: 1 = evaluated for the current light.
     pub mask: wgpu::Buffer,
+    pub position_view: wgpu::TextureView,
+    pub normal_view: wgpu::TextureView,
 }
 
 impl GBuffer {
     pub fn new(gpu: &Gpu, w: u32, h: u32) -> GBuffer {
         let c = wgpu::TextureUsages::COPY_SRC;
+        let position = raster::render_target(gpu, "gbuffer.position", w, h, POSITION_FORMAT, c);
+        let normal = raster::render_target(gpu, "gbuffer.normal", w, h, NORMAL_FORMAT, c);
         GBuffer {
             width: w,
             height: h,
-            position: raster::render_target(gpu, "gbuffer.position", w, h, POSITION_FORMAT, c),
-            normal: raster::render_target(gpu, "gbuffer.normal", w, h, NORMAL_FORMAT, c),
+            position_view: position.create_view(&Default::default()),
+            normal_view: normal.create_view(&Default::default()),
+            position,
+            normal,
             albedo: raster::render_target(gpu, "gbuffer.albedo", w, h, ALBEDO_FORMAT, c),
             motion: raster::render_target(gpu, "gbuffer.motion", w, h, MOTION_FORMAT, c),
             depth: raster::render_target(gpu, "gbuffer.depth", w, h, raster::DEPTH_FORMAT, wgpu::TextureUsages::empty()),

@@ -141,16 +141,7 @@ impl CubeNotw {
         let mut result = Ok(());
         for face in self.faces.iter_mut().filter(|face| face.samples > 0) {
             let g = f.gbuffer;
-            let gbuffer = GBuffer {
-                width: g.width,
-                height: g.height,
-                position: g.position.clone(),
-                normal: g.normal.clone(),
-                albedo: g.albedo.clone(),
-                motion: g.motion.clone(),
-                depth: g.depth.clone(),
-                mask: face.mask.clone().expect("sized in prepare"),
-            };
+            let gbuffer = GBuffer { mask: face.mask.clone().expect("sized in prepare"), ..g.clone() };
             let vis = face.vis.clone().expect("sized in prepare");
             let fi = FrameInputs {
                 scene: &face.scene,

@@ -40,7 +40,8 @@ impl Resources {
             tile_buf: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("iasm.tiles"),
                 size: TILE_STRIDE * TILE_COUNT as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                // STORAGE: bound as read-only storage on lavapipe (crate::quirks)
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             dummy: dummy_target(gpu),

@@ -63,13 +63,14 @@ impl TilePass {
         // the tile uniform for both stages, the buffer for the fragment stage only (writable
         // storage in vertex shaders needs a feature)
         let entry = |i: u32, visibility, ty| wgpu::BindGroupLayoutEntry { binding: i, visibility, ty, count: None };
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("iasm.render"),
-            entries: &[
+        let layout = binding::entries_layout(
+            d,
+            "iasm.render",
+            &[
                 entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, binding::uniform()),
                 entry(1, wgpu::ShaderStages::FRAGMENT, binding::storage(false)),
             ],
-        });
+        );
         let groups = (0..TILE_COUNT as u64)
             .map(|t| {
                 let tb = wgpu::BufferBinding { buffer: tile_buf, offset: t * TILE_STRIDE, size: wgpu::BufferSize::new(80) };

@@ -237,7 +237,7 @@ pub struct Warped {
 /// A bind group layout of `entries` (binding, type), all visible to `vis`.
 fn layout_at(gpu: &Gpu, label: &str, vis: wgpu::ShaderStages, entries: &[(u32, wgpu::BindingType)]) -> wgpu::BindGroupLayout {
     let e: Vec<_> = entries.iter().map(|&(binding, ty)| wgpu::BindGroupLayoutEntry { binding, visibility: vis, ty, count: None }).collect();
-    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &e })
+    crate::binding::entries_layout(&gpu.device, label, &e)
 }
 
 /// How a warped map projects the world before the desired view and the warp.
