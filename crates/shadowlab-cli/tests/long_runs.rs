@@ -99,8 +99,10 @@ fn a_view_with_nothing_evaluated_says_so() {
 
 #[test]
 fn coincident_triangles_run_through_every_default_technique() {
-    // a floor and 5,000 copies of one triangle above it (duplicated faces, as CAD and scan
-    // exports have them): the BVH stays shallow and every technique of the default set runs
+    // a floor and 40 copies of one triangle above it (duplicated faces, as CAD and scan exports
+    // have them; more than a BVH leaf holds): the BVH stays shallow and every technique of the
+    // default set runs. Few copies: notw's subdivision splits every copy on its own (100 copies
+    // took it 11 s a frame in the debug build; docs/bench/robustness.md)
     if skip_gpu() {
         return;
     }
@@ -108,7 +110,7 @@ fn coincident_triangles_run_through_every_default_technique() {
     std::fs::create_dir_all(&dir).unwrap();
     let obj = dir.join("copies.obj");
     let mut text = String::from("v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nv 0 1 0\nv 1 1 0\nv 0 1 1\nf 1 3 2\nf 1 4 3\n");
-    text.push_str(&"f 5 7 6\n".repeat(5_000));
+    text.push_str(&"f 5 7 6\n".repeat(40));
     std::fs::write(&obj, text).unwrap();
     let out = dir.join("report");
     let o =
@@ -116,9 +118,9 @@ fn coincident_triangles_run_through_every_default_technique() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && !err.contains("panicked"), "{err}");
     let m = json(out.join("metrics.json"));
-    assert_eq!(m["triangles"], 5_002);
+    assert_eq!(m["triangles"], 42);
     let depth = m["bvh"]["depth"].as_u64().unwrap();
-    assert!(depth <= 16, "BVH depth {depth} over 5,000 copies");
+    assert!(depth <= 6, "BVH depth {depth} over 40 copies");
     assert!(m["techniques"].as_array().unwrap().len() >= 10);
     assert!(m["reference"]["evaluated_pixels"].as_u64().unwrap() > 0);
     let _ = std::fs::remove_dir_all(&dir);
