@@ -41,20 +41,23 @@ fn memory_does_not_grow_with_the_frame_count() {
     }
 }
 
+/// A fresh scratch directory `name` holding `file` with `text`: (the directory, the file).
+fn scratch_with(name: &str, file: &str, text: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = tmp(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(file);
+    std::fs::write(&path, text).unwrap();
+    (dir, path)
+}
+
 #[test]
 fn a_view_with_nothing_evaluated_says_so() {
     if skip_gpu() {
         return;
     }
-    let dir = tmp("empty-view");
-    std::fs::create_dir_all(&dir).unwrap();
-    let setup = dir.join("away.toml");
     // planebox's camera turned to look away from everything
-    std::fs::write(
-        &setup,
-        "[scene]\nbuiltin = \"planebox\"\n[camera]\nposition = [0.0, 5.0, 20.0]\ntarget = [0.0, 5.0, 40.0]\nfov_y_deg = 40.0\nnear = 0.1\nfar = 50.0\n",
-    )
-    .unwrap();
+    let camera = "[camera]\nposition = [0.0, 5.0, 20.0]\ntarget = [0.0, 5.0, 40.0]\nfov_y_deg = 40.0\nnear = 0.1\nfar = 50.0\n";
+    let (dir, setup) = scratch_with("empty-view", "away.toml", &format!("[scene]\nbuiltin = \"planebox\"\n{camera}"));
     let out = dir.join("report");
     let o = run(&[
         "compare",
@@ -106,12 +109,8 @@ fn coincident_triangles_run_through_every_default_technique() {
     if skip_gpu() {
         return;
     }
-    let dir = tmp("coincident");
-    std::fs::create_dir_all(&dir).unwrap();
-    let obj = dir.join("copies.obj");
-    let mut text = String::from("v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nv 0 1 0\nv 1 1 0\nv 0 1 1\nf 1 3 2\nf 1 4 3\n");
-    text.push_str(&"f 5 7 6\n".repeat(40));
-    std::fs::write(&obj, text).unwrap();
+    let floor = "v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nv 0 1 0\nv 1 1 0\nv 0 1 1\nf 1 3 2\nf 1 4 3\n";
+    let (dir, obj) = scratch_with("coincident", "copies.obj", &format!("{floor}{}", "f 5 7 6\n".repeat(40)));
     let out = dir.join("report");
     let o =
         run(&["compare", "--scene", obj.to_str().unwrap(), "--size", "32x32", "--repeat", "1", "--quiet", "--out", out.to_str().unwrap()]);
