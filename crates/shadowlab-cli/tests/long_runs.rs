@@ -3,24 +3,18 @@
 
 use crate::common::*;
 
+/// `shadowlab compare ARGS --size 32x32 --out OUT`, run to completion.
+fn compare_32(args: &[&str], out: &std::path::Path) -> std::process::Output {
+    let mut all = vec!["compare"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--size", "32x32", "--out", out.to_str().unwrap()]);
+    run(&all)
+}
+
 /// Peak resident memory (MiB) of `compare --frames frames` with `spec` on planebox at 32x32.
 fn peak_mib(spec: &str, frames: usize) -> f64 {
     let out = tmp(&format!("mem-{}-{frames}", spec.replace([':', ',', '='], "_")));
-    let frames_arg = frames.to_string();
-    let o = run(&[
-        "compare",
-        "--scene",
-        "planebox",
-        "-t",
-        spec,
-        "--frames",
-        &frames_arg,
-        "--size",
-        "32x32",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = compare_32(&["--scene", "planebox", "-t", spec, "--frames", &frames.to_string(), "--quiet"], &out);
     assert!(o.status.success(), "{spec}: {}", String::from_utf8_lossy(&o.stderr));
     let m = json(out.join("metrics.json"));
     let _ = std::fs::remove_dir_all(&out);
@@ -59,19 +53,7 @@ fn a_view_with_nothing_evaluated_says_so() {
     let camera = "[camera]\nposition = [0.0, 5.0, 20.0]\ntarget = [0.0, 5.0, 40.0]\nfov_y_deg = 40.0\nnear = 0.1\nfar = 50.0\n";
     let (dir, setup) = scratch_with("empty-view", "away.toml", &format!("[scene]\nbuiltin = \"planebox\"\n{camera}"));
     let out = dir.join("report");
-    let o = run(&[
-        "compare",
-        "--setup",
-        setup.to_str().unwrap(),
-        "-t",
-        "sm",
-        "--size",
-        "32x32",
-        "--repeat",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = compare_32(&["--setup", setup.to_str().unwrap(), "-t", "sm", "--repeat", "1"], &out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("warning:") && err.contains("no evaluated pixels"), "no warning on stderr: {err}");
@@ -81,20 +63,7 @@ fn a_view_with_nothing_evaluated_says_so() {
     assert!(w.len() == 1 && w[0].as_str().unwrap().contains("no evaluated pixels"), "{w:?}");
     // a view that sees the scene has no such warning
     let seen = dir.join("seen");
-    let o = run(&[
-        "compare",
-        "--scene",
-        "planebox",
-        "-t",
-        "sm",
-        "--size",
-        "32x32",
-        "--repeat",
-        "1",
-        "--quiet",
-        "--out",
-        seen.to_str().unwrap(),
-    ]);
+    let o = compare_32(&["--scene", "planebox", "-t", "sm", "--repeat", "1", "--quiet"], &seen);
     assert!(o.status.success());
     assert_eq!(json(seen.join("metrics.json"))["warnings"], serde_json::json!([]));
     let _ = std::fs::remove_dir_all(&dir);
@@ -112,8 +81,7 @@ fn coincident_triangles_run_through_every_default_technique() {
     let floor = "v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nv 0 1 0\nv 1 1 0\nv 0 1 1\nf 1 3 2\nf 1 4 3\n";
     let (dir, obj) = scratch_with("coincident", "copies.obj", &format!("{floor}{}", "f 5 7 6\n".repeat(40)));
     let out = dir.join("report");
-    let o =
-        run(&["compare", "--scene", obj.to_str().unwrap(), "--size", "32x32", "--repeat", "1", "--quiet", "--out", out.to_str().unwrap()]);
+    let o = compare_32(&["--scene", obj.to_str().unwrap(), "--repeat", "1", "--quiet"], &out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && !err.contains("panicked"), "{err}");
     let m = json(out.join("metrics.json"));

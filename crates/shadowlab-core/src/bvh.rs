@@ -61,7 +61,8 @@ impl Bvh {
         let boxes: Vec<Aabb> = tris.iter().map(|&[a, b, c]| Aabb::from_points(&[a.into(), b.into(), c.into()])).collect();
         let groups = Groups::of(&boxes);
         let mut core = std::time::Duration::ZERO;
-        let reps: Vec<Aabb> = groups.starts.iter().map(|&s| boxes[groups.members[s as usize] as usize]).collect();
+        let reps: Vec<Aabb> =
+            groups.starts[..groups.starts.len() - 1].iter().map(|&s| boxes[groups.members[s as usize] as usize]).collect();
         let b = build_bvh2(&reps, BvhBuildParams::medium_build(), &mut core);
         let (nodes, local) = expand(&b, &groups, &boxes);
         let depth = tree_depth(&nodes);
@@ -109,7 +110,8 @@ pub const LEAF_PRIMS: usize = 8;
 /// Triangles grouped for the `obvhs` build, in order of first appearance: a bounding box that
 /// more than [`LEAF_PRIMS`] triangles share bit for bit is one group, every other triangle is a
 /// group of its own (the two halves of a quad share a box; a handful of copies does not hurt
-/// the build). Group `g` is `members[starts[g] .. starts[g + 1]]` (triangle indices, ascending).
+/// the build). Group `g` is `members[starts[g] .. starts[g + 1]]` (triangle indices, ascending;
+/// `starts` ends with `members.len()`).
 struct Groups {
     starts: Vec<u32>,
     members: Vec<u32>,
@@ -158,14 +160,11 @@ impl Groups {
             members[next[g as usize] as usize] = t as u32;
             next[g as usize] += 1;
         }
-        starts.pop();
         Groups { starts, members }
     }
 
     fn members(&self, g: u32) -> &[u32] {
-        let s = self.starts[g as usize] as usize;
-        let e = self.starts.get(g as usize + 1).map_or(self.members.len(), |&e| e as usize);
-        &self.members[s..e]
+        &self.members[self.starts[g as usize] as usize..self.starts[g as usize + 1] as usize]
     }
 }
 

@@ -24,8 +24,6 @@ pub struct Gpu {
     pub limits: wgpu::Limits,
     /// Stage times come from GPU timestamps (else wall clock with a device wait); see `timing`.
     pub gpu_timestamps: bool,
-    /// Uniform buffers are bound as read-only storage buffers on this adapter ([`crate::quirks`]).
-    pub uniforms_as_storage: bool,
     errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
     /// Queue submissions made through [`Gpu::submit`] (tests count a frame's submits).
     submits: std::sync::atomic::AtomicU64,
@@ -78,8 +76,7 @@ impl Gpu {
         let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(e.to_string())));
-        let uniforms_as_storage = crate::quirks::uniforms_as_storage(&info);
-        Ok(Gpu { device, queue, info, limits, gpu_timestamps, uniforms_as_storage, errors, submits: Default::default() })
+        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors, submits: Default::default() })
     }
 
     /// Submits one command buffer (every submit of shadowlab goes through here and is counted).
@@ -229,7 +226,7 @@ impl Gpu {
 
     /// A WGSL module (uniform buffers declared as the adapter binds them, [`crate::quirks`]).
     pub fn shader(&self, label: &str, source: &str) -> wgpu::ShaderModule {
-        let source = crate::quirks::wgsl(source, self.uniforms_as_storage);
+        let source = crate::quirks::wgsl(source, crate::quirks::uniforms_as_storage(&self.info));
         self.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source) })
     }
 
