@@ -310,7 +310,7 @@ impl Pipelines {
         let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, plan.exact_depth);
         let occluders = plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &lookup_layout, scene));
         let (split_layout, split) = subdiv::pipelines(gpu, name, scene);
-        let (eval_layout, eval) = eval::pipelines(gpu, name);
+        let (eval_layout, eval) = eval::pipelines(gpu, name, &plan.params);
         let sampler = eval::sampler(gpu);
         let prefix = PrefixSum::new(gpu);
         Pipelines {

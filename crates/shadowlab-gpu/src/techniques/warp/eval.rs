@@ -4,7 +4,7 @@
 //! with the nearest depth of 3x3 texels per tap); the analysis variant also counts the samples
 //! per warped texel.
 
-use super::{Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{WarpParams, Warped, DV_CROP_CLOSED, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, Gpu, GpuError};
@@ -15,16 +15,28 @@ pub(super) fn source() -> String {
     compose_view(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{EVAL_WGSL}"), false)
 }
 
+/// The evaluation's pipeline constants (eval.wgsl, lookup.wgsl `MAY_WARP`): the knobs of `p`
+/// that choose code paths, so that the pipeline holds only the path this map takes.
+pub(super) fn constants(p: &WarpParams) -> [(&'static str, f64); 4] {
+    let flag = |b: bool| if b { 1.0 } else { 0.0 };
+    [
+        ("MAY_WARP", flag(p.warped > 0.5)),
+        ("BIAS_MODE", p.bias_mode.round() as f64),
+        ("CLOSE_CRACKS", flag(p.dv_mode == DV_CROP_CLOSED)),
+        ("PERSPECTIVE", flag(p.perspective > 0.5)),
+    ]
+}
+
 /// The evaluation layout (the view, the lookup, the map, its comparison sampler, the counts) and
-/// the evaluation with its analysis variant.
-pub(super) fn pipelines(gpu: &Gpu, name: &str) -> (wgpu::BindGroupLayout, EvalPipelines) {
+/// the evaluation with its analysis variant, specialised to `p` ([`constants`]).
+pub(super) fn pipelines(gpu: &Gpu, name: &str, p: &WarpParams) -> (wgpu::BindGroupLayout, EvalPipelines) {
     let (ro, rw, tex) = (binding::storage(true), binding::storage(false), binding::texture_float());
     let layout = view_layout(
         gpu,
         &format!("{name}.final_pass"),
         &[binding::uniform(), ro, tex, tex, binding::texture_depth(), binding::comparison_sampler(), rw],
     );
-    let eval = EvalPipelines::new(gpu, &format!("{name}.final_pass"), &source(), &layout, &[]);
+    let eval = EvalPipelines::new(gpu, &format!("{name}.final_pass"), &source(), &layout, &constants(p));
     (layout, eval)
 }
 

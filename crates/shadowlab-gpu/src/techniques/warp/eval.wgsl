@@ -11,6 +11,14 @@
 // (`texel_jacobian`: exact across the warp's kinks, docs/bench/warp_kinks.md). Also counts the samples per warped texel
 // (sampling statistics after warping).
 
+// The knobs that choose code paths, fixed per map at pipeline creation (eval.rs `constants`,
+// equal to the uniform's `bias_mode`, `dv_mode` and `perspective`; `MAY_WARP` in lookup.wgsl):
+// a branch on a uniform value is paid in full on SIMD rasterisers (lavapipe runs both sides of
+// an `if` on lanes it masks off), a constant one is compiled away.
+override BIAS_MODE: u32;
+override CLOSE_CRACKS: bool;
+override PERSPECTIVE: bool;
+
 @group(0) @binding(10) var shadow_map: texture_depth_2d;
 @group(0) @binding(11) var cmp: sampler_comparison;
 @group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
@@ -134,17 +142,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
 
     // world size of one cropped texel at p, then of one warped texel
     var texel = wp.texel_world * max(r.z - r.x, r.w - r.y);
-    if wp.perspective > 0.5 {
+    if PERSPECTIVE {
         texel *= max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
     }
     if is_paraboloid(wp) {
         // texel.x = 2 / res radians per texel at the rim; (1 + n.z) x that in general
         texel *= distance(p, light.position.xyz) * (1.0 + max(hemisphere_side(wp, p), 0.0));
     }
-    if wp.warped > 0.5 {
+    if MAY_WARP && wp.warped > 0.5 {
         let j = jacobian(u0, 0.5 / res);
         let sv = singular_values(j[0], j[1]);
-        if wp.bias_mode > 3.5 {
+        if BIAS_MODE >= 4u {
             // mode 4: the secant Jacobian of the warped texel the sample falls in (the central
             // difference where that texel is off the map or collapsed)
             var jt = texel_jacobian(c0);
@@ -152,7 +160,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 jt = j;
             }
             texel = gradient_footprint(p, n, l, r, jt, texel);
-        } else if wp.bias_mode > 2.5 {
+        } else if BIAS_MODE == 3u {
             // mode 3: the largest gradient footprint at u0 and one texel to each side (the
             // warp's kinks: the Jacobian changes within a texel)
             var f = gradient_footprint(p, n, l, r, j, texel);
@@ -161,9 +169,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 f = max(f, gradient_footprint(p, n, l, r, jacobian(u0 + o, 0.5 / res), texel));
             }
             texel = f;
-        } else if wp.bias_mode > 1.5 {
+        } else if BIAS_MODE == 2u {
             texel = gradient_footprint(p, n, l, r, j, texel);
-        } else if wp.bias_mode > 0.5 {
+        } else if BIAS_MODE == 1u {
             // the cropped texel, shrunk only where the warp magnifies in every direction
             texel /= clamp(sv.x, 1.0, 1e3);
         } else {
@@ -192,7 +200,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var x = 0; x < k; x++) {
             let uv = u + (vec2<f32>(f32(x), f32(y)) - half) / res;
             let z = m.z;
-            if wp.dv_mode > 1.5 {
+            if CLOSE_CRACKS {
                 lit += select(0.0, 1.0, z <= min_depth_3x3(uv, u32(res)));
             } else {
                 lit += textureSampleCompareLevel(shadow_map, cmp, uv, z);

@@ -294,13 +294,16 @@ fn mix_corner(a: u32, b: u32, t: f32) -> u32 {
 // flips) and one such vertex spreads its triangle across the whole map. Clip space is affine in
 // world space, so the cut corners are exact barycentric mixes. Wholly behind: nothing drawn;
 // a cut leaving a quad: its second half is appended like a finished piece.
+// A whole triangle's corners as packed barycentrics: (0, 0), (1, 0), (0, 1).
+const ROOT_CORNERS = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
+
 @compute @workgroup_size(64)
 fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
     if tri >= wp.triangles {
         return;
     }
-    let c = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
+    let c = ROOT_CORNERS;
     if is_paraboloid(wp) {
         place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
         return;
