@@ -17,7 +17,7 @@ pub fn scene_pipeline(
     scene_pipeline_with(gpu, label, source, layouts, targets, true, &[])
 }
 
-/// [`scene_pipeline`] with WGSL `override` constants for the fragment stage.
+/// [`scene_pipeline`] with WGSL `override` constants (both stages: one module).
 pub fn scene_pipeline_constants(
     gpu: &Gpu,
     label: &str,
@@ -36,6 +36,19 @@ pub fn depth_pipeline(gpu: &Gpu, label: &str, source: &str, layouts: &[&wgpu::Bi
     scene_pipeline_with(gpu, label, source, layouts, &[], has_cutouts, &[])
 }
 
+/// A depth-only scene pipeline with a fragment stage where `fragment`, and WGSL `override`
+/// constants for both stages.
+pub fn depth_pipeline_with(
+    gpu: &Gpu,
+    label: &str,
+    source: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    fragment: bool,
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
+    scene_pipeline_with(gpu, label, source, layouts, &[], fragment, constants)
+}
+
 fn scene_pipeline_with(
     gpu: &Gpu,
     label: &str,
@@ -50,7 +63,12 @@ fn scene_pipeline_with(
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
-        vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[] },
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+            buffers: &[],
+        },
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,

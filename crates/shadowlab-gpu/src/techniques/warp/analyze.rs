@@ -3,7 +3,7 @@
 //! cropped map and the warps built from it: NoTW's row warps, the count map rebuilt through
 //! them and the column warps; RTW's 1D collapse, blur and offsets.
 
-use super::{Variant, Warped, PARAMS_WGSL, SMOOTH_BLOCK};
+use super::{base_constants, Variant, WarpParams, Warped, PARAMS_WGSL, SMOOTH_BLOCK};
 use crate::prefix_sum::ScanParams;
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, FrameInputs};
@@ -28,7 +28,12 @@ fn entries(variant: Variant) -> &'static [&'static str] {
 
 /// The analysis layout (the view, then the uniform, the DV bounds, the two work buffers, the two
 /// warps written and the occluder pyramid) and a pipeline per entry point of `variant`.
-pub(super) fn pipelines(gpu: &Gpu, name: &str, variant: Variant) -> (wgpu::BindGroupLayout, Vec<(&'static str, wgpu::ComputePipeline)>) {
+pub(super) fn pipelines(
+    gpu: &Gpu,
+    name: &str,
+    variant: Variant,
+    p: &WarpParams,
+) -> (wgpu::BindGroupLayout, Vec<(&'static str, wgpu::ComputePipeline)>) {
     let (ro, rw) = (binding::storage(true), binding::storage(false));
     let store = wgpu::BindingType::StorageTexture {
         access: wgpu::StorageTextureAccess::WriteOnly,
@@ -37,7 +42,8 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, variant: Variant) -> (wgpu::BindG
     };
     let layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store, ro]);
     let src = source();
-    let constants = [("SMOOTH_BLOCK", SMOOTH_BLOCK as f64)];
+    let mut constants = base_constants(p);
+    constants.push(("SMOOTH_BLOCK", SMOOTH_BLOCK as f64));
     let pipelines =
         entries(variant).iter().map(|&e| (e, gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout], &constants))).collect();
     (layout, pipelines)

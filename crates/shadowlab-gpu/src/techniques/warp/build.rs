@@ -96,8 +96,6 @@ struct Plan {
     subdiv: bool,
     extra: u32,
     queue: u32,
-    /// The depth pass writes the exact depth (depth_exact.wgsl).
-    exact_depth: bool,
     /// The occluder map and its pyramid (`cull_hidden`, `edge_importance`).
     occluders: bool,
 }
@@ -111,7 +109,7 @@ impl Plan {
         let (subdiv, extra, queue) = subdivision_capacity(k, name, tris, max_binding)?;
         let params = uniform(k, &base, tris, extra);
         let occluders = k.cull_hidden || k.edge_importance > 0;
-        Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, exact_depth: k.exact_depth, occluders })
+        Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, occluders })
     }
 
     /// Texels of the two warp textures: NoTW one function per row and per column, RTW one 1D
@@ -306,10 +304,10 @@ struct Pipelines {
 impl Pipelines {
     fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan) -> Pipelines {
         let name = plan.name;
-        let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant);
-        let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, plan.exact_depth);
-        let occluders = plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &lookup_layout, scene));
-        let (split_layout, split) = subdiv::pipelines(gpu, name, scene);
+        let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant, &plan.params);
+        let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, &plan.params);
+        let occluders = plan.occluders.then(|| occluders::Occluders::new(gpu, name, &plan.params, &lookup_layout, scene));
+        let (split_layout, split) = subdiv::pipelines(gpu, name, scene, &plan.params);
         let (eval_layout, eval) = eval::pipelines(gpu, name, &plan.params);
         let sampler = eval::sampler(gpu);
         let prefix = PrefixSum::new(gpu);

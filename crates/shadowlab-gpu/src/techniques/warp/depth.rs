@@ -4,7 +4,7 @@
 //! warp's preimage of the fragment (depth_exact.wgsl). Its lookup bindings (the uniform, the DV
 //! bounds, the warps) are shared with the occluder and subdivision passes.
 
-use super::{compose, layout_at, Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, compose, flag, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::FrameInputs;
@@ -26,8 +26,23 @@ pub(super) fn lookup_entries() -> [(u32, wgpu::BindingType); 4] {
     [(6, binding::uniform()), (7, binding::storage(true)), (8, tex), (9, tex)]
 }
 
-/// The lookup layout (bindings 6-9, the pieces at 10) and the warped depth pipeline.
-pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, exact: bool) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
+/// The depth pass's pipeline constants (depth.wgsl): the knobs of `p` that choose code paths,
+/// and whether the scene has alpha cut-outs.
+pub(super) fn constants(p: &WarpParams, cutouts: bool) -> Vec<(&'static str, f64)> {
+    let mut c = base_constants(p);
+    c.extend([
+        ("SUBDIVIDED", flag(p.subdiv > 0.0)),
+        ("EXACT_DEPTH", flag(p.exact_depth != 0)),
+        ("EXACT_INVERSE", flag(p.exact_inverse > 0.5)),
+        ("CUTOUTS", flag(cutouts)),
+    ]);
+    c
+}
+
+/// The lookup layout (bindings 6-9, the pieces at 10) and the warped depth pipeline, specialised
+/// to `p` ([`constants`]). A planar map with interpolated depth over a scene without cut-outs
+/// discards nothing: it has no fragment stage (the rasteriser then tests depth early, as `sm`).
+pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
     let look = lookup_entries();
     let layout = layout_at(
         gpu,
@@ -35,7 +50,11 @@ pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, exact: bool) -> 
         wgpu::ShaderStages::VERTEX_FRAGMENT,
         &[look[0], look[1], look[2], look[3], (10, binding::storage(true))],
     );
-    let pipeline = raster::scene_pipeline(gpu, &format!("{name}.shadow_map"), &source(exact), &[&layout, &scene.layout], &[]);
+    let exact = p.exact_depth != 0;
+    let fragment = exact || scene.has_cutouts || p.projection != 0;
+    let label = format!("{name}.shadow_map");
+    let layouts = [&layout, &scene.layout];
+    let pipeline = raster::depth_pipeline_with(gpu, &label, &source(exact), &layouts, fragment, &constants(p, scene.has_cutouts));
     (layout, pipeline)
 }
 

@@ -3,7 +3,7 @@
 // post-projective depth (0 = near the light; paraboloid: distance / far). With subdivision on,
 // the vertices come from the pieces of subdiv.wgsl.
 //
-// `exact_depth` (wp.exact_depth): the rasteriser interpolates depth linearly between warped
+// `exact_depth` (EXACT_DEPTH): the rasteriser interpolates depth linearly between warped
 // vertices, which is wrong inside a piece by up to the subdivision threshold. The stored depth
 // d = clip_to_map(base_clip(p)).z of a point p on a plane is an affine function of its base
 // (cropped, unwarped) map coordinates u, for orthographic and perspective (spot) projections
@@ -13,6 +13,14 @@
 // plane's depth there.
 
 @group(0) @binding(10) var<storage, read> pieces: array<vec4<u32>>;
+
+// The map's knobs that choose code paths, fixed at pipeline creation (depth.rs `constants`;
+// equal to the uniform's `subdiv > 0`, `exact_depth`, `exact_inverse`, and the scene's
+// cut-outs; PARABOLOID and WARPED in params.wgsl).
+override SUBDIVIDED: bool;
+override EXACT_DEPTH: bool;
+override EXACT_INVERSE: bool;
+override CUTOUTS: bool;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -32,6 +40,14 @@ struct VsOut {
 // discarded; their images would wrap around the map.
 fn behind_hemisphere(in: VsOut) -> bool {
     return in.side < -SPLIT_OVERLAP;
+}
+
+// Whether the fragment stage drops this fragment: an alpha cut-out, or behind the hemisphere.
+fn discarded(in: VsOut) -> bool {
+    if CUTOUTS && cut_out(materials[in.material], in.uv) {
+        return true;
+    }
+    return PARABOLOID && behind_hemisphere(in);
 }
 
 fn bary_pos(tri: u32, b: vec2<f32>) -> vec3<f32> {
@@ -77,7 +93,7 @@ fn depth_plane(a: array<vec4<f32>, 3>, r: vec4<f32>) -> vec4<f32> {
 fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     var v: Vertex;
     var piece = vec4<u32>(vi / 3u, 0u, 0xffffu, 0xffff0000u);
-    if wp.subdiv > 0.0 {
+    if SUBDIVIDED {
         piece = pieces[vi / 3u];
         v = piece_vertex(piece, vi % 3u);
     } else {
@@ -92,12 +108,12 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     o.plane = vec4<f32>(0.0);
     o.zrange = vec2<f32>(0.0, 1.0);
     o.side = hemisphere_side(wp, v.pos);
-    if wp.exact_depth != 0u {
+    if EXACT_DEPTH {
         let a = base_clip(wp, v.pos);
         o.u = to_dv(clip_to_map(a).xy, r);
         // the whole triangle's plane (better conditioned than a small piece's), else the piece's
         let t = piece.x;
-        if is_paraboloid(wp) {
+        if PARABOLOID {
             o.plane = paraboloid_plane(t);
             o.zrange = vec2<f32>(abs(o.plane.w), piece_zrange(piece).y);
             return o;

@@ -8,7 +8,7 @@
 
 @fragment
 fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
-    if cut_out(materials[in.material], in.uv) || behind_hemisphere(in) {
+    if discarded(in) {
         discard;
     }
     if in.plane.w == 0.0 {
@@ -16,7 +16,7 @@ fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
     }
     let res = wp.res;
     var inv = vec3<f32>(0.0);
-    if wp.exact_inverse > 0.5 {
+    if EXACT_INVERSE {
         inv = vec3<f32>(unwarp_exact(in.clip.xy / res), 0.0);
     } else {
         inv = unwarp(in.clip.xy / res, in.u);
@@ -26,7 +26,7 @@ fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
         return in.clip.z;
     }
     let u = inv.xy;
-    if is_paraboloid(wp) {
+    if PARABOLOID {
         // the direction of the unwarped map point, then the distance to the plane along it
         let r = dv_rect();
         let m = r.xy + u * (r.zw - r.xy);

@@ -2,7 +2,7 @@
 
 @fragment
 fn fs_main(in: VsOut) {
-    if cut_out(materials[in.material], in.uv) || behind_hemisphere(in) {
+    if discarded(in) {
         discard;
     }
 }

@@ -4,7 +4,7 @@
 //! with the nearest depth of 3x3 texels per tap); the analysis variant also counts the samples
 //! per warped texel.
 
-use super::{WarpParams, Warped, DV_CROP_CLOSED, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, flag, WarpParams, Warped, DV_CROP_CLOSED, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, Gpu, GpuError};
@@ -15,16 +15,16 @@ pub(super) fn source() -> String {
     compose_view(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{EVAL_WGSL}"), false)
 }
 
-/// The evaluation's pipeline constants (eval.wgsl, lookup.wgsl `MAY_WARP`): the knobs of `p`
-/// that choose code paths, so that the pipeline holds only the path this map takes.
-pub(super) fn constants(p: &WarpParams) -> [(&'static str, f64); 4] {
-    let flag = |b: bool| if b { 1.0 } else { 0.0 };
-    [
-        ("MAY_WARP", flag(p.warped > 0.5)),
+/// The evaluation's pipeline constants (eval.wgsl and params.wgsl): the knobs of `p` that choose
+/// code paths, so that the pipeline holds only the path this map takes.
+pub(super) fn constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
+    let mut c = base_constants(p);
+    c.extend([
         ("BIAS_MODE", p.bias_mode.round() as f64),
         ("CLOSE_CRACKS", flag(p.dv_mode == DV_CROP_CLOSED)),
         ("PERSPECTIVE", flag(p.perspective > 0.5)),
-    ]
+    ]);
+    c
 }
 
 /// The evaluation layout (the view, the lookup, the map, its comparison sampler, the counts) and

@@ -12,9 +12,8 @@
 // (sampling statistics after warping).
 
 // The knobs that choose code paths, fixed per map at pipeline creation (eval.rs `constants`,
-// equal to the uniform's `bias_mode`, `dv_mode` and `perspective`; `MAY_WARP` in lookup.wgsl):
-// a branch on a uniform value is paid in full on SIMD rasterisers (lavapipe runs both sides of
-// an `if` on lanes it masks off), a constant one is compiled away.
+// equal to the uniform's `bias_mode`, `dv_mode` and `perspective`; PARABOLOID and WARPED in
+// params.wgsl).
 override BIAS_MODE: u32;
 override CLOSE_CRACKS: bool;
 override PERSPECTIVE: bool;
@@ -145,11 +144,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if PERSPECTIVE {
         texel *= max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
     }
-    if is_paraboloid(wp) {
+    if PARABOLOID {
         // texel.x = 2 / res radians per texel at the rim; (1 + n.z) x that in general
         texel *= distance(p, light.position.xyz) * (1.0 + max(hemisphere_side(wp, p), 0.0));
     }
-    if MAY_WARP && wp.warped > 0.5 {
+    if WARPED {
         let j = jacobian(u0, 0.5 / res);
         let sv = singular_values(j[0], j[1]);
         if BIAS_MODE >= 4u {
@@ -187,7 +186,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let a = base_clip(wp, q);
     let m = clip_to_map(a);
     var u = warp(to_dv(m.xy, r));
-    if is_paraboloid(wp) && a.w > 0.0 {
+    if PARABOLOID && a.w > 0.0 {
         // a biased point that crossed the split plane reads the map's border texels
         u = clamp(u, vec2<f32>(0.0), vec2<f32>(1.0));
     }

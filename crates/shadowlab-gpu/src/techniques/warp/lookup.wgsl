@@ -3,11 +3,6 @@
 // per texture row (one row for RTW), warp_y one column function per texture column.
 
 @group(0) @binding(6) var<uniform> wp: WarpParams;
-// Whether this pipeline may warp at all (a pipeline constant, true unless the pipeline sets
-// it): false compiles the warp away for maps that never warp (`dpsm`, `notw-dv`); true leaves
-// it to the uniform's `warped`.
-override MAY_WARP: bool = true;
-
 @group(0) @binding(7) var<storage, read> dv_bounds: array<u32>;
 @group(0) @binding(8) var warp_x: texture_2d<f32>;
 @group(0) @binding(9) var warp_y: texture_2d<f32>;
@@ -57,10 +52,7 @@ fn offset_y(j: u32, y: f32) -> f32 {
 // `flags.x` the offsets are interpolated between the two nearest functions instead. The offsets
 // are scaled by the warp strength `ext.x` (1 = the seeds' warp; 0 = the identity, i.e. DV only).
 fn warp(u: vec2<f32>) -> vec2<f32> {
-    if !MAY_WARP {
-        return u;
-    }
-    if wp.warped < 0.5 {
+    if !WARPED {
         return u;
     }
     let res = u32(wp.res);
@@ -126,10 +118,7 @@ fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32) -> f32 {
 // at x', which the goal gives, so y is one 1D inversion; the row pass reads its functions at
 // y, so x is another.
 fn unwarp_exact(t: vec2<f32>) -> vec2<f32> {
-    if !MAY_WARP {
-        return t;
-    }
-    if wp.warped < 0.5 {
+    if !WARPED {
         return t;
     }
     let res = u32(wp.res);

@@ -235,6 +235,21 @@ pub struct Warped {
 }
 
 /// A bind group layout of `entries` (binding, type), all visible to `vis`.
+/// The pipeline constants of every warp shader (params.wgsl): the projection and whether the map
+/// warps, from the map's uniform. Each pass adds its own.
+fn base_constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
+    vec![("PARABOLOID", flag(p.projection != 0)), ("WARPED", flag(p.warped > 0.5))]
+}
+
+/// A boolean pipeline constant.
+fn flag(b: bool) -> f64 {
+    if b {
+        1.0
+    } else {
+        0.0
+    }
+}
+
 fn layout_at(gpu: &Gpu, label: &str, vis: wgpu::ShaderStages, entries: &[(u32, wgpu::BindingType)]) -> wgpu::BindGroupLayout {
     let e: Vec<_> = entries.iter().map(|&(binding, ty)| wgpu::BindGroupLayoutEntry { binding, visibility: vis, ty, count: None }).collect();
     crate::binding::entries_layout(&gpu.device, label, &e)

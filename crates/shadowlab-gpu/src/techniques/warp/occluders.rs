@@ -5,7 +5,7 @@
 //! decision is a function of the edge (both pieces on it agree: no cracks) and of the map (the
 //! same on every run), and an unsplit edge is still drawn, coarser, never dropped.
 
-use super::{compose, layout_at, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, compose, layout_at, WarpParams, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::scene_gpu::GpuScene;
 use crate::{binding, raster, Gpu};
 
@@ -49,9 +49,11 @@ pub fn pyramid_len(res: u32) -> u64 {
 }
 
 impl Occluders {
-    pub fn new(gpu: &Gpu, name: &str, res: u32, lookup: &wgpu::BindGroupLayout, scene: &GpuScene) -> Occluders {
+    pub fn new(gpu: &Gpu, name: &str, p: &WarpParams, lookup: &wgpu::BindGroupLayout, scene: &GpuScene) -> Occluders {
+        let res = p.res as u32;
         let label = format!("{name}.occluders");
-        let raster = raster::depth_pipeline(gpu, &label, &occluders_src(), &[lookup, &scene.layout], scene.has_cutouts);
+        let constants = base_constants(p);
+        let raster = raster::depth_pipeline_with(gpu, &label, &occluders_src(), &[lookup, &scene.layout], scene.has_cutouts, &constants);
         let depth = raster::depth_target(gpu, &label, res, res, 1, wgpu::TextureUsages::empty());
         let layout = layout_at(
             gpu,
@@ -79,8 +81,8 @@ impl Occluders {
         Occluders {
             res,
             hzb,
-            base: gpu.compute_pipeline(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout]),
-            reduce: gpu.compute_pipeline(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout]),
+            base: gpu.compute_pipeline_with(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout], &constants),
+            reduce: gpu.compute_pipeline_with(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout], &constants),
             groups,
             depth,
             raster,

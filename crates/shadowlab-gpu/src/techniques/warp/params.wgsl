@@ -73,6 +73,13 @@ struct WarpParams {
     pad2: u32,
 }
 
+// Knobs that choose code paths, fixed per map at pipeline creation (mod.rs `Warped` passes
+// `base_constants` to every warp pipeline): PARABOLOID = the uniform's `projection` is not
+// PLANAR, WARPED = its `warped`. lavapipe runs both sides of a branch on a uniform value on
+// lanes it masks off, so a branch on a constant, which is compiled away, is the lean one.
+override PARABOLOID: bool;
+override WARPED: bool;
+
 // Fixed-point scale of DV coordinates for the atomic min/max.
 const DV_SCALE: f32 = 16777216.0;
 
@@ -84,17 +91,13 @@ const PLANAR: u32 = 0u;
 const PARABOLOID_FRONT: u32 = 1u;
 const PARABOLOID_BACK: u32 = 2u;
 
-fn is_paraboloid(pw: WarpParams) -> bool {
-    return pw.projection != PLANAR;
-}
-
 // Base map coordinates (x, y) and depth of a world point as a clip position; w <= 0 behind a
 // spot. Paraboloid: the homogeneous form (n.x, n.y, depth (1 + n.z), 1 + n.z), finite for every
 // direction but the opposite axis (w = 0); directions of the other hemisphere land outside the
 // unit disc (the depth pass discards them by `hemisphere_side`).
 fn base_clip(pw: WarpParams, p: vec3<f32>) -> vec4<f32> {
     let a = pw.light_view_proj * vec4<f32>(p, 1.0);
-    if !is_paraboloid(pw) {
+    if !PARABOLOID {
         return a;
     }
     let d = length(a.xyz);
@@ -106,7 +109,7 @@ fn base_clip(pw: WarpParams, p: vec3<f32>) -> vec4<f32> {
 // Paraboloid: n.z of the direction of p in the hemisphere's light space (>= 0: this
 // hemisphere; the split plane belongs to the front, whose axis the light space's +z is). Planar: 1.
 fn hemisphere_side(pw: WarpParams, p: vec3<f32>) -> f32 {
-    if !is_paraboloid(pw) {
+    if !PARABOLOID {
         return 1.0;
     }
     let a = (pw.light_view_proj * vec4<f32>(p, 1.0)).xyz;
@@ -123,7 +126,7 @@ const SPLIT_OVERLAP: f32 = 0.1;
 // owns the split plane (side >= 0), the back (whose +z is the opposite axis) only side > 0.
 fn owns_sample(pw: WarpParams, p: vec3<f32>) -> bool {
     let s = hemisphere_side(pw, p);
-    return !is_paraboloid(pw) || s > 0.0 || (s == 0.0 && pw.projection == PARABOLOID_FRONT);
+    return !PARABOLOID || s > 0.0 || (s == 0.0 && pw.projection == PARABOLOID_FRONT);
 }
 
 fn clip_to_map(c: vec4<f32>) -> vec3<f32> {

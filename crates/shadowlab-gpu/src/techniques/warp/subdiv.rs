@@ -5,7 +5,7 @@
 //! the occluder map is drawn first (occluders.rs) and hidden edges stay unsplit.
 
 use super::depth::lookup_entries;
-use super::{compose, layout_at, Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, compose, flag, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::FrameInputs;
@@ -18,8 +18,9 @@ pub(super) fn source() -> String {
 }
 
 /// The subdivision layout (the lookup, the pieces, the counters, the two queues, the level's
-/// uniform, the occluder pyramid) and its split_root, split_args, split_level and draw_args.
-pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene) -> (wgpu::BindGroupLayout, [wgpu::ComputePipeline; 4]) {
+/// uniform, the occluder pyramid) and its split_root, split_args, split_level and draw_args,
+/// specialised to `p` (params.wgsl's constants and `CULL_HIDDEN`).
+pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) -> (wgpu::BindGroupLayout, [wgpu::ComputePipeline; 4]) {
     let look = lookup_entries();
     let (ro, rw) = (binding::storage(true), binding::storage(false));
     let layout = layout_at(
@@ -29,8 +30,10 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene) -> (wgpu::BindG
         &[look[0], look[1], look[2], look[3], (10, rw), (11, rw), (12, rw), (13, rw), (14, binding::uniform()), (15, ro)],
     );
     let src = source();
+    let mut constants = base_constants(p);
+    constants.push(("CULL_HIDDEN", flag(p.cull_hidden > 0.5)));
     let pipelines = ["split_root", "split_args", "split_level", "draw_args"]
-        .map(|e| gpu.compute_pipeline(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout]));
+        .map(|e| gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout], &constants));
     (layout, pipelines)
 }
 

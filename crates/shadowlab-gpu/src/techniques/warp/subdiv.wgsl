@@ -24,6 +24,9 @@
 // per piece on it), -, -], then per queue BUCKETS children and BUCKETS pieces by
 // bucket of triangle index.
 
+// `cull_hidden`, fixed at pipeline creation (subdiv.rs; PARABOLOID and WARPED in params.wgsl).
+override CULL_HIDDEN: bool;
+
 struct Level {
     // x: level (1..), y: 1 on the last level, z: input queue (0 or 1), w: capacity per queue
     v: vec4<u32>,
@@ -90,7 +93,7 @@ fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
         return false;
     }
     // paraboloid: an edge wholly behind the drawn part of the hemisphere is never drawn
-    if is_paraboloid(wp) && max(hemisphere_side(wp, pa), hemisphere_side(wp, pb)) < -SPLIT_OVERLAP {
+    if PARABOLOID && max(hemisphere_side(wp, pa), hemisphere_side(wp, pb)) < -SPLIT_OVERLAP {
         return false;
     }
     let ua = to_dv(clip_to_map(a).xy, r);
@@ -98,7 +101,7 @@ fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
     if any(max(ua, ub) < vec2<f32>(0.0)) || any(min(ua, ub) > vec2<f32>(1.0)) {
         return false;
     }
-    if is_paraboloid(wp) {
+    if PARABOLOID {
         return paraboloid_edge_error(pa, pb, warp(ua), warp(ub), r) > wp.subdiv;
     }
     let wa = warp(ua);
@@ -123,7 +126,7 @@ fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
 // Outside the crop: unknown, not hidden. Point-sampled maps can miss gaps below a texel; an
 // edge judged hidden there is only drawn coarser (unsplit), never dropped.
 fn hidden(lo: vec2<f32>, hi: vec2<f32>, z: f32) -> bool {
-    if wp.cull_hidden < 0.5 {
+    if !CULL_HIDDEN {
         return false;
     }
     let res = u32(wp.res);
@@ -192,7 +195,7 @@ fn interior_needs_split(p: vec4<u32>) -> bool {
     if min(min(a.w, b.w), c.w) <= 1e-7 {
         return false;
     }
-    if is_paraboloid(wp) {
+    if PARABOLOID {
         let side = max(max(hemisphere_side(wp, corner_pos(p.x, p.y)), hemisphere_side(wp, corner_pos(p.x, p.z))),
             hemisphere_side(wp, corner_pos(p.x, p.w)));
         if side < -SPLIT_OVERLAP {
@@ -289,14 +292,14 @@ fn mix_corner(a: u32, b: u32, t: f32) -> u32 {
     return pack_corner(vec2<u32>(round(mix(vec2<f32>(corner(a)), vec2<f32>(corner(b)), t))));
 }
 
+// A whole triangle's corners as packed barycentrics: (0, 0), (1, 0), (0, 1).
+const ROOT_CORNERS = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
+
 // Planar projections: the triangle clipped to the light's near plane (clip z >= 0) before any
 // warping, because the warp of a vertex behind a spot light is meaningless (its projection
 // flips) and one such vertex spreads its triangle across the whole map. Clip space is affine in
 // world space, so the cut corners are exact barycentric mixes. Wholly behind: nothing drawn;
 // a cut leaving a quad: its second half is appended like a finished piece.
-// A whole triangle's corners as packed barycentrics: (0, 0), (1, 0), (0, 1).
-const ROOT_CORNERS = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
-
 @compute @workgroup_size(64)
 fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
@@ -304,7 +307,7 @@ fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
         return;
     }
     let c = ROOT_CORNERS;
-    if is_paraboloid(wp) {
+    if PARABOLOID {
         place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
         return;
     }
