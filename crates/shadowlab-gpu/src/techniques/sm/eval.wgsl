@@ -10,6 +10,9 @@ struct SmParams {
 }
 
 @group(0) @binding(6) var<uniform> sm: SmParams;
+// The PCF kernel width (= sm.texel.w), fixed at pipeline creation (pass.rs): a constant loop
+// bound is unrolled; lavapipe runs a loop bounded by a uniform value with masked lanes.
+override PCF: u32;
 @group(0) @binding(7) var shadow_map: texture_depth_2d;
 @group(0) @binding(8) var cmp: sampler_comparison;
 @group(0) @binding(9) var<storage, read_write> counts: array<atomic<u32>>;
@@ -36,7 +39,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     count_sample(to_map(p), res);
 
     // the PCF kernel reaches `half` texels from the sample (bias.wgsl)
-    let k = i32(sm.texel.w);
+    let k = i32(PCF);
     let half = f32(k - 1) * 0.5;
     let q = biased_point(p, n, l, texel_at(sm.texel, p), sm.bias, half);
     let m = to_map(q);

@@ -99,7 +99,7 @@ impl MapPass {
             &label,
             &[binding::uniform(), binding::texture_depth(), binding::comparison_sampler(), binding::storage(false)],
         );
-        let eval = EvalPipelines::new(gpu, &label, &eval_source(), &eval_layout, &[]);
+        let eval = EvalPipelines::new(gpu, &label, &eval_source(), &eval_layout, &[("PCF", pcf as f64)]);
         let sampler = raster::comparison_sampler(gpu, &format!("{name}.cmp"));
         let counts = gpu.storage(&format!("{name}.counts"), res as u64 * res as u64 * 4);
         MapPass { depth, pcf, params, counts, eval, eval_layout, sampler }
