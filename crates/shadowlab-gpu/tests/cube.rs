@@ -188,7 +188,7 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 }
 
 #[test]
-fn cube_notw_lists_notws_parameters_with_eight_defaults_of_its_own() {
+fn cube_notw_lists_notws_parameters_with_nine_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
     // notw's whole list (the same keys in the same order, as the code reads them all)
     let (a, b) = (cube::CubeNotwSettings::defs(), warp::NotwSettings::defs());
@@ -203,6 +203,8 @@ fn cube_notw_lists_notws_parameters_with_eight_defaults_of_its_own() {
         ("bias_mode", cube::DEFAULT_NOTW_BIAS_MODE),
         ("window_tent", cube::DEFAULT_NOTW_WINDOW_TENT),
         ("edge_importance", cube::DEFAULT_NOTW_EDGE_IMPORTANCE),
+        // notw's exact inversion was chosen on planar maps; the faces keep the Newton steps
+        ("exact_inverse", warp::DEFAULT_EXACT_INVERSE),
     ];
     for (x, y) in a.iter().zip(b) {
         match own.iter().find(|(k, _)| *k == x.key) {

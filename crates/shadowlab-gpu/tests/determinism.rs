@@ -36,7 +36,8 @@ fn subdivision_out_of_capacity_is_deterministic_and_flagged() {
         ("courtyard", 0, "rtw:subdiv_capacity=64", true),
         ("room", 1, "dpsm:subdiv_capacity=64", true),
         ("room", 1, "dpsm-notw:subdiv_capacity=64", true),
-        ("courtyard", 0, "notw:subdiv_capacity=100000", true),
+        // window 16 (notw's earlier default): about twice the pieces of today's 128
+        ("courtyard", 0, "notw:window=16,subdiv_capacity=100000", true),
         ("room", 1, "cube-notw:subdiv_capacity=64", true),
         ("courtyard", 0, "rtw", false),
         ("room", 1, "dpsm", false),

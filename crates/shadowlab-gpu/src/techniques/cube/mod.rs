@@ -153,6 +153,8 @@ shadowlab_core::param_set! {
     pub struct CubeNotwSettings {
         pub notw: w::NotwSettings = Block::as_declared()
             .with(w::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"))
+            // notw's exact inversion was chosen on planar maps; the faces keep the Newton steps
+            .with(w::EXACT_INVERSE)
             .with(w::NOTW_BLUR.with_default(DEFAULT_NOTW_BLUR, THREE_SETUPS))
             .with(w::MIX.with_default(DEFAULT_NOTW_MIX, THREE_SETUPS))
             .with(w::NOTW_SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, THREE_SETUPS))

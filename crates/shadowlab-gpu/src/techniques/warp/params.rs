@@ -209,12 +209,25 @@ pub const DEPTH_CLAMP: ParamDef = ParamDef::integer(
 /// straddles the warp's kinks (a residual above 0.25 warped texels falls back to the
 /// interpolated depth, off by up to the subdivision bend). Off: the Newton steps.
 pub const DEFAULT_EXACT_INVERSE: f64 = 0.0;
+/// `notw`'s window and inversion, chosen on the quality/cost front (issue 31; `shadowlab tune`,
+/// 1024x1024, docs/bench/lean.md): trained on warp-courtyard, warp-sponza and kinks-city, where
+/// window 16 / 64 / 128 / 256 give a mean 0.872 / 0.688 / 0.632 / 0.648 % wrong; validated on
+/// courtyard, sponza, warp-conference and kinks-city-b (not used to choose): 0.690 -> 0.539 %
+/// mean, no worse on any, with 5.3x fewer subdivision pieces on courtyard (594 k -> 111 k) and
+/// 5.6x on sponza. A wide window smooths the warp, so fewer edges bend past `subdiv`; the exact
+/// inversion is as good or better than the Newton steps and cheaper on lavapipe. Too low: a
+/// kink per function, millions of pieces; too high: RTW-like, less even sampling.
+pub const DEFAULT_NOTW_WINDOW: f64 = 128.0;
+pub const DEFAULT_NOTW_EXACT_INVERSE: f64 = 1.0;
+const NOTW_TUNED: &str = "shadowlab tune: trained on warp-courtyard, warp-sponza, kinks-city; validated on courtyard, sponza, warp-conference, kinks-city-b (docs/bench/lean.md)";
+pub const NOTW_WINDOW: ParamDef = WINDOW.with_default(DEFAULT_NOTW_WINDOW, NOTW_TUNED);
 pub const EXACT_INVERSE: ParamDef = ParamDef::flag(
     "exact_inverse",
     DEFAULT_EXACT_INVERSE != 0.0,
     "exact_depth: pull fragments back through the warp exactly (bisection over the texel edges of the two 1D passes) instead of 3 Newton steps; no fallback to the interpolated depth",
     "shadowlab (NoTW kinks, issue 18; docs/bench/warp_kinks.md)",
 );
+pub const NOTW_EXACT_INVERSE: ParamDef = EXACT_INVERSE.with_default(DEFAULT_NOTW_EXACT_INVERSE, NOTW_TUNED);
 
 /// Subdivision leaves an edge unsplit when an unwarped occluder map (the scene drawn into the
 /// DV-cropped map, res x res, then a pyramid of maxima) is nearer than the edge all around it:

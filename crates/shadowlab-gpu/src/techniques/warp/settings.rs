@@ -167,7 +167,7 @@ shadowlab_core::param_set! {
     /// the shadow-edge importance (planar maps only).
     pub struct NotwSettings {
         pub res: u32 = RES,
-        pub core: NotwCore = Block::as_declared(),
+        pub core: NotwCore = Block::as_declared().with(NOTW_WINDOW).with(NOTW_EXACT_INVERSE),
         pub cull_hidden: bool = CULL_HIDDEN,
         pub window_tent: bool = WINDOW_TENT,
         pub edge_importance: u32 = EDGE_IMPORTANCE,
