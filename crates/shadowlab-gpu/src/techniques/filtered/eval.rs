@@ -3,7 +3,7 @@
 //! gather; with mips trilinear at the pixel's footprint); the analysis variant counts the view
 //! samples per texel.
 
-use super::{Filtered, MOMENTS_WGSL, PARAMS_WGSL};
+use super::{Filtered, FilteredParams, MOMENTS_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, Gpu, GpuError};
@@ -14,13 +14,25 @@ pub(super) fn source() -> String {
     compose_view(&format!("{MOMENTS_WGSL}{PARAMS_WGSL}{EVAL_WGSL}"), false)
 }
 
+/// The evaluation's pipeline constants (eval.wgsl): the knobs of `p` that choose code paths.
+fn constants(p: &FilteredParams) -> [(&'static str, f64); 4] {
+    let flag = |b: bool| if b { 1.0 } else { 0.0 };
+    [
+        ("KIND", p.kind as f64),
+        ("SINGLE_DEPTH", flag(p.single_depth != 0)),
+        ("MIPPED", flag(p.mip_levels > 1)),
+        ("PERSPECTIVE", flag(p.perspective > 0.5)),
+    ]
+}
+
 /// The evaluation layout (the view, the uniform, the map, its sampler, the counts), the
-/// evaluation with its analysis variant, and the map's clamped sampler.
-pub(super) fn pipelines(gpu: &Gpu, name: &str) -> (wgpu::BindGroupLayout, EvalPipelines, wgpu::Sampler) {
+/// evaluation with its analysis variant specialised to `p` ([`constants`]), and the map's
+/// clamped sampler.
+pub(super) fn pipelines(gpu: &Gpu, name: &str, p: &FilteredParams) -> (wgpu::BindGroupLayout, EvalPipelines, wgpu::Sampler) {
     let sampler_type = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering);
     let layout =
         view_layout(gpu, &format!("{name}.eval"), &[binding::uniform(), binding::texture_float(), sampler_type, binding::storage(false)]);
-    let eval = EvalPipelines::new(gpu, &format!("{name}.evaluate"), &source(), &layout, &[]);
+    let eval = EvalPipelines::new(gpu, &format!("{name}.evaluate"), &source(), &layout, &constants(p));
     let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("filtered.gather"),
         address_mode_u: wgpu::AddressMode::ClampToEdge,

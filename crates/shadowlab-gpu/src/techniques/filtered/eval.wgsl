@@ -9,6 +9,13 @@
 
 
 @group(0) @binding(6) var<uniform> fp: FilteredParams;
+// The uniform's `kind`, `single_depth != 0`, `mip_levels > 1` and `perspective`, fixed at
+// pipeline creation (eval.rs): lavapipe runs every side of a branch on a value it reads from a
+// buffer, so the four representations' tests and the trilinear path cost every variant.
+override KIND: u32;
+override SINGLE_DEPTH: bool;
+override MIPPED: bool;
+override PERSPECTIVE: bool;
 @group(0) @binding(7) var shadow_map: texture_2d<f32>;
 @group(0) @binding(8) var gather_sampler: sampler;
 @group(0) @binding(9) var<storage, read_write> counts: array<atomic<u32>>;
@@ -16,12 +23,12 @@
 fn to_map(p: vec3<f32>) -> vec3<f32> {
     let c = fp.light_view_proj * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
-    let depth = select(c.z, c.w * fp.inv_far, fp.perspective > 0.5);
+    let depth = select(c.z, c.w * fp.inv_far, PERSPECTIVE);
     return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, depth);
 }
 
 fn visibility_of(m: vec4<f32>, d: f32) -> f32 {
-    switch fp.kind {
+    switch KIND {
         case 0u: {
             return vsm_visibility(m, d, fp.min_variance);
         }
@@ -38,7 +45,7 @@ fn visibility_of(m: vec4<f32>, d: f32) -> f32 {
 }
 
 fn visibility_gather(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
-    return visibility_gather_of(fp.kind, z, w, d, vec4<f32>(fp.min_variance, fp.esm_c, fp.evsm_c_pos, fp.evsm_c_neg), fp.moment_bias);
+    return visibility_gather_of(KIND, z, w, d, vec4<f32>(fp.min_variance, fp.esm_c, fp.evsm_c_pos, fp.evsm_c_neg), fp.moment_bias);
 }
 
 // The 2x2 texels around uv on mip `level`, interpolated bilinearly (same texels and weights
@@ -90,7 +97,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
     }
     var texel = fp.texel_world;
-    if fp.perspective > 0.5 {
+    if PERSPECTIVE {
         texel = fp.texel_world * max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
     }
     let l = to_light(light, s.p);
@@ -102,12 +109,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let d = max(m.z, 0.0);
     let w = gather_weights(m.xy, res);
-    if fp.single_depth != 0u {
+    if SINGLE_DEPTH {
         let z = textureGather(0, shadow_map, gather_sampler, m.xy);
         visibility[s.i] = visibility_gather(z, w, d);
         return;
     }
-    if fp.mip_levels > 1u {
+    if MIPPED {
         // trilinear: the level whose texels match the pixel's footprint in the map
         let top = f32(fp.mip_levels - 1u);
         let lod = clamp(log2(max(footprint(vec2<i32>(id.xy), m0.xy), 1.0)), 0.0, top);

@@ -18,7 +18,7 @@ impl Filtered {
         let plan = Plan::new(gpu, scene, settings, rep, light)?;
         let t = Targets::new(gpu, &plan)?;
         let (render_pipeline, render_group) = render::pipeline(gpu, scene, plan.kind.name(), plan.format, &t.uniform);
-        let (eval_layout, eval, sampler) = eval::pipelines(gpu, plan.kind.name());
+        let (eval_layout, eval, sampler) = eval::pipelines(gpu, plan.kind.name(), &plan.params);
         Ok(Filtered {
             kind: plan.kind,
             sd: plan.sd,
