@@ -15,8 +15,9 @@ pub(super) fn source() -> String {
 }
 
 /// The evaluation layout (the view, `CubeParams`, the face array, the counts) and the
-/// evaluation with its analysis variant; `hardware`: the faces hold reversed depth.
-pub(super) fn pipelines(gpu: &Gpu, hardware: bool) -> (wgpu::BindGroupLayout, EvalPipelines) {
+/// evaluation with its analysis variant; `hardware`: the faces hold reversed depth; `pcf`: the
+/// kernel width (a pipeline constant).
+pub(super) fn pipelines(gpu: &Gpu, hardware: bool, pcf: u32) -> (wgpu::BindGroupLayout, EvalPipelines) {
     let array = wgpu::BindingType::Texture {
         sample_type: wgpu::TextureSampleType::Depth,
         view_dimension: wgpu::TextureViewDimension::D2Array,
@@ -24,7 +25,7 @@ pub(super) fn pipelines(gpu: &Gpu, hardware: bool) -> (wgpu::BindGroupLayout, Ev
     };
     let layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
     let hw = if hardware { 1.0 } else { 0.0 };
-    let eval = EvalPipelines::new(gpu, "cube.evaluate", &source(), &layout, &[("HW_DEPTH", hw)]);
+    let eval = EvalPipelines::new(gpu, "cube.evaluate", &source(), &layout, &[("HW_DEPTH", hw), ("PCF", pcf as f64)]);
     (layout, eval)
 }
 

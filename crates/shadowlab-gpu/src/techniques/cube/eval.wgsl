@@ -24,6 +24,8 @@ struct CubeParams {
 // `depth=hardware`: the faces hold near / z (reversed depth, 0 = empty); the occluder's
 // distance is z times the length of the texel's centre direction (whose axis component is 1).
 override HW_DEPTH: bool = false;
+// The PCF kernel width (= cube.pcf), fixed at pipeline creation: a constant loop bound.
+override PCF: u32;
 
 fn stored_distance(g: u32, t: vec2<i32>, res: f32) -> f32 {
     let v = textureLoad(faces, t, i32(g), 0);
@@ -57,7 +59,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         atomicAdd(&counts[(f0 * u32(ires) + u32(t0.y)) * u32(ires) + u32(t0.x)], 1u);
     }
 
-    let k = i32(cube.pcf);
+    let k = i32(PCF);
     let half = f32(k - 1) * 0.5;
     let texel = 2.0 * dot(d0, cube_basis(f0)[0]) / res;
     let q = biased_point(s.p, s.n, l, texel, cube.bias, half);

@@ -24,7 +24,7 @@ impl CubeMap {
         let map = raster::depth_target(gpu, "cube.map", res, res, 6, wgpu::TextureUsages::empty());
         let faces = FacePasses::new(gpu, scene, pos, near, far, hardware);
         let params = CubeParams { position: pos.into(), far, res: res as f32, pcf: pcf as f32, near, pad0: 0.0, bias: p.bias.packed() };
-        let (eval_layout, eval) = eval::pipelines(gpu, hardware);
+        let (eval_layout, eval) = eval::pipelines(gpu, hardware, pcf);
         Ok(CubeMap {
             res,
             far,

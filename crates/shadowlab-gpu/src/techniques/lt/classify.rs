@@ -4,6 +4,7 @@
 
 use super::resources::Resources;
 use super::screen::Screen;
+use super::uniforms::{LtParams, FLAG_POINT};
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, FrameInputs};
 use crate::techniques::filtered::MOMENTS_WGSL;
@@ -21,7 +22,9 @@ pub(super) struct ClassifyPass {
 }
 
 impl ClassifyPass {
-    pub fn new(gpu: &Gpu, name: &str) -> ClassifyPass {
+    /// The pass, specialised to `p`'s technique, base representation, projection and light kind
+    /// (classify.wgsl's pipeline constants).
+    pub fn new(gpu: &Gpu, name: &str, p: &LtParams) -> ClassifyPass {
         let nf = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering);
         let (ro, rw, tex) = (binding::storage(true), binding::storage(false), binding::texture_float());
         let arr = wgpu::BindingType::Texture {
@@ -30,7 +33,14 @@ impl ClassifyPass {
             multisampled: false,
         };
         let layout = view_layout(gpu, &format!("{name}.classify"), &[binding::uniform(), arr, arr, nf, tex, ro, rw, ro, rw, rw]);
-        let pipeline = gpu.compute_pipeline(&format!("{name}.classify"), &source(), "main", &[&layout]);
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let constants = [
+            ("TECHNIQUE", p.technique as f64),
+            ("BASE", p.base as f64),
+            ("PERSPECTIVE", flag(p.perspective > 0.5)),
+            ("POINT", flag(p.flags & FLAG_POINT != 0)),
+        ];
+        let pipeline = gpu.compute_pipeline_with(&format!("{name}.classify"), &source(), "main", &[&layout], &constants);
         ClassifyPass { layout, pipeline }
     }
 

@@ -65,6 +65,12 @@ const FLAG_HISTORY_TEST: u32 = 8u;
 const FLAG_DYNAMIC: u32 = 16u;
 const FLAG_HAS_HISTORY: u32 = 32u;
 const FLAG_POINT: u32 = 64u;
+// The uniform's `technique`, `base`, `perspective` and FLAG_POINT, fixed at pipeline creation
+// (classify.rs): lavapipe runs every side of a branch on a value it reads from a buffer.
+override TECHNIQUE: u32;
+override BASE: u32;
+override PERSPECTIVE: bool;
+override POINT: bool;
 
 const BIT_ST: u32 = 1u;
 const BIT_LTT: u32 = 2u;
@@ -84,7 +90,7 @@ const BIT_RS: u32 = 4u;
 fn to_map(level: u32, p: vec3<f32>) -> vec3<f32> {
     let c = lp.levels[level].view_proj * vec4<f32>(p, 1.0);
     let ndc = c.xyz / c.w;
-    let depth = select(c.z, c.w * lp.inv_far, lp.perspective > 0.5);
+    let depth = select(c.z, c.w * lp.inv_far, PERSPECTIVE);
     return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, depth);
 }
 
@@ -101,7 +107,7 @@ fn cube_face(d: vec3<f32>) -> u32 {
 }
 
 fn base_visibility(z: vec4<f32>, w: vec4<f32>, d: f32) -> f32 {
-    return visibility_gather_of(lp.base, z, w, d, vec4<f32>(lp.min_variance, lp.esm_c, lp.evsm_c_pos, lp.evsm_c_neg), lp.moment_bias);
+    return visibility_gather_of(BASE, z, w, d, vec4<f32>(lp.min_variance, lp.esm_c, lp.evsm_c_pos, lp.evsm_c_neg), lp.moment_bias);
 }
 
 // Mask bits of pixel i (one light in the low 3 bits of a `history.z`-bit texel, packed in words).
@@ -203,7 +209,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let depth = textureLoad(g_position, id.xy, 0).w;
     let levels = u32(lp.layers);
     var c = 0u;
-    if (lp.flags & FLAG_POINT) != 0u {
+    if POINT {
         c = cube_face(s.p - light.position.xyz);
     } else {
         while c < levels && depth > lp.levels[c].info.z {
@@ -212,10 +218,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let level = min(c, levels - 1u);
     var texel = lp.levels[level].info.x;
-    if (lp.flags & FLAG_POINT) != 0u {
+    if POINT {
         let a = abs(s.p - light.position.xyz);
         texel *= max(a.x, max(a.y, a.z));
-    } else if lp.perspective > 0.5 {
+    } else if PERSPECTIVE {
         texel *= max(dot(s.p - light.position.xyz, light.direction.xyz), 0.0);
     }
     let l = to_light(light, s.p);
@@ -235,7 +241,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             z = min(z, zd);
         }
         let eps = lp.eps;
-        if lp.technique == 2u {
+        if TECHNIQUE == 2u {
             // hybrid-pcf: 2x2 hard tests of the plain depth map (bias applied above)
             let lit = vec4<f32>(z >= vec4<f32>(d));
             let n_lit = dot(lit, vec4<f32>(1.0));
@@ -246,7 +252,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             ray = eps < v && v < 1.0 - eps;
         }
         st = v < 0.5;
-        if lp.technique == 0u {
+        if TECHNIQUE == 0u {
             let ltt0 = ray;
             ray = temporal(id.xy, s.p, s.n, ltt0, st, may_remove);
             if ltt0 && !ray {

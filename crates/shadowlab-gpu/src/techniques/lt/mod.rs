@@ -151,7 +151,7 @@ impl LeakTracing {
         let resources = Resources::new(gpu, &plan);
         let name = plan.mode.name();
         let map_pass = MapPass::new(gpu, scene, name, &resources.map_uniforms);
-        let classify = ClassifyPass::new(gpu, name);
+        let classify = ClassifyPass::new(gpu, name, &plan.params);
         let trace = TracePass::new(gpu, scene, name);
         Ok(LeakTracing {
             mode: plan.mode,
