@@ -7,6 +7,16 @@ pub const COMMON: &str = include_str!("common.wgsl");
 pub const SCENE: &str = include_str!("scene.wgsl");
 pub const DEPTH: &str = include_str!("depth.wgsl");
 
+/// The value of a boolean WGSL `override` in a pipeline's constants (wgpu takes every constant
+/// as an f64).
+pub fn flag(b: bool) -> f64 {
+    if b {
+        1.0
+    } else {
+        0.0
+    }
+}
+
 /// `common.wgsl`, then `scene.wgsl` if `with_scene`, then `body`.
 pub fn compose(body: &str, with_scene: bool) -> String {
     let mut s = String::from(COMMON);

@@ -5,7 +5,7 @@ use wgpu::TextureFormat as F;
 
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
+use crate::shaders::{compose, flag};
 use crate::{binding, raster, Gpu};
 
 const GBUFFER_WGSL: &str = include_str!("gbuffer.wgsl");
@@ -113,7 +113,7 @@ impl GBufferPass {
         let targets: Vec<Option<wgpu::ColorTargetState>> =
             [POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT, MOTION_FORMAT].iter().map(|f| Some((*f).into())).collect();
         // nothing to discard: the same fragments survive, without shading the hidden ones
-        let discards = if scene.has_cutouts || scene.single_sided { 1.0 } else { 0.0 };
+        let discards = flag(scene.has_cutouts || scene.single_sided);
         let raster = raster::scene_pipeline_constants(
             gpu,
             "gbuffer",

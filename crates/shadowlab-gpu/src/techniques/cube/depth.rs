@@ -8,7 +8,7 @@ use shadowlab_core::techniques::cube::face_view_proj;
 use super::{CubeFace, CubeMap, FACES_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose_depth;
+use crate::shaders::{compose_depth, flag};
 use crate::technique::FrameInputs;
 use crate::{binding, raster, Gpu};
 
@@ -129,7 +129,7 @@ fn face_pipeline(
     cull_in_vs: bool,
     cutouts: bool,
 ) -> wgpu::RenderPipeline {
-    let constants = [("CULL_IN_VS", if cull_in_vs { 1.0 } else { 0.0 }), ("HW_DEPTH", if hardware { 1.0 } else { 0.0 })];
+    let constants = [("CULL_IN_VS", flag(cull_in_vs)), ("HW_DEPTH", flag(hardware))];
     let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     let fragment = match (hardware, cutouts) {
         (false, _) => Some("fs_main"),

@@ -4,6 +4,7 @@
 
 use super::{CubeMap, FACES_WGSL};
 use crate::record::Recorder;
+use crate::shaders::flag;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::techniques::sm::BIAS_WGSL;
 use crate::{binding, Gpu, GpuError};
@@ -24,8 +25,7 @@ pub(super) fn pipelines(gpu: &Gpu, hardware: bool, pcf: u32) -> (wgpu::BindGroup
         multisampled: false,
     };
     let layout = view_layout(gpu, "cube.evaluate", &[binding::uniform(), array, binding::storage(false)]);
-    let hw = if hardware { 1.0 } else { 0.0 };
-    let eval = EvalPipelines::new(gpu, "cube.evaluate", &source(), &layout, &[("HW_DEPTH", hw), ("PCF", pcf as f64)]);
+    let eval = EvalPipelines::new(gpu, "cube.evaluate", &source(), &layout, &[("HW_DEPTH", flag(hardware)), ("PCF", pcf as f64)]);
     (layout, eval)
 }
 

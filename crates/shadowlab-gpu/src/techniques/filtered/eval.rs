@@ -5,6 +5,7 @@
 
 use super::{Filtered, FilteredParams, MOMENTS_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
+use crate::shaders::flag;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, Gpu, GpuError};
 
@@ -16,7 +17,6 @@ pub(super) fn source() -> String {
 
 /// The evaluation's pipeline constants (eval.wgsl): the knobs of `p` that choose code paths.
 fn constants(p: &FilteredParams) -> [(&'static str, f64); 4] {
-    let flag = |b: bool| if b { 1.0 } else { 0.0 };
     [
         ("KIND", p.kind as f64),
         ("SINGLE_DEPTH", flag(p.single_depth != 0)),

@@ -6,6 +6,7 @@ use super::resources::Resources;
 use super::screen::Screen;
 use super::uniforms::{LtParams, FLAG_POINT};
 use crate::record::Recorder;
+use crate::shaders::flag;
 use crate::technique::{compose_view, view_layout, FrameInputs};
 use crate::techniques::filtered::MOMENTS_WGSL;
 use crate::{binding, Gpu};
@@ -33,7 +34,6 @@ impl ClassifyPass {
             multisampled: false,
         };
         let layout = view_layout(gpu, &format!("{name}.classify"), &[binding::uniform(), arr, arr, nf, tex, ro, rw, ro, rw, rw]);
-        let flag = |b: bool| if b { 1.0 } else { 0.0 };
         let constants = [
             ("TECHNIQUE", p.technique as f64),
             ("BASE", p.base as f64),

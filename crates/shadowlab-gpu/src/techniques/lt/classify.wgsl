@@ -64,8 +64,7 @@ const FLAG_FORCE_ALL: u32 = 4u;
 const FLAG_HISTORY_TEST: u32 = 8u;
 const FLAG_DYNAMIC: u32 = 16u;
 const FLAG_HAS_HISTORY: u32 = 32u;
-const FLAG_POINT: u32 = 64u;
-// The uniform's `technique`, `base`, `perspective` and FLAG_POINT, fixed at pipeline creation
+// The uniform's `technique`, `base`, `perspective` and its FLAG_POINT bit (uniforms.rs), fixed at pipeline creation
 // (classify.rs): lavapipe runs every side of a branch on a value it reads from a buffer.
 override TECHNIQUE: u32;
 override BASE: u32;

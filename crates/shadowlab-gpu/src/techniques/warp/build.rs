@@ -306,7 +306,7 @@ impl Pipelines {
         let name = plan.name;
         let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant, &plan.params);
         let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, &plan.params);
-        let occluders = plan.occluders.then(|| occluders::Occluders::new(gpu, name, &plan.params, &lookup_layout, scene));
+        let occluders = plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &plan.params, &lookup_layout, scene));
         let (split_layout, split) = subdiv::pipelines(gpu, name, scene, &plan.params);
         let (eval_layout, eval) = eval::pipelines(gpu, name, &plan.params);
         let sampler = eval::sampler(gpu);

@@ -4,9 +4,10 @@
 //! warp's preimage of the fragment (depth_exact.wgsl). Its lookup bindings (the uniform, the DV
 //! bounds, the warps) are shared with the occluder and subdivision passes.
 
-use super::{base_constants, compose, flag, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, compose, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
+use crate::shaders::flag;
 use crate::technique::FrameInputs;
 use crate::{binding, raster, Gpu};
 

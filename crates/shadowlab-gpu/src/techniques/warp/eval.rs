@@ -4,8 +4,9 @@
 //! with the nearest depth of 3x3 texels per tap); the analysis variant also counts the samples
 //! per warped texel.
 
-use super::{base_constants, flag, WarpParams, Warped, DV_CROP_CLOSED, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, WarpParams, Warped, DV_CROP_CLOSED, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
+use crate::shaders::flag;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, Gpu, GpuError};
 

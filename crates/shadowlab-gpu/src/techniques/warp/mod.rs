@@ -44,7 +44,7 @@ use shadowlab_core::techniques::dpsm::Hemisphere;
 
 use crate::prefix_sum::PrefixSum;
 use crate::record::Recorder;
-use crate::shaders::compose;
+use crate::shaders::{compose, flag};
 use crate::technique::{counted_evaluation, FrameInputs, Technique, TechniqueInfo, TechniqueReport};
 use crate::{Gpu, GpuError};
 
@@ -239,15 +239,6 @@ pub struct Warped {
 /// warps, from the map's uniform. Each pass adds its own.
 fn base_constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
     vec![("PARABOLOID", flag(p.projection != 0)), ("WARPED", flag(p.warped > 0.5))]
-}
-
-/// A boolean pipeline constant.
-fn flag(b: bool) -> f64 {
-    if b {
-        1.0
-    } else {
-        0.0
-    }
 }
 
 fn layout_at(gpu: &Gpu, label: &str, vis: wgpu::ShaderStages, entries: &[(u32, wgpu::BindingType)]) -> wgpu::BindGroupLayout {

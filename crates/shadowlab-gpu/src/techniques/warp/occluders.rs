@@ -49,8 +49,7 @@ pub fn pyramid_len(res: u32) -> u64 {
 }
 
 impl Occluders {
-    pub fn new(gpu: &Gpu, name: &str, p: &WarpParams, lookup: &wgpu::BindGroupLayout, scene: &GpuScene) -> Occluders {
-        let res = p.res as u32;
+    pub fn new(gpu: &Gpu, name: &str, res: u32, p: &WarpParams, lookup: &wgpu::BindGroupLayout, scene: &GpuScene) -> Occluders {
         let label = format!("{name}.occluders");
         let constants = base_constants(p);
         let raster = raster::depth_pipeline_with(gpu, &label, &occluders_src(), &[lookup, &scene.layout], scene.has_cutouts, &constants);

@@ -5,9 +5,10 @@
 //! the occluder map is drawn first (occluders.rs) and hidden edges stay unsplit.
 
 use super::depth::lookup_entries;
-use super::{base_constants, compose, flag, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, compose, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
+use crate::shaders::flag;
 use crate::technique::FrameInputs;
 use crate::{binding, Gpu};
 
