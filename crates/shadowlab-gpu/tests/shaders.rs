@@ -251,7 +251,7 @@ fn csm_and_reduce_layouts_match_rust() {
 
 #[test]
 fn iasm_layouts_match_wgsl() {
-    use shadowlab_gpu::techniques::iasm::{IasmParams, TileParams};
+    use shadowlab_gpu::techniques::iasm::{FitParams, IasmParams, TileParams};
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     for n in ["iasm/analysis.wgsl", "iasm/eval.wgsl", "iasm/eval_atlas.wgsl", "iasm/probe.wgsl"] {
@@ -274,6 +274,7 @@ fn iasm_layouts_match_wgsl() {
     for n in ["iasm/render.wgsl", "iasm/atlas.wgsl"] {
         check(&get(n), "TileParams", size_of::<TileParams>(), &[("tile", offset_of!(TileParams, tile))]);
     }
+    check_all(&get("iasm/fit.wgsl"), "FitParams", size_of::<FitParams>(), fields!(FitParams; margin, min_side, prev, div, shrink, steps, pad0, pad1));
 }
 
 #[test]

@@ -1,10 +1,10 @@
 //! `iasm`'s importance pass `iasm.importance` (analysis.wgsl): per tile of the square, the view
 //! samples' importance (equation 3.1), count and light-depth range, and the samples outside the
-//! square; read back for the plan (`iasm.readback`, the sync).
+//! square; read back for the plan with the fit's square (`iasm.readback`, the sync).
 
 use shadowlab_core::techniques::iasm::TILE_COUNT;
 
-use super::plan::{TileStats, STATS_WORDS};
+use super::plan::READ_WORDS;
 use super::uniforms::{IasmParams, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, FrameInputs};
@@ -28,21 +28,18 @@ impl AnalysisPass {
         AnalysisPass { layout, pipeline }
     }
 
-    /// Dispatches the analysis of `f` over the square of `params` (written to `params_buf`) into
-    /// `stats_buf`.
-    pub fn record(
-        &self,
-        gpu: &Gpu,
-        f: &FrameInputs,
-        rec: &mut Recorder,
-        params: &IasmParams,
-        params_buf: &wgpu::Buffer,
-        stats_buf: &wgpu::Buffer,
-    ) {
+    /// Writes `params` into `params_buf` and clears the statistics in `stats_buf` (not the
+    /// fit's tail), before [`AnalysisPass::dispatch`]; `fit=view` places the square between
+    /// the two.
+    pub fn clear(&self, rec: &mut Recorder, params: &IasmParams, params_buf: &wgpu::Buffer, stats_buf: &wgpu::Buffer) {
         rec.write_buffer(params_buf, 0, bytemuck::bytes_of(params));
         let mut init: Vec<u32> = (0..TILE_COUNT).flat_map(|_| [0, 0, 0, u32::MAX, 0, 0, 0, 0]).collect();
         init.push(0);
         rec.write_buffer(stats_buf, 0, bytemuck::cast_slice(&init));
+    }
+
+    /// Dispatches the analysis of `f` over the square in `params_buf` into `stats_buf`.
+    pub fn dispatch(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, params_buf: &wgpu::Buffer, stats_buf: &wgpu::Buffer) {
         let group = f.view_group(gpu, "iasm.analysis", &self.layout, &[params_buf.as_entire_binding(), stats_buf.as_entire_binding()]);
         rec.stage("iasm.importance", |enc| {
             gpu.dispatch_2d(enc, "iasm.importance", &self.pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
@@ -50,10 +47,11 @@ impl AnalysisPass {
     }
 }
 
-/// The statistics in `stats_buf`, read back now (the sync `iasm.readback`).
-pub(super) fn read_stats(rec: &mut Recorder, stats_buf: &wgpu::Buffer) -> TileStats {
+/// The statistics in `stats_buf` and the fit's tail ([`READ_WORDS`]), read back now (the
+/// sync `iasm.readback`, the frame's only one).
+pub(super) fn read_stats(rec: &mut Recorder, stats_buf: &wgpu::Buffer) -> Vec<u32> {
     let t0 = std::time::Instant::now();
-    let words: Vec<u32> = rec.read_buffer_as(stats_buf, STATS_WORDS, "iasm.readback");
+    let words: Vec<u32> = rec.read_buffer_as(stats_buf, READ_WORDS, "iasm.readback");
     rec.cpu("iasm.readback", t0.elapsed().as_secs_f64() * 1e3);
-    TileStats::parse(&words)
+    words
 }

@@ -1,57 +1,90 @@
 //! `iasm:fit=view`: the square fitted to the view samples (seed 001, 3.2 and chapter 5's
-//! suggestion; CPU rule in `shadowlab_core::techniques::iasm::fit`). The light-space x/y bounds
-//! of every evaluated sample come from `sdsm`'s bounds reduction (`csm/sdsm_bounds.wgsl`,
-//! ordered-uint atomics: deterministic) run with one cascade in iasm's light basis, read back
-//! with one sync (`iasm.fit.readback`, 320 bytes) before the importance analysis, which needs
-//! the square. With `delayed`, the previous frame's bounds are read without a stall (frame 0,
-//! or a frame whose predecessor has not finished: this frame's, with the sync).
+//! suggestion). The light-space x/y bounds of every evaluated sample come from `sdsm`'s bounds
+//! reduction (`csm/sdsm_bounds.wgsl`, ordered-uint atomics: deterministic) run with one cascade
+//! in iasm's light basis; one GPU thread (fit.wgsl) turns them into the square by the rule of
+//! `shadowlab_core::techniques::iasm::fit::fit_square` (the CPU half, which the tests hold it to) and writes it into the frame's
+//! `IasmParams` for the importance analysis, and into the statistics' tail
+//! ([`FIT_WORDS`] after `STATS_WORDS`). The square comes back with the statistics, in the one
+//! readback of the frame (`iasm.readback`), as the thesis has it. With `delayed` the fit is
+//! recorded after the shadows for the next frame and read with the statistics without a stall.
 
-use glam::{Mat4, Vec3, Vec4};
-use shadowlab_core::techniques::iasm::fit::fit_square;
+use glam::{Vec2, Vec3};
+use shadowlab_core::techniques::iasm::fit::snap_divisions;
 use shadowlab_core::techniques::iasm::{light_basis, Placement};
-use shadowlab_core::techniques::sdsm::SampleBounds;
+use shadowlab_core::techniques::sdsm::{SampleBounds, SHRINK_STEPS, SIZE_STEPS_PER_OCTAVE};
 
-use crate::record::{DelayedRead, Recorder};
+use super::plan::STATS_WORDS;
+use crate::record::Recorder;
+use crate::reduce::ORDER_KEY_WGSL;
+use crate::shaders::flag;
 use crate::technique::FrameInputs;
-use crate::techniques::csm::{decode_bounds, BoundsReduce, SdsmReduce, SDSM_BOUNDS_BYTES, SDSM_OUT_WORDS};
-use crate::Gpu;
+use crate::techniques::csm::{BoundsReduce, SdsmReduce, SDSM_BOUNDS_BYTES};
+use crate::{binding, Gpu};
+
+const FIT_WGSL: &str = include_str!("fit.wgsl");
+
+/// Words the fit writes after the statistics: a flag (1: fitted, 0: no sample), the square's
+/// origin x, y and side, the samples' bounds x0, y0, x1, y1 (f32 bits) and their count.
+pub(super) const FIT_WORDS: usize = 9;
+
+/// The composed placement shader, listed as `iasm/fit.wgsl`.
+pub(super) fn source() -> String {
+    format!("{ORDER_KEY_WGSL}const TAIL: u32 = {STATS_WORDS}u;\n{FIT_WGSL}")
+}
 
 /// Where a frame's square came from (the `fit_source` counter).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FitSource {
     /// No evaluated sample: the thesis's fixed placement.
     Fixed = 0,
-    /// This frame's samples (after the sync).
+    /// This frame's samples (read back with the statistics).
     ThisFrame = 1,
-    /// The previous frame's samples (delayed, no sync).
+    /// The previous frame's samples (delayed).
     PreviousFrame = 2,
+}
+
+/// WGSL `FitParams` (fit.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FitParams {
+    pub margin: f32,
+    pub min_side: f32,
+    /// The side fitted last; 0: none.
+    pub prev: f32,
+    pub div: f32,
+    pub shrink: f32,
+    pub steps: f32,
+    pub pad0: f32,
+    pub pad1: f32,
 }
 
 pub(super) struct ViewFit {
     reduce: BoundsReduce,
-    uniform: wgpu::Buffer,
+    reduce_uniform: wgpu::Buffer,
     /// The reduction's [min, max] view depth input: zero (unused with one cascade).
     depth_mm: wgpu::Buffer,
     out: wgpu::Buffer,
-    delayed: Option<DelayedRead>,
+    uniform: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
     light_dir: Vec3,
-    margin: f32,
-    min_side: f32,
-    snap: bool,
-    /// The side fitted last frame (the snapped side's hysteresis).
+    params: FitParams,
+    /// The side fitted last (the snapped side's hysteresis).
     prev: Option<f32>,
     pub bounds: Option<SampleBounds>,
     pub source: FitSource,
 }
 
-/// Bytes the fit keeps on the GPU beyond the shadow data (reduction output and its input).
-pub const FIT_BYTES: u64 = SDSM_BOUNDS_BYTES + 8;
+/// Bytes the fit keeps on the GPU beyond the shadow data (reduction output and its input, the
+/// placement's parameters and the statistics' tail).
+pub const FIT_BYTES: u64 = SDSM_BOUNDS_BYTES + 8 + std::mem::size_of::<FitParams>() as u64 + FIT_WORDS as u64 * 4;
 
 impl ViewFit {
-    pub fn new(gpu: &Gpu, light_dir: Vec3, margin: f32, min_side: f32, snap: bool, delayed: bool) -> ViewFit {
+    /// `auto_k`: k of equation 3.1 is half the side (the `k` parameter 0).
+    pub fn new(gpu: &Gpu, light_dir: Vec3, margin: f32, min_side: f32, snap: bool, auto_k: bool) -> ViewFit {
         let (right, up, dir) = light_basis(light_dir);
-        let basis = Mat4::from_cols(right.extend(0.0), up.extend(0.0), dir.extend(0.0), Vec4::W).transpose();
-        let params = SdsmReduce {
+        let basis = glam::Mat4::from_cols(right.extend(0.0), up.extend(0.0), dir.extend(0.0), glam::Vec4::W).transpose();
+        let reduce = SdsmReduce {
             light_view: basis.to_cols_array_2d(),
             near: 0.0,
             far: 1.0,
@@ -62,59 +95,79 @@ impl ViewFit {
             pad1: 0.0,
             pad2: 0.0,
         };
-        ViewFit {
-            reduce: BoundsReduce::new(gpu, "iasm.fit"),
-            uniform: gpu.uniform("iasm.fit", &params),
-            depth_mm: gpu.storage("iasm.fit.depth", 8),
-            out: gpu.storage("iasm.fit", SDSM_BOUNDS_BYTES),
-            delayed: delayed.then(|| DelayedRead::new(gpu, "iasm.fit.delayed", SDSM_BOUNDS_BYTES)),
-            light_dir,
+        let params = FitParams {
             margin,
             min_side,
-            snap,
+            prev: 0.0,
+            div: snap_divisions(),
+            shrink: (2.0f32).powf(-SHRINK_STEPS / SIZE_STEPS_PER_OCTAVE),
+            steps: SIZE_STEPS_PER_OCTAVE,
+            pad0: 0.0,
+            pad1: 0.0,
+        };
+        let layout = binding::layout(
+            &gpu.device,
+            "iasm.fit.place",
+            wgpu::ShaderStages::COMPUTE,
+            &[binding::uniform(), binding::storage(true), binding::storage(false), binding::storage(false)],
+        );
+        let constants = [("SNAP", flag(snap)), ("AUTO_K", flag(auto_k))];
+        let pipeline = gpu.compute_pipeline_with("iasm.fit.place", &source(), "main", &[&layout], &constants);
+        ViewFit {
+            reduce: BoundsReduce::new(gpu, "iasm.fit"),
+            reduce_uniform: gpu.uniform("iasm.fit", &reduce),
+            depth_mm: gpu.storage("iasm.fit.depth", 8),
+            out: gpu.storage("iasm.fit", SDSM_BOUNDS_BYTES),
+            uniform: gpu.uniform("iasm.fit.place", &params),
+            layout,
+            pipeline,
+            light_dir,
+            params,
             prev: None,
             bounds: None,
             source: FitSource::Fixed,
         }
     }
 
-    fn record(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
-        rec.stage("iasm.fit", |enc| self.reduce.record(gpu, enc, "iasm.fit", f, &self.uniform, &self.depth_mm, &self.out));
+    /// Records the reduction of `f`'s samples and the square's placement, written into the
+    /// frame's `IasmParams` (`params_buf`) and the tail of `stats_buf`, fitted against the
+    /// side of the last square [`ViewFit::apply`] took.
+    pub fn record(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, params_buf: &wgpu::Buffer, stats_buf: &wgpu::Buffer) {
+        let p = FitParams { prev: self.prev.unwrap_or(0.0), ..self.params };
+        rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&p));
+        let group = binding::group(
+            &gpu.device,
+            "iasm.fit.place",
+            &self.layout,
+            &[self.uniform.as_entire_binding(), self.out.as_entire_binding(), params_buf.as_entire_binding(), stats_buf.as_entire_binding()],
+        );
+        rec.stage("iasm.fit", |enc| {
+            self.reduce.record(gpu, enc, "iasm.fit", f, &self.reduce_uniform, &self.depth_mm, &self.out);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("iasm.fit.place"), timestamp_writes: None });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        });
     }
 
-    /// This frame's square: fitted to the previous frame's bounds (delayed, when finished) or
-    /// to this frame's (one sync). None when no sample was evaluated (the caller places it by
-    /// the fixed rule).
-    pub fn place(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Option<Placement> {
-        let prev = self.delayed.as_mut().and_then(|d| d.take::<u32>(gpu, SDSM_OUT_WORDS));
-        let (words, source) = match prev {
-            Some(w) => (w, FitSource::PreviousFrame),
-            None => {
-                self.record(gpu, f, rec);
-                let t0 = std::time::Instant::now();
-                let w: Vec<u32> = rec.read_buffer_as(&self.out, SDSM_OUT_WORDS, "iasm.fit.readback");
-                rec.cpu("iasm.fit.readback", t0.elapsed().as_secs_f64() * 1e3);
-                (w, FitSource::ThisFrame)
-            }
-        };
-        self.bounds = decode_bounds(&words, 0);
-        let Some(b) = self.bounds else {
+    /// The square in `tail` (the [`FIT_WORDS`] after the statistics), from the samples of
+    /// `source`; None when no sample was evaluated (the caller places it by the fixed rule).
+    pub fn apply(&mut self, tail: &[u32], source: FitSource) -> Option<Placement> {
+        let word = |i: usize| f32::from_bits(tail[i]);
+        if tail[0] == 0 {
+            self.bounds = None;
             self.source = FitSource::Fixed;
             return None;
-        };
-        self.source = source;
-        let (p, side) = fit_square(self.light_dir, b.lo.truncate(), b.hi.truncate(), self.margin, self.min_side, self.snap, self.prev);
-        self.prev = Some(side);
-        Some(p)
-    }
-
-    /// Delayed: reduces this frame's samples for the next frame, read back without a stall.
-    pub fn record_for_next(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
-        if self.delayed.is_some() {
-            self.record(gpu, f, rec);
-            if let Some(d) = self.delayed.as_mut() {
-                d.record(rec, &self.out);
-            }
         }
+        self.bounds = Some(SampleBounds {
+            lo: Vec3::new(word(4), word(5), 0.0),
+            hi: Vec3::new(word(6), word(7), 0.0),
+            samples: tail[8],
+        });
+        self.source = source;
+        let side = word(3);
+        self.prev = Some(side);
+        let (right, up, dir) = light_basis(self.light_dir);
+        Some(Placement { right, up, dir, origin: Vec2::new(word(1), word(2)), size: side })
     }
 }

@@ -10,9 +10,9 @@
 //! plane (nearest the light); the buffer stores the bits of 1 - z (cleared 0 reads z = 1), the
 //! atlas stores z (cleared to 1). A cleared texel is lit.
 //! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::techniques::iasm`.
-//! Stage names (timing keys): `iasm.fit` and `iasm.fit.readback` (fit=view), `iasm.importance`
-//! (analysis pass), `iasm.readback` (waiting for and mapping the 16 tiles' stats: the sync
-//! cost), `iasm.shadows.clear`, `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
+//! Stage names (timing keys): `iasm.fit` (fit=view: the samples' bounds and the square, on the
+//! GPU), `iasm.importance` (analysis pass), `iasm.readback` (waiting for and mapping the 16
+//! tiles' stats and the fitted square: the sync cost, one a frame), `iasm.shadows.clear`, `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
 //!
 //! Files: `params.rs` the parameter table; `uniforms.rs` the structs shared with WGSL;
 //! construction in stages, `setup.rs` (the settings read and checked, the chunks' boxes) then
@@ -44,9 +44,9 @@ use atlas::{Atlas, AtlasPass};
 pub(crate) use chunks::BOUNDS_WGSL;
 use eval::EvalPass;
 use fit::ViewFit;
-pub use fit::{FitSource, FIT_BYTES};
+pub use fit::{FitParams, FitSource, FIT_BYTES};
 pub use params::*;
-use plan::{Plan, TileStats, STATS_WORDS};
+use plan::{Plan, TileStats, READ_WORDS, STATS_WORDS};
 use resources::Resources;
 use setup::Setup;
 use tiles::TilePass;
@@ -66,6 +66,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("iasm/probe.wgsl", probe::source()),
         ("iasm/atlas.wgsl", atlas::source()),
         ("iasm/eval_atlas.wgsl", eval::atlas_source()),
+        ("iasm/fit.wgsl", fit::source()),
     ]
 }
 
@@ -78,7 +79,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 001 (IASM thesis) chapter 3",
     lights: &["directional"],
     params: ParamTable::of::<IasmSettings>(),
-    stalls: "iasm.readback: the tile statistics are read back for the plan; fit=view adds iasm.fit.readback before it (the samples' bounds for the square); delayed=true plans with the previous frame's, read back without a stall, and with fit=view the previous frame's bounds (a sync only on the first frame, or when the previous frame has not finished)",
+    stalls: "iasm.readback: the tile statistics are read back for the plan, with fit=view's square (placed on the GPU) in the same readback; delayed=true plans with the previous frame's statistics and square, read back without a stall (a sync only on the first frame, or when the previous frame has not finished)",
     needs: "",
     compare: &[""],
     shaders,
@@ -120,7 +121,7 @@ impl Iasm {
         let analysis = AnalysisPass::new(gpu);
         let eval = EvalPass::buffer(gpu);
         let atlas_pass = atlas.is_some().then(|| AtlasPass::new(gpu, &[&tiles.layout, &scene.layout], scene.has_cutouts));
-        let fit = setup.fit_margin.map(|margin| ViewFit::new(gpu, setup.light_dir, margin, 1e-3 * setup.size, setup.snap, setup.delayed));
+        let fit = setup.fit_margin.map(|margin| ViewFit::new(gpu, setup.light_dir, margin, 1e-3 * setup.size, setup.snap, setup.k <= 0.0));
         Ok(Iasm {
             placement: setup.basis,
             plan: Plan::default(),
@@ -179,23 +180,35 @@ impl Iasm {
         probe::probe_indices(gpu, self.params(), res, uvs)
     }
 
-    /// Places the square for the camera of `f`: fitted to the view samples (`fit=view`, when
-    /// any was evaluated) or by the thesis's rule.
-    fn place(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
-        if let Some(p) = self.fit.as_mut().and_then(|v| v.place(gpu, f, rec)) {
-            self.placement = p;
-            return;
-        }
+    /// The thesis's square for the camera of `f` (and `fit=view`'s when no sample was
+    /// evaluated).
+    fn fixed_placement(&self, f: &FrameInputs) -> Placement {
         let (s, cam) = (&self.setup, &f.camera);
         let forward = (cam.target - cam.position).normalize_or_zero();
         let min_res = *THESIS_RESOLUTIONS.iter().min().unwrap_or(&16) as f32;
         let step = s.snap.then_some(s.size / core::TILES_PER_SIDE as f32 / min_res);
-        self.placement = core::place(s.light_dir, cam.position, forward, s.size, step, s.anchor);
+        core::place(s.light_dir, cam.position, forward, s.size, step, s.anchor)
     }
 
-    /// Dispatches the analysis of `f` with the current placement into the statistics.
-    fn analyse(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
-        self.analysis.record(gpu, f, rec, &self.params(), &self.res.params_buf, &self.res.stats_buf);
+    /// Records the analysis of `f` over `self.placement`, with `fit=view` placing the square on
+    /// the GPU first (over `f`'s samples): `IasmParams` and the statistics (and the square
+    /// after them) in `stats_buf`.
+    fn analyse(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, fit_first: bool) {
+        let (params, stats) = (&self.res.params_buf, &self.res.stats_buf);
+        self.analysis.clear(rec, &self.params(), params, stats);
+        if let Some(v) = self.fit.as_ref().filter(|_| fit_first) {
+            v.record(gpu, f, rec, params, stats);
+        }
+        self.analysis.dispatch(gpu, f, rec, params, stats);
+    }
+
+    /// The square read back after the statistics in `words` (`fit=view`, from `source`'s
+    /// samples), or the fixed one when there is none.
+    fn square(&mut self, f: &FrameInputs, words: &[u32], source: FitSource) -> Placement {
+        match self.fit.as_mut().and_then(|v| v.apply(&words[STATS_WORDS..], source)) {
+            Some(p) => p,
+            None => self.fixed_placement(f),
+        }
     }
 
     /// The evaluation of the store in use and its bind group.
@@ -210,22 +223,28 @@ impl Iasm {
 
 impl Technique for Iasm {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.place(gpu, f, rec);
-        self.current = self.placement;
-        let delayed = self.setup.delayed;
-        if delayed && self.pending {
-            // the previous frame's analysis belongs to the previous frame's square: keep both
-            // together, so every tile's planes and resolution describe that tile's region
+        let words = if self.setup.delayed && self.pending {
+            // the previous frame's analysis and its square for this one (recorded after its
+            // shadows), without a stall when that frame has finished
+            let words = match self.res.delayed_read.take::<u32>(gpu, READ_WORDS) {
+                Some(w) => w,
+                None => analysis::read_stats(rec, &self.res.stats_buf),
+            };
+            self.current = self.square(f, &words, FitSource::PreviousFrame);
+            // the analysis belongs to the previous frame's square: keep both together, so
+            // every tile's planes and resolution describe that tile's region
             self.placement = self.analysed;
+            words
         } else {
-            self.analyse(gpu, f, rec);
-        }
-        let stats = match self.res.delayed_read.take::<u32>(gpu, STATS_WORDS).filter(|_| delayed && self.pending) {
-            Some(words) => TileStats::parse(&words),
-            // this frame's analysis (or, delayed, one whose frame has not finished): a sync
-            None => analysis::read_stats(rec, &self.res.stats_buf),
+            // this frame's square and analysis, read back together: the frame's one sync
+            self.placement = self.fixed_placement(f);
+            self.analyse(gpu, f, rec, true);
+            let words = analysis::read_stats(rec, &self.res.stats_buf);
+            self.placement = self.square(f, &words, FitSource::ThisFrame);
+            self.current = self.placement;
+            words
         };
-        self.make_plan(stats);
+        self.make_plan(TileStats::parse(&words));
         tiles::write_tiles(rec, &self.res.tile_buf, &self.placement, &self.plan);
         rec.write_buffer(&self.res.params_buf, 0, bytemuck::bytes_of(&self.params()));
         self.evaluated = Some(self.params());
@@ -246,15 +265,16 @@ impl Technique for Iasm {
         pass.evaluate(gpu, f, rec, &group);
         if self.setup.delayed {
             // this frame's analysis, over this frame's square, feeds the next frame (thesis 4.3:
-            // copied after the shadows)
+            // copied after the shadows), and with fit=view the square of this frame's samples
+            // (placed after the analysis, which keeps this frame's square)
             self.placement = self.current;
-            self.analyse(gpu, f, rec);
+            self.analyse(gpu, f, rec, false);
+            if let Some(v) = &self.fit {
+                v.record(gpu, f, rec, &self.res.params_buf, &self.res.stats_buf);
+            }
             self.res.delayed_read.record(rec, &self.res.stats_buf);
             self.analysed = self.current;
             self.pending = true;
-            if let Some(v) = self.fit.as_mut() {
-                v.record_for_next(gpu, f, rec);
-            }
         }
         Ok(())
     }

@@ -8,6 +8,9 @@ use shadowlab_core::techniques::iasm::{self as core, Placement, THESIS_RESOLUTIO
 
 /// Words of the analysis's statistics (analysis.wgsl): 8 per tile, then the samples outside.
 pub(super) const STATS_WORDS: usize = TILE_COUNT * 8 + 1;
+/// Words read back a frame: the statistics, then `fit=view`'s square (fit.rs, unused
+/// without it).
+pub(super) const READ_WORDS: usize = STATS_WORDS + super::fit::FIT_WORDS;
 
 /// What the analysis found per tile.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -5,7 +5,7 @@
 use bytemuck::Zeroable;
 use shadowlab_core::techniques::iasm::{self as core, TILE_COUNT};
 
-use super::plan::STATS_WORDS;
+use super::plan::READ_WORDS;
 use super::setup::Setup;
 use super::tiles::dummy_target;
 use super::uniforms::{IasmParams, TILE_STRIDE};
@@ -15,7 +15,7 @@ use crate::Gpu;
 pub(super) struct Resources {
     /// The frame's `IasmParams`.
     pub params_buf: wgpu::Buffer,
-    /// The analysis's output (`STATS_WORDS`).
+    /// The analysis's output (`STATS_WORDS`) and the fit's square after it (`READ_WORDS`).
     pub stats_buf: wgpu::Buffer,
     /// store=buffer: the tiles' depth in the linear per-tile layout.
     pub shadow: wgpu::Buffer,
@@ -31,7 +31,7 @@ pub(super) struct Resources {
 
 impl Resources {
     pub fn new(gpu: &Gpu, s: &Setup) -> Resources {
-        let stats_bytes = STATS_WORDS as u64 * 4;
+        let stats_bytes = READ_WORDS as u64 * 4;
         Resources {
             params_buf: gpu.uniform("iasm.params", &IasmParams::zeroed()),
             stats_buf: gpu.storage("iasm.stats", stats_bytes),
