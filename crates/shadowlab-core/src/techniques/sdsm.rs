@@ -41,15 +41,35 @@ pub fn sample_splits(near: f32, far: f32, range: Option<(f32, f32)>, n: usize, l
     practical_splits(lo, hi, n, lambda)
 }
 
-/// `x > 0` rounded up to a power of 2^(1/steps) (idempotent, never below `x`).
+/// `x > 0` rounded up to a power of 2^(1/steps): the smallest [`size_step`] not below `x`
+/// (idempotent, never below `x`). `steps` a whole number.
 pub fn quantize_up(x: f32, steps: f32) -> f32 {
-    let q = (2.0f32).powf((x.log2() * steps).ceil() / steps);
-    if q >= x {
-        q
-    } else {
-        // float rounding of powf: one step more
-        (2.0f32).powf(((x.log2() * steps).ceil() + 1.0) / steps)
+    if !(x > 0.0 && x.is_finite()) {
+        return x;
     }
+    let n = steps as i32;
+    let mut k = (x.log2() * steps).ceil() as i32;
+    // log2's rounding can put k one step off either way
+    while size_step(k - 1, n) >= x {
+        k -= 1;
+    }
+    while size_step(k, n) < x {
+        k += 1;
+    }
+    size_step(k, n)
+}
+
+/// 2^(k/steps) for a whole `k`: 2^(r/steps) (0 <= r < steps, [`step_fractions`]) times the
+/// octave's power of two, exact, so that a GPU holding the same fractions gets the same bits
+/// (iasm's fit.wgsl). Equal to powf(2, k/steps) for every k of a normal f32 (tested).
+pub fn size_step(k: i32, steps: i32) -> f32 {
+    let (octave, r) = (k.div_euclid(steps), k.rem_euclid(steps));
+    (2.0f32).powf(r as f32 / steps as f32) * (2.0f32).powi(octave)
+}
+
+/// 2^(r/16) for r in 0..16: the fractions of [`size_step`] at [`SIZE_STEPS_PER_OCTAVE`].
+pub fn step_fractions() -> [f32; 16] {
+    std::array::from_fn(|r| size_step(r as i32, SIZE_STEPS_PER_OCTAVE as i32))
 }
 
 /// The light-space (light view, [`light_view`]) bounds of the view samples of one cascade, as
@@ -226,6 +246,25 @@ mod tests {
         // ends rounded outwards: the range holds the samples
         let r = sample_splits(0.1, 100.0, Some((3.0, 40.0)), 3, 1.0);
         assert!(r[0] <= 3.0 && r[0] > 2.7 && r[3] >= 40.0 && r[3] < 44.0, "{r:?}");
+    }
+
+    #[test]
+    fn size_steps_are_powf_and_quantize_up_is_the_old_rule() {
+        for k in -16 * 126..16 * 127 {
+            assert_eq!(size_step(k, 16).to_bits(), (2.0f32).powf(k as f32 / 16.0).to_bits(), "k {k}");
+        }
+        // the previous rule (powf of the ceiled log2, one step more if short) on ordinary sizes
+        let old = |x: f32| {
+            let q = (2.0f32).powf((x.log2() * 16.0).ceil() / 16.0);
+            if q >= x { q } else { (2.0f32).powf(((x.log2() * 16.0).ceil() + 1.0) / 16.0) }
+        };
+        let mut x = 1e-5f32;
+        while x < 1e7 {
+            assert_eq!(quantize_up(x, 16.0), old(x), "{x}");
+            x *= 1.000_37;
+        }
+        assert_eq!(quantize_up(0.0, 16.0), 0.0);
+        assert!(quantize_up(f32::INFINITY, 16.0).is_infinite());
     }
 
     #[test]

@@ -11,7 +11,7 @@
 use glam::{Vec2, Vec3};
 use shadowlab_core::techniques::iasm::fit::snap_divisions;
 use shadowlab_core::techniques::iasm::{light_basis, Placement};
-use shadowlab_core::techniques::sdsm::{SampleBounds, SHRINK_STEPS, SIZE_STEPS_PER_OCTAVE};
+use shadowlab_core::techniques::sdsm::{step_fractions, SampleBounds, SHRINK_STEPS, SIZE_STEPS_PER_OCTAVE};
 
 use super::plan::STATS_WORDS;
 use crate::record::Recorder;
@@ -56,6 +56,8 @@ pub struct FitParams {
     pub steps: f32,
     pub pad0: f32,
     pub pad1: f32,
+    /// sdsm's `step_fractions`.
+    pub fracs: [[f32; 4]; 4],
 }
 
 pub(super) struct ViewFit {
@@ -104,6 +106,7 @@ impl ViewFit {
             steps: SIZE_STEPS_PER_OCTAVE,
             pad0: 0.0,
             pad1: 0.0,
+            fracs: bytemuck::cast(step_fractions()),
         };
         let layout = binding::layout(
             &gpu.device,

@@ -20,6 +20,8 @@ struct FitParams {
     steps: f32,
     pad0: f32,
     pad1: f32,
+    // 2^(r/steps), r = 0..15 (sdsm.rs `step_fractions`): the size steps in the CPU's bits
+    fracs: array<vec4<f32>, 4>,
 }
 
 // The side held in sdsm's steps (with hysteresis) and the origin on whole steps.
@@ -32,14 +34,27 @@ override AUTO_K: bool = true;
 @group(0) @binding(2) var<storage, read_write> params: array<f32>;
 @group(0) @binding(3) var<storage, read_write> stats: array<u32>;
 
-// sdsm's quantize_up: x rounded up to a power of 2^(1/steps), never below x.
-fn quantize_up(x: f32) -> f32 {
-    let k = ceil(log2(x) * fp.steps);
-    let q = exp2(k / fp.steps);
-    if q >= x {
-        return q;
+// sdsm's size_step: 2^(k/steps), the CPU's fraction times the octave's power of two (exact).
+fn size_step(k: i32) -> f32 {
+    let n = i32(fp.steps);
+    var octave = k / n;
+    if k % n < 0 {
+        octave -= 1;
     }
-    return exp2((k + 1.0) / fp.steps);
+    let r = k - octave * n;
+    return ldexp(fp.fracs[r / 4][r % 4], octave);
+}
+
+// sdsm's quantize_up: the smallest size step not below x (log2 only guesses the step).
+fn quantize_up(x: f32) -> f32 {
+    var k = i32(ceil(log2(x) * fp.steps));
+    for (var i = 0; i < 4 && size_step(k - 1) >= x; i++) {
+        k -= 1;
+    }
+    for (var i = 0; i < 4 && size_step(k) < x; i++) {
+        k += 1;
+    }
+    return size_step(k);
 }
 
 // sdsm's held_extent: the previous side while the need is within its shrink steps.
