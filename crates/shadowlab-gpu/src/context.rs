@@ -53,9 +53,11 @@ impl Gpu {
         let has_ts = adapter.features().contains(ts);
         wgpu::DeviceDescriptor {
             label: Some("shadowlab"),
-            // sv: unclipped depth (infinite extrusion) and a float depth-stencil target, where offered
+            // sv: unclipped depth (infinite extrusion) and a float depth-stencil target; the
+            // paraboloid maps: clip distances (warp/depth_clip.wgsl); each where offered
             required_features: (if has_ts { ts } else { wgpu::Features::empty() })
-                | (adapter.features() & (wgpu::Features::DEPTH_CLIP_CONTROL | wgpu::Features::DEPTH32FLOAT_STENCIL8)),
+                | (adapter.features()
+                    & (wgpu::Features::DEPTH_CLIP_CONTROL | wgpu::Features::DEPTH32FLOAT_STENCIL8 | wgpu::Features::CLIP_DISTANCES)),
             required_limits: adapter.limits(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
@@ -150,6 +152,12 @@ impl Gpu {
         // STORAGE: bound as read-only storage on lavapipe (crate::quirks)
         let usage = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         self.buffer_init(label, bytemuck::bytes_of(value), usage)
+    }
+
+    /// Whether the device clips by distances from the vertex stage (`CLIP_DISTANCES`): the
+    /// paraboloid depth passes then need no fragment stage.
+    pub fn clip_distances(&self) -> bool {
+        self.device.features().contains(wgpu::Features::CLIP_DISTANCES)
     }
 
     pub fn wait(&self) {

@@ -14,11 +14,19 @@ use crate::{binding, raster, Gpu};
 const DEPTH_WGSL: &str = include_str!("depth.wgsl");
 const DEPTH_PLAIN_WGSL: &str = include_str!("depth_plain.wgsl");
 const DEPTH_EXACT_WGSL: &str = include_str!("depth_exact.wgsl");
+const DEPTH_VS_WGSL: &str = include_str!("depth_vs.wgsl");
+const DEPTH_CLIP_WGSL: &str = include_str!("depth_clip.wgsl");
 
 /// The depth pass; `exact`: the fragment stage writes the plane's depth at the inverted warp.
 pub(super) fn source(exact: bool) -> String {
     let fs = if exact { DEPTH_EXACT_WGSL } else { DEPTH_PLAIN_WGSL };
-    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{DEPTH_WGSL}{fs}"), true)
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{DEPTH_WGSL}{DEPTH_VS_WGSL}{fs}"), true)
+}
+
+/// The paraboloid depth pass that clips behind the split plane instead of discarding
+/// (depth_clip.wgsl; needs `wgpu::Features::CLIP_DISTANCES`).
+pub(super) fn clipped_source() -> String {
+    format!("enable clip_distances;\n{}", compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{DEPTH_WGSL}{DEPTH_CLIP_WGSL}"), true))
 }
 
 /// lookup.wgsl's bindings 6-9: the uniform, the DV bounds, the two warps.
@@ -41,8 +49,10 @@ pub(super) fn constants(p: &WarpParams, cutouts: bool) -> Vec<(&'static str, f64
 }
 
 /// The lookup layout (bindings 6-9, the pieces at 10) and the warped depth pipeline, specialised
-/// to `p` ([`constants`]). A planar map with interpolated depth over a scene without cut-outs
-/// discards nothing: it has no fragment stage (the rasteriser then tests depth early, as `sm`).
+/// to `p` ([`constants`]). A map with interpolated depth over a scene without cut-outs has no
+/// fragment stage (the rasteriser then tests depth early, as `sm`) when it discards nothing:
+/// planar maps, and paraboloid ones where the device clips behind the split plane
+/// ([`clipped_source`]; without clip distances the fragment stage discards there).
 pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
     let look = lookup_entries();
     let layout = layout_at(
@@ -52,10 +62,12 @@ pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) 
         &[look[0], look[1], look[2], look[3], (10, binding::storage(true))],
     );
     let exact = p.exact_depth != 0;
-    let fragment = exact || scene.has_cutouts || p.projection != 0;
+    let clipped = p.projection != 0 && !exact && !scene.has_cutouts && gpu.clip_distances();
+    let fragment = exact || scene.has_cutouts || (p.projection != 0 && !clipped);
     let label = format!("{name}.shadow_map");
     let layouts = [&layout, &scene.layout];
-    let pipeline = raster::depth_pipeline_with(gpu, &label, &source(exact), &layouts, fragment, &constants(p, scene.has_cutouts));
+    let src = if clipped { clipped_source() } else { source(exact) };
+    let pipeline = raster::depth_pipeline_with(gpu, &label, &src, &layouts, fragment, &constants(p, scene.has_cutouts));
     (layout, pipeline)
 }
 

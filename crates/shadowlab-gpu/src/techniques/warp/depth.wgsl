@@ -89,8 +89,8 @@ fn depth_plane(a: array<vec4<f32>, 3>, r: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(g, m0.z - dot(g, u0), 1.0);
 }
 
-@vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+// The vertex stage's work (the entry point is depth_vs.wgsl's or depth_clip.wgsl's).
+fn depth_vertex(vi: u32) -> VsOut {
     var v: Vertex;
     var piece = vec4<u32>(vi / 3u, 0u, 0xffffu, 0xffff0000u);
     if SUBDIVIDED {

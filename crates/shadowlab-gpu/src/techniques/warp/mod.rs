@@ -58,6 +58,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("warp/analyze.wgsl", analyze::source()),
         ("warp/depth.wgsl", depth::source(false)),
         ("warp/depth_exact.wgsl", depth::source(true)),
+        ("warp/depth_clip.wgsl", depth::clipped_source()),
         ("warp/subdiv.wgsl", subdiv::source()),
         ("warp/occluders.wgsl", occluders::occluders_src()),
         ("warp/hzb.wgsl", occluders::hzb_src()),
