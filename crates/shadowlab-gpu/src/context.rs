@@ -1,6 +1,5 @@
 //! Device creation, buffer helpers and readback.
 
-use wgpu::util::DeviceExt;
 
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
@@ -27,6 +26,8 @@ pub struct Gpu {
     errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
     /// Queue submissions made through [`Gpu::submit`] (tests count a frame's submits).
     submits: std::sync::atomic::AtomicU64,
+    /// The buffer counter and the upload / readback pools (alloc.rs).
+    pub(crate) alloc: crate::alloc::Alloc,
 }
 
 impl Gpu {
@@ -78,7 +79,7 @@ impl Gpu {
         let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(e.to_string())));
-        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors, submits: Default::default() })
+        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors, submits: Default::default(), alloc: Default::default() })
     }
 
     /// Submits one command buffer (every submit of shadowlab goes through here and is counted).
@@ -136,11 +137,11 @@ impl Gpu {
     pub fn buffer_init(&self, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
         // wgpu rejects empty buffers; keep one word so bindings stay valid.
         let contents = if contents.is_empty() { &[0u8; 4][..] } else { contents };
-        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        self.buffer_desc_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
     }
 
     pub fn storage(&self, label: &str, size: u64) -> wgpu::Buffer {
-        self.device.create_buffer(&wgpu::BufferDescriptor {
+        self.buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: size.max(4),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
@@ -167,16 +168,14 @@ impl Gpu {
     /// Copies a buffer back to the CPU (blocking).
     pub fn read_buffer(&self, src: &wgpu::Buffer) -> Vec<u8> {
         let size = src.size();
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let staging = self.readback(size);
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
         self.submit(enc.finish());
-        self.map_and_take(&staging)
+        let mut bytes = self.map_and_take(&staging);
+        self.give_readback(staging);
+        bytes.truncate(size as usize);
+        bytes
     }
 
     /// Maps a `MAP_READ` buffer whose copy was already submitted, and reads `count` values.
@@ -195,12 +194,7 @@ impl Gpu {
         let (w, h) = (tex.width(), tex.height());
         let row = w * bytes_per_pixel;
         let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback-texture"),
-            size: (padded * h) as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let staging = self.readback((padded * h) as u64);
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
             tex.as_image_copy(),
@@ -212,6 +206,7 @@ impl Gpu {
         );
         self.submit(enc.finish());
         let data = self.map_and_take(&staging);
+        self.give_readback(staging);
         let mut out = Vec::with_capacity((row * h) as usize);
         for y in 0..h as usize {
             out.extend_from_slice(&data[y * padded as usize..y * padded as usize + row as usize]);

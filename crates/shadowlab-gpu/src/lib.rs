@@ -6,6 +6,7 @@
 //! visibility on the same samples -> [`shade`].
 //! [`lab::Lab`] runs that flow for one view and hands back what metrics and reports need.
 
+pub mod alloc;
 pub mod binding;
 pub mod blur;
 pub mod context;

@@ -23,8 +23,6 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use wgpu::util::DeviceExt;
-
 use crate::Gpu;
 
 /// Stages (pairs of timestamps) one frame can time.
@@ -46,13 +44,13 @@ impl FrameStamps {
             count: n,
         });
         let size = n as u64 * 8;
-        let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let resolve = gpu.buffer(&wgpu::BufferDescriptor {
             label: Some("frame.timestamps.resolve"),
             size,
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let readback = gpu.buffer(&wgpu::BufferDescriptor {
             label: Some("frame.timestamps.readback"),
             size,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -183,12 +181,17 @@ impl<'a> Recorder<'a> {
         if data.is_empty() {
             return;
         }
-        let staging = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("recorder.write"),
-            contents: data,
-            usage: wgpu::BufferUsages::COPY_SRC,
-        });
-        self.enc.copy_buffer_to_buffer(&staging, 0, buf, offset, data.len() as u64);
+        let size = (data.len() as u64).div_ceil(4) * 4;
+        let staging = self.gpu.upload(size);
+        {
+            let mut view = staging.slice(..size).get_mapped_range_mut().expect("an upload buffer is mapped until its copy is recorded");
+            let mut padded = data.to_vec();
+            padded.resize(size as usize, 0);
+            view.copy_from_slice(&padded);
+        }
+        staging.unmap();
+        self.enc.copy_buffer_to_buffer(&staging, 0, buf, offset, size);
+        self.gpu.recycle_upload(self.enc, &staging);
     }
 
     /// The mid-frame stalls so far.
@@ -206,15 +209,12 @@ impl<'a> Recorder<'a> {
     /// [`Recorder::sync`]s and reads them: one stall, one submit.
     pub fn read_buffer_as<T: bytemuck::Pod>(&mut self, buf: &wgpu::Buffer, count: usize, why: &str) -> Vec<T> {
         let size = ((count * std::mem::size_of::<T>()) as u64).div_ceil(4) * 4;
-        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(why),
-            size: size.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let staging = self.gpu.readback(size.max(4));
         self.enc.copy_buffer_to_buffer(buf, 0, &staging, 0, size);
         self.sync(why);
-        self.gpu.map_read_as(&staging, count)
+        let out = self.gpu.map_read_as(&staging, count);
+        self.gpu.give_readback(staging);
+        out
     }
 
     /// Ends recording: on a timestamp frame records the one resolve (and its copy for reading).
@@ -319,7 +319,7 @@ pub struct DelayedRead {
 
 impl DelayedRead {
     pub fn new(gpu: &Gpu, label: &str, size: u64) -> DelayedRead {
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let staging = gpu.buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: size.div_ceil(4).max(1) * 4,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,

@@ -12,6 +12,7 @@ mod determinism;
 mod dpsm;
 mod filtered;
 mod gpu;
+mod hygiene;
 mod host;
 mod iasm;
 mod iasm_fit;

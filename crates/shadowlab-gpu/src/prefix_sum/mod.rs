@@ -43,6 +43,9 @@ impl ScanParams {
 pub struct PrefixSum {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    /// One uniform per `ScanParams` seen: a map's scans repeat every frame (no buffer per
+    /// frame, tests/hygiene.rs).
+    uniforms: std::sync::Mutex<std::collections::HashMap<[u32; 8], wgpu::Buffer>>,
 }
 
 impl PrefixSum {
@@ -54,13 +57,16 @@ impl PrefixSum {
             &[binding::uniform(), binding::storage(true), binding::storage(false)],
         );
         let pipeline = gpu.compute_pipeline("prefix_sum", &compose(SCAN_WGSL, false), "scan_rows", &[&layout]);
-        PrefixSum { layout, pipeline }
+        PrefixSum { layout, pipeline, uniforms: Default::default() }
     }
 
     /// Records the scan of `p` from `input` (u32 words) into `output` (f32); they must be
     /// different buffers.
     pub fn encode(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, input: &wgpu::Buffer, output: &wgpu::Buffer, p: ScanParams) {
-        let uniform = gpu.uniform("prefix_sum.params", &p);
+        let uniform = {
+            let mut made = self.uniforms.lock().unwrap();
+            made.entry(bytemuck::cast(p)).or_insert_with(|| gpu.uniform("prefix_sum.params", &p)).clone()
+        };
         let group = binding::group(
             &gpu.device,
             "prefix_sum",

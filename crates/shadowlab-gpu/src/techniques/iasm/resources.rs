@@ -37,7 +37,7 @@ impl Resources {
             stats_buf: gpu.storage("iasm.stats", stats_bytes),
             shadow: gpu.storage("iasm.shadow", s.texels * core::TEXEL_BYTES),
             counts: gpu.storage("iasm.counts", s.texels * 4),
-            tile_buf: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            tile_buf: gpu.buffer(&wgpu::BufferDescriptor {
                 label: Some("iasm.tiles"),
                 size: TILE_STRIDE * TILE_COUNT as u64,
                 // STORAGE: bound as read-only storage on lavapipe (crate::quirks)

@@ -140,6 +140,8 @@ pub struct LeakTracing {
     classify: ClassifyPass,
     trace: TracePass,
     screen: Option<Screen>,
+    /// The trace's `TraceParams` for (mask bits, pixels): made once per output size.
+    trace_uniform: Option<((u32, u32), wgpu::Buffer)>,
 }
 
 impl LeakTracing {
@@ -170,6 +172,7 @@ impl LeakTracing {
             classify,
             trace,
             screen: None,
+            trace_uniform: None,
         })
     }
 
@@ -249,10 +252,14 @@ impl Technique for LeakTracing {
         params.frame = frames;
         params.flags |= if frames > 0 { FLAG_HAS_HISTORY } else { 0 } | if has_dynamic { FLAG_DYNAMIC } else { 0 };
         rec.write_buffer(&self.resources.uniform, 0, bytemuck::bytes_of(&params));
-        let trace = TracePass::uniform(gpu, name, self.mask_bits, w * h);
+        let key = (self.mask_bits, w * h);
+        if self.trace_uniform.as_ref().map(|(k, _)| *k) != Some(key) {
+            self.trace_uniform = Some((key, TracePass::uniform(gpu, name, self.mask_bits, w * h)));
+        }
+        let trace = &self.trace_uniform.as_ref().expect("made above").1;
         let s = self.screen.as_ref().expect("allocated above");
         let classify = self.classify.group(gpu, f, name, &self.resources, s);
-        let trace_groups = self.trace.groups(gpu, f, name, &trace, s);
+        let trace_groups = self.trace.groups(gpu, f, name, trace, s);
         self.classify.record(gpu, rec, name, &classify, s);
         self.trace.record(rec, name, f, &trace_groups, s);
         self.screen.as_mut().expect("allocated above").frames += 1;

@@ -25,7 +25,7 @@ impl Screen {
         let per_word = (32 / mask_bits) as u64;
         let mask = || gpu.storage(&format!("{name}.mask"), n.div_ceil(per_word) * 4);
         let history = || gpu.storage(&format!("{name}.history"), n * 8);
-        let args = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let args = gpu.buffer(&wgpu::BufferDescriptor {
             label: Some(&format!("{name}.args")),
             size: 16,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,

@@ -129,7 +129,6 @@ impl MinShadowMap {
         let frame = frustum::light_frame(light, &scene.bounds).ok_or_else(no_point)?;
         let (pcf, grid) = (p.pcf, p.grid);
         let pass = MapPass::new(gpu, scene, "min-sm", &p.map(), &scene_fit);
-        let d = &gpu.device;
         let reduce = MsfReduce {
             frame_view: frame.view.as_mat4().to_cols_array_2d(),
             mode: [frame.perspective as u32, grid, RUN, 0],
@@ -142,7 +141,7 @@ impl MinShadowMap {
         let rows_pipeline = gpu.compute_pipeline("min-sm.reduce.rows", &src, "rows", &[&reduce_layout]);
         let words = frustum::buffer_words(grid as usize) as u64 * 4;
         let red = gpu.storage("min-sm.reduction", words);
-        let staging = d.create_buffer(&wgpu::BufferDescriptor {
+        let staging = gpu.buffer(&wgpu::BufferDescriptor {
             label: Some("min-sm.reduction.readback"),
             size: words,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,

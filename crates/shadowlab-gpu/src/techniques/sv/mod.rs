@@ -192,7 +192,7 @@ impl ShadowVolumes {
         let t = self.targets.as_ref()?;
         let set =
             gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("sv.fill"), ty: wgpu::QueryType::Occlusion, count: 1 });
-        let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        let resolve = gpu.buffer(&wgpu::BufferDescriptor {
             label: Some("sv.fill"),
             size: 8,
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,

@@ -248,7 +248,7 @@ impl Resources {
             fwork: gpu.storage(&format!("{name}.fwork"), if scratch { (3 * n + 3 * res as u64) * 4 } else { 4 }),
             pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
             queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16)),
-            counters: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            counters: gpu.buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{name}.counters")),
                 size: 1048 * 4,
                 usage: wgpu::BufferUsages::STORAGE
@@ -263,7 +263,7 @@ impl Resources {
             uniform: gpu.uniform(&format!("{name}.params"), &plan.params),
             dv: gpu.storage(&format!("{name}.dv"), 32),
             counts: gpu.storage(&format!("{name}.counts"), n * 4),
-            dispatch: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            dispatch: gpu.buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{name}.dispatch")),
                 size: 12,
                 usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,

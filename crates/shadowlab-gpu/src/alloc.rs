@@ -1,0 +1,124 @@
+//! Every buffer shadowlab makes goes through [`Gpu::buffer`] (or the helpers built on it:
+//! `storage`, `uniform`, `buffer_init`), which counts it: the per-frame hygiene test records
+//! each technique's frames and asserts that a frame after the first creates no buffer
+//! (`tests/hygiene.rs`), and a source check keeps `create_buffer` calls out of every other file.
+//!
+//! What a frame needs afresh each time comes from two pools instead of new buffers:
+//! - uploads ([`Gpu::upload`]): mapped `COPY_SRC` buffers that
+//!   [`crate::record::Recorder::write_buffer`] fills and copies from; each is mapped again when
+//!   its frame's commands have run, then handed out again;
+//! - readbacks ([`Gpu::readback`]): `MAP_READ` buffers for mid-frame and report readbacks,
+//!   returned once read.
+//!
+//! Both hand out buffers by power-of-two size class (at least 256 bytes) and keep at most
+//! [`POOL_CAP`] idle buffers and [`POOL_BYTES`] idle bytes each (a report's readback of a large
+//! map is dropped after use, not kept).
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use wgpu::util::DeviceExt;
+
+use crate::Gpu;
+
+/// Idle buffers a pool keeps; more are dropped.
+pub const POOL_CAP: usize = 64;
+/// Idle bytes a pool keeps; a buffer that would exceed them is dropped.
+pub const POOL_BYTES: u64 = 64 << 20;
+
+/// The counter and pools a [`Gpu`] holds.
+#[derive(Default)]
+pub struct Alloc {
+    buffers: AtomicU64,
+    uploads: Arc<Mutex<Vec<wgpu::Buffer>>>,
+    reads: Mutex<Vec<wgpu::Buffer>>,
+}
+
+/// The pools' size class of `size` bytes.
+fn class(size: u64) -> u64 {
+    size.max(256).next_power_of_two()
+}
+
+fn take(pool: &Mutex<Vec<wgpu::Buffer>>, size: u64) -> Option<wgpu::Buffer> {
+    let mut free = pool.lock().unwrap();
+    let i = free.iter().position(|b| b.size() == class(size))?;
+    Some(free.swap_remove(i))
+}
+
+fn give(pool: &Mutex<Vec<wgpu::Buffer>>, buf: wgpu::Buffer) {
+    let mut free = pool.lock().unwrap();
+    let idle: u64 = free.iter().map(|b| b.size()).sum();
+    if free.len() < POOL_CAP && idle + buf.size() <= POOL_BYTES {
+        free.push(buf);
+    }
+}
+
+impl Gpu {
+    /// Buffers created through this device wrapper so far.
+    pub fn buffers_created(&self) -> u64 {
+        self.alloc.buffers.load(Ordering::Relaxed)
+    }
+
+    /// A new buffer (counted).
+    pub fn buffer(&self, desc: &wgpu::BufferDescriptor) -> wgpu::Buffer {
+        self.alloc.buffers.fetch_add(1, Ordering::Relaxed);
+        self.device.create_buffer(desc)
+    }
+
+    /// A new buffer with its contents (counted).
+    pub fn buffer_desc_init(&self, desc: &wgpu::util::BufferInitDescriptor) -> wgpu::Buffer {
+        self.alloc.buffers.fetch_add(1, Ordering::Relaxed);
+        self.device.create_buffer_init(desc)
+    }
+
+    /// A mapped `COPY_SRC` buffer of at least `size` bytes (from the pool, or new). Give it
+    /// back with [`Gpu::recycle_upload`] in the encoder that copies from it.
+    pub(crate) fn upload(&self, size: u64) -> wgpu::Buffer {
+        take(&self.alloc.uploads, size).unwrap_or_else(|| {
+            self.buffer(&wgpu::BufferDescriptor {
+                label: Some("upload"),
+                size: class(size),
+                usage: wgpu::BufferUsages::MAP_WRITE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: true,
+            })
+        })
+    }
+
+    /// Maps `buf` again when `enc`'s commands have run, and then returns it to the pool.
+    pub(crate) fn recycle_upload(&self, enc: &mut wgpu::CommandEncoder, buf: &wgpu::Buffer) {
+        let (pool, back) = (self.alloc.uploads.clone(), buf.clone());
+        enc.map_buffer_on_submit(buf, wgpu::MapMode::Write, .., move |r| {
+            if r.is_ok() {
+                give(&pool, back);
+            }
+        });
+    }
+
+    /// An unmapped `MAP_READ | COPY_DST` buffer of at least `size` bytes (from the pool, or
+    /// new); give it back with [`Gpu::give_readback`] once read.
+    pub(crate) fn readback(&self, size: u64) -> wgpu::Buffer {
+        take(&self.alloc.reads, size).unwrap_or_else(|| {
+            self.buffer(&wgpu::BufferDescriptor {
+                label: Some("readback"),
+                size: class(size),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        })
+    }
+
+    pub(crate) fn give_readback(&self, buf: wgpu::Buffer) {
+        give(&self.alloc.reads, buf);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn size_classes_are_powers_of_two_from_256() {
+        assert_eq!(super::class(0), 256);
+        assert_eq!(super::class(256), 256);
+        assert_eq!(super::class(257), 512);
+        assert_eq!(super::class(5000), 8192);
+    }
+}
