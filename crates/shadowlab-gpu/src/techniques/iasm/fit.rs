@@ -67,7 +67,9 @@ pub(super) struct ViewFit {
     depth_mm: wgpu::Buffer,
     out: wgpu::Buffer,
     uniform: wgpu::Buffer,
-    layout: wgpu::BindGroupLayout,
+    /// The placement's bindings: its parameters, the reduction's output, the frame's
+    /// `IasmParams` and the statistics (all made once, with the technique).
+    group: wgpu::BindGroup,
     pipeline: wgpu::ComputePipeline,
     light_dir: Vec3,
     params: FitParams,
@@ -82,8 +84,19 @@ pub(super) struct ViewFit {
 pub const FIT_BYTES: u64 = SDSM_BOUNDS_BYTES + 8 + std::mem::size_of::<FitParams>() as u64 + FIT_WORDS as u64 * 4;
 
 impl ViewFit {
-    /// `auto_k`: k of equation 3.1 is half the side (the `k` parameter 0).
-    pub fn new(gpu: &Gpu, light_dir: Vec3, margin: f32, min_side: f32, snap: bool, auto_k: bool) -> ViewFit {
+    /// `auto_k`: k of equation 3.1 is half the side (the `k` parameter 0). The square is
+    /// written into `params_buf` (the frame's `IasmParams`) and the tail of `stats_buf`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        gpu: &Gpu,
+        light_dir: Vec3,
+        margin: f32,
+        min_side: f32,
+        snap: bool,
+        auto_k: bool,
+        params_buf: &wgpu::Buffer,
+        stats_buf: &wgpu::Buffer,
+    ) -> ViewFit {
         let (right, up, dir) = light_basis(light_dir);
         let basis = glam::Mat4::from_cols(right.extend(0.0), up.extend(0.0), dir.extend(0.0), glam::Vec4::W).transpose();
         let reduce = SdsmReduce {
@@ -116,13 +129,20 @@ impl ViewFit {
         );
         let constants = [("SNAP", flag(snap)), ("AUTO_K", flag(auto_k))];
         let pipeline = gpu.compute_pipeline_with("iasm.fit.place", &source(), "main", &[&layout], &constants);
+        let (uniform, out) = (gpu.uniform("iasm.fit.place", &params), gpu.storage("iasm.fit", SDSM_BOUNDS_BYTES));
+        let group = binding::group(
+            &gpu.device,
+            "iasm.fit.place",
+            &layout,
+            &[uniform.as_entire_binding(), out.as_entire_binding(), params_buf.as_entire_binding(), stats_buf.as_entire_binding()],
+        );
         ViewFit {
             reduce: BoundsReduce::new(gpu, "iasm.fit"),
             reduce_uniform: gpu.uniform("iasm.fit", &reduce),
             depth_mm: gpu.storage("iasm.fit.depth", 8),
-            out: gpu.storage("iasm.fit", SDSM_BOUNDS_BYTES),
-            uniform: gpu.uniform("iasm.fit.place", &params),
-            layout,
+            out,
+            uniform,
+            group,
             pipeline,
             light_dir,
             params,
@@ -133,22 +153,16 @@ impl ViewFit {
     }
 
     /// Records the reduction of `f`'s samples and the square's placement, written into the
-    /// frame's `IasmParams` (`params_buf`) and the tail of `stats_buf`, fitted against the
-    /// side of the last square [`ViewFit::apply`] took.
-    pub fn record(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, params_buf: &wgpu::Buffer, stats_buf: &wgpu::Buffer) {
+    /// frame's `IasmParams` and the statistics' tail, fitted against the side of the last
+    /// square [`ViewFit::apply`] took.
+    pub fn record(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let p = FitParams { prev: self.prev.unwrap_or(0.0), ..self.params };
         rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&p));
-        let group = binding::group(
-            &gpu.device,
-            "iasm.fit.place",
-            &self.layout,
-            &[self.uniform.as_entire_binding(), self.out.as_entire_binding(), params_buf.as_entire_binding(), stats_buf.as_entire_binding()],
-        );
         rec.stage("iasm.fit", |enc| {
             self.reduce.record(gpu, enc, "iasm.fit", f, &self.reduce_uniform, &self.depth_mm, &self.out);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("iasm.fit.place"), timestamp_writes: None });
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &group, &[]);
+            pass.set_bind_group(0, &self.group, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         });
     }

@@ -121,7 +121,10 @@ impl Iasm {
         let analysis = AnalysisPass::new(gpu);
         let eval = EvalPass::buffer(gpu);
         let atlas_pass = atlas.is_some().then(|| AtlasPass::new(gpu, &[&tiles.layout, &scene.layout], scene.has_cutouts));
-        let fit = setup.fit_margin.map(|margin| ViewFit::new(gpu, setup.light_dir, margin, 1e-3 * setup.size, setup.snap, setup.k <= 0.0));
+        let fit = setup.fit_margin.map(|margin| {
+            let (params, stats) = (&res.params_buf, &res.stats_buf);
+            ViewFit::new(gpu, setup.light_dir, margin, 1e-3 * setup.size, setup.snap, setup.k <= 0.0, params, stats)
+        });
         Ok(Iasm {
             placement: setup.basis,
             plan: Plan::default(),
@@ -197,7 +200,7 @@ impl Iasm {
         let (params, stats) = (&self.res.params_buf, &self.res.stats_buf);
         self.analysis.clear(rec, &self.params(), params, stats);
         if let Some(v) = self.fit.as_ref().filter(|_| fit_first) {
-            v.record(gpu, f, rec, params, stats);
+            v.record(gpu, f, rec);
         }
         self.analysis.dispatch(gpu, f, rec, params, stats);
     }
@@ -270,7 +273,7 @@ impl Technique for Iasm {
             self.placement = self.current;
             self.analyse(gpu, f, rec, false);
             if let Some(v) = &self.fit {
-                v.record(gpu, f, rec, &self.res.params_buf, &self.res.stats_buf);
+                v.record(gpu, f, rec);
             }
             self.res.delayed_read.record(rec, &self.res.stats_buf);
             self.analysed = self.current;
