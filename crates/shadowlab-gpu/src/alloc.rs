@@ -30,6 +30,7 @@ pub const POOL_BYTES: u64 = 64 << 20;
 #[derive(Default)]
 pub struct Alloc {
     buffers: AtomicU64,
+    bind_groups: AtomicU64,
     uploads: Arc<Mutex<Vec<wgpu::Buffer>>>,
     reads: Mutex<Vec<wgpu::Buffer>>,
 }
@@ -57,6 +58,17 @@ impl Gpu {
     /// Buffers created through this device wrapper so far.
     pub fn buffers_created(&self) -> u64 {
         self.alloc.buffers.load(Ordering::Relaxed)
+    }
+
+    /// Bind groups created through this device wrapper so far.
+    pub fn bind_groups_created(&self) -> u64 {
+        self.alloc.bind_groups.load(Ordering::Relaxed)
+    }
+
+    /// A new bind group (counted).
+    pub fn bind_group(&self, desc: &wgpu::BindGroupDescriptor) -> wgpu::BindGroup {
+        self.alloc.bind_groups.fetch_add(1, Ordering::Relaxed);
+        self.device.create_bind_group(desc)
     }
 
     /// A new buffer (counted).

@@ -52,8 +52,56 @@ pub fn entries_layout(device: &wgpu::Device, label: &str, entries: &[wgpu::BindG
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
 }
 
-pub fn group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
+/// A bind group of `resources` at bindings 0, 1, ... (counted, [`crate::Gpu::bind_group`]).
+pub fn group(gpu: &crate::Gpu, label: &str, layout: &wgpu::BindGroupLayout, resources: &[wgpu::BindingResource]) -> wgpu::BindGroup {
     let entries: Vec<_> =
         resources.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() }).collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+    gpu.bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+}
+
+/// One resource of a bind group by identity (wgpu handles compare by object).
+#[derive(PartialEq, Eq)]
+enum Bound {
+    Buffer(wgpu::Buffer, u64, Option<wgpu::BufferSize>),
+    View(wgpu::TextureView),
+    Sampler(wgpu::Sampler),
+}
+
+fn bound(r: &wgpu::BindingResource) -> Option<Bound> {
+    match r {
+        wgpu::BindingResource::Buffer(b) => Some(Bound::Buffer(b.buffer.clone(), b.offset, b.size)),
+        wgpu::BindingResource::TextureView(v) => Some(Bound::View((*v).clone())),
+        wgpu::BindingResource::Sampler(s) => Some(Bound::Sampler((*s).clone())),
+        _ => None,
+    }
+}
+
+/// A bind group kept while its layout and resources stay the same objects, so that a pass
+/// whose inputs do not change makes no bind group after its first frame (tests/hygiene.rs).
+/// One per call site; a change of any resource (another view, a resized target) makes the
+/// group again. Resources held here live as long as the cache (its pass) or until replaced.
+#[derive(Default)]
+pub struct GroupCache(std::sync::Mutex<Option<(wgpu::BindGroupLayout, Vec<Bound>, wgpu::BindGroup)>>);
+
+impl GroupCache {
+    /// The group of `resources` over `layout`: the kept one when they are the same, else a new one
+    /// ([`group`]), kept.
+    pub fn get(
+        &self,
+        gpu: &crate::Gpu,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        resources: &[wgpu::BindingResource],
+    ) -> wgpu::BindGroup {
+        let key: Option<Vec<Bound>> = resources.iter().map(bound).collect();
+        let mut slot = self.0.lock().unwrap();
+        if let (Some(k), Some((l, kept, g))) = (&key, slot.as_ref()) {
+            if l == layout && k == kept {
+                return g.clone();
+            }
+        }
+        let g = group(gpu, label, layout, resources);
+        *slot = key.map(|k| (layout.clone(), k, g.clone()));
+        g
+    }
 }

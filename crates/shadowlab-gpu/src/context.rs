@@ -1,6 +1,5 @@
 //! Device creation, buffer helpers and readback.
 
-
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     #[error("no GPU adapter found ({0}). On Debian/Ubuntu without a GPU install Mesa's software Vulkan: sudo apt-get install mesa-vulkan-drivers libvulkan1")]

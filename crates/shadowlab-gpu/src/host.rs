@@ -83,7 +83,7 @@ impl HostView {
         );
         let tv = visibility_texture.create_view(&Default::default());
         let copy_group = binding::group(
-            &gpu.device,
+            gpu,
             "host.visibility_texture",
             &layout,
             &[frame.as_entire_binding(), visibility.as_entire_binding(), wgpu::BindingResource::TextureView(&tv)],

@@ -155,7 +155,7 @@ impl GpuScene {
         types[5] = binding::uniform();
         let layout = binding::layout(&gpu.device, "scene", vis, &types);
         let group = binding::group(
-            &gpu.device,
+            gpu,
             "scene",
             &layout,
             &[
@@ -226,7 +226,7 @@ impl GpuScene {
         let info = SceneInfo { triangle_count: count, dynamic_first: count, dynamic_root: 0, _pad: 0 };
         let info_buf = gpu.uniform(&format!("{label}.info"), &info);
         let group = binding::group(
-            &gpu.device,
+            gpu,
             label,
             &self.layout,
             &[

@@ -52,8 +52,16 @@ pub fn view_layout(gpu: &Gpu, label: &str, extra: &[wgpu::BindingType]) -> wgpu:
 }
 
 impl FrameInputs<'_> {
-    /// Bind group for [`view_layout`]: the view inputs, then `extra` from binding 6.
-    pub fn view_group(&self, gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, extra: &[wgpu::BindingResource]) -> wgpu::BindGroup {
+    /// Bind group for [`view_layout`]: the view inputs, then `extra` from binding 6; kept in
+    /// `cache` while they are the same objects (no bind group per frame).
+    pub fn view_group(
+        &self,
+        gpu: &Gpu,
+        cache: &crate::binding::GroupCache,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        extra: &[wgpu::BindingResource],
+    ) -> wgpu::BindGroup {
         let mut res = vec![
             self.frame.as_entire_binding(),
             self.light_buf.as_entire_binding(),
@@ -63,7 +71,7 @@ impl FrameInputs<'_> {
             self.visibility.as_entire_binding(),
         ];
         res.extend_from_slice(extra);
-        crate::binding::group(&gpu.device, label, layout, &res)
+        cache.get(gpu, label, layout, &res)
     }
 }
 

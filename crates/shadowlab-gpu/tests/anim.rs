@@ -193,7 +193,7 @@ fn occluded_static_and_occluded_dynamic_each_see_their_part() {
         gpu.compute_pipeline("split", &compose_view(&format!("{TRACE_WGSL}{SPLIT_WGSL}"), true), "main", &[&layout, &lab.gscene.layout]);
     let hits = gpu.storage("split.hits", 256 * 256 * 4);
     let inputs = v.inputs(&lab.gscene);
-    let group = inputs.view_group(&gpu, "split", &layout, &[hits.as_entire_binding()]);
+    let group = inputs.view_group(&gpu, &Default::default(), "split", &layout, &[hits.as_entire_binding()]);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     gpu.dispatch_2d(&mut enc, "split", &pipeline, &[&group, &lab.gscene.group], 256, 256);
     gpu.queue.submit([enc.finish()]);

@@ -138,11 +138,12 @@ fn dpsm_rejects_other_lights() {
 /// the split plane in a fragment stage instead of clipping there.
 fn gpu_without_clip_distances(gpu: &shadowlab_gpu::Gpu) -> Option<shadowlab_gpu::Gpu> {
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-        power_preference: wgpu::PowerPreference::HighPerformance,
-        ..Default::default()
-    }))
-    .ok()?;
+    let adapter =
+        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .ok()?;
     if adapter.get_info().name != gpu.info.name {
         return None;
     }

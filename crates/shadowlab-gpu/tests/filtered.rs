@@ -263,7 +263,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let input = gpu.buffer_init("cases", bytemuck::cast_slice(&cases), wgpu::BufferUsages::STORAGE);
     let out = gpu.storage("out", cases.len() as u64 * 8);
     let layout = binding::layout(&gpu.device, "t", wgpu::ShaderStages::COMPUTE, &[binding::storage(true), binding::storage(false)]);
-    let group = binding::group(&gpu.device, "t", &layout, &[input.as_entire_binding(), out.as_entire_binding()]);
+    let group = binding::group(&gpu, "t", &layout, &[input.as_entire_binding(), out.as_entire_binding()]);
     let pipeline = gpu.compute_pipeline("moments-test", &src, "main", &[&layout]);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     gpu.dispatch_2d(&mut enc, "moments-test", &pipeline, &[&group], 256, 64);

@@ -55,6 +55,8 @@ static INFO: TechniqueInfo = TechniqueInfo {
 struct Threshold {
     uniform: wgpu::Buffer,
     layout: wgpu::BindGroupLayout,
+    /// The evaluation's bind group, kept while the frame's inputs are the same.
+    groups: shadowlab_gpu::binding::GroupCache,
     pipeline: wgpu::ComputePipeline,
 }
 
@@ -63,7 +65,7 @@ impl Threshold {
         let uniform = gpu.uniform("threshold.params", &[p.height, 0.0, 0.0, 0.0]);
         let layout = view_layout(gpu, "threshold.eval", &[shadowlab_gpu::binding::uniform()]);
         let pipeline = gpu.compute_pipeline("threshold.eval", &shaders()[0].1, "main", &[&layout]);
-        Threshold { uniform, layout, pipeline }
+        Threshold { uniform, layout, groups: Default::default(), pipeline }
     }
 }
 
@@ -72,7 +74,7 @@ impl Technique for Threshold {
         Ok(())
     }
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let group = f.view_group(gpu, "threshold.eval", &self.layout, &[self.uniform.as_entire_binding()]);
+        let group = f.view_group(gpu, &self.groups, "threshold.eval", &self.layout, &[self.uniform.as_entire_binding()]);
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         rec.stage("threshold.evaluate", |enc| gpu.dispatch_2d(enc, "threshold.evaluate", &self.pipeline, &[&group], w, h));
         Ok(())

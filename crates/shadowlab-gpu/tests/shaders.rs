@@ -275,7 +275,12 @@ fn iasm_layouts_match_wgsl() {
     for n in ["iasm/render.wgsl", "iasm/atlas.wgsl"] {
         check(&get(n), "TileParams", size_of::<TileParams>(), &[("tile", offset_of!(TileParams, tile))]);
     }
-    check_all(&get("iasm/fit.wgsl"), "FitParams", size_of::<FitParams>(), fields!(FitParams; margin, min_side, prev, div, shrink, steps, pad0, pad1, fracs));
+    check_all(
+        &get("iasm/fit.wgsl"),
+        "FitParams",
+        size_of::<FitParams>(),
+        fields!(FitParams; margin, min_side, prev, div, shrink, steps, pad0, pad1, fracs),
+    );
 }
 
 #[test]

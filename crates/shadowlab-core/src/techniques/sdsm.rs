@@ -256,7 +256,11 @@ mod tests {
         // the previous rule (powf of the ceiled log2, one step more if short) on ordinary sizes
         let old = |x: f32| {
             let q = (2.0f32).powf((x.log2() * 16.0).ceil() / 16.0);
-            if q >= x { q } else { (2.0f32).powf(((x.log2() * 16.0).ceil() + 1.0) / 16.0) }
+            if q >= x {
+                q
+            } else {
+                (2.0f32).powf(((x.log2() * 16.0).ceil() + 1.0) / 16.0)
+            }
         };
         let mut x = 1e-5f32;
         while x < 1e7 {

@@ -79,7 +79,7 @@ impl Blur {
         let group = |dir: [i32; 2], src: &wgpu::TextureView, dst: &wgpu::TextureView| {
             let u = gpu.uniform(label, &BlurParams { dir, half, sigma });
             binding::group(
-                d,
+                gpu,
                 label,
                 &layout,
                 &[u.as_entire_binding(), wgpu::BindingResource::TextureView(src), wgpu::BindingResource::TextureView(dst)],

@@ -90,7 +90,7 @@ impl MaskPass {
         let pv = g.position.create_view(&Default::default());
         let nv = g.normal.create_view(&Default::default());
         let group = binding::group(
-            &gpu.device,
+            gpu,
             "mask",
             &self.layout,
             &[
@@ -127,7 +127,7 @@ impl GBufferPass {
 
     /// Rasterises the scene into `g` (stage `gbuffer`).
     pub fn render(&self, gpu: &Gpu, rec: &mut Recorder, scene: &GpuScene, frame: &wgpu::Buffer, g: &GBuffer) {
-        let group = binding::group(&gpu.device, "gbuffer.frame", &self.frame_layout, &[frame.as_entire_binding()]);
+        let group = binding::group(gpu, "gbuffer.frame", &self.frame_layout, &[frame.as_entire_binding()]);
         let views: Vec<wgpu::TextureView> =
             [&g.position, &g.normal, &g.albedo, &g.motion].iter().map(|t| t.create_view(&Default::default())).collect();
         let depth = g.depth.create_view(&Default::default());

@@ -68,7 +68,7 @@ impl PrefixSum {
             made.entry(bytemuck::cast(p)).or_insert_with(|| gpu.uniform("prefix_sum.params", &p)).clone()
         };
         let group = binding::group(
-            &gpu.device,
+            gpu,
             "prefix_sum",
             &self.layout,
             &[uniform.as_entire_binding(), input.as_entire_binding(), output.as_entire_binding()],

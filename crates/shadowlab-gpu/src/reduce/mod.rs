@@ -53,7 +53,7 @@ impl MinMax {
     pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str, src: &wgpu::Texture, mask: &wgpu::Buffer) {
         let view = src.create_view(&Default::default());
         let group = binding::group(
-            &gpu.device,
+            gpu,
             label,
             &self.layout,
             &[

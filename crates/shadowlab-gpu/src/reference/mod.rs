@@ -41,6 +41,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 pub struct RayTraced {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    groups: crate::binding::GroupCache,
     rays: wgpu::Buffer,
     bvh_bytes: usize,
 }
@@ -49,7 +50,7 @@ impl RayTraced {
     pub fn new(gpu: &Gpu, scene: &GpuScene) -> RayTraced {
         let layout = view_layout(gpu, "rt", &[binding::storage(false)]);
         let pipeline = gpu.compute_pipeline("rt", &rt_src(), "main", &[&layout, &scene.layout]);
-        RayTraced { pipeline, layout, rays: gpu.storage("rt.rays", 4), bvh_bytes: scene.bvh_bytes }
+        RayTraced { pipeline, layout, groups: Default::default(), rays: gpu.storage("rt.rays", 4), bvh_bytes: scene.bvh_bytes }
     }
 }
 
@@ -60,7 +61,7 @@ impl Technique for RayTraced {
     }
 
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let group = f.view_group(gpu, "rt", &self.layout, &[self.rays.as_entire_binding()]);
+        let group = f.view_group(gpu, &self.groups, "rt", &self.layout, &[self.rays.as_entire_binding()]);
         rec.stage("rt.trace", |enc| {
             enc.clear_buffer(&self.rays, 0, None);
             gpu.dispatch_2d(enc, "rt.trace", &self.pipeline, &[&group, &f.scene.group], f.gbuffer.width, f.gbuffer.height)

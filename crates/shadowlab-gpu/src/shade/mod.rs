@@ -41,7 +41,7 @@ impl ShadePass {
         let g = f.gbuffer;
         let views: Vec<_> = [&g.position, &g.normal, &g.albedo].iter().map(|t| t.create_view(&Default::default())).collect();
         let group = binding::group(
-            &gpu.device,
+            gpu,
             "shade",
             &self.layout,
             &[

@@ -423,7 +423,7 @@ impl<'a> Renderer<'a> {
         let ubuf = gpu.uniform("view.compose", &params);
         let tv = t.view.create_view(&Default::default());
         let group = binding::group(
-            &gpu.device,
+            gpu,
             "view.compose",
             &self.compose_layout,
             &[

@@ -86,7 +86,7 @@ impl BoundsReduce {
     ) {
         let view = f.gbuffer.position.create_view(&Default::default());
         let group = binding::group(
-            &gpu.device,
+            gpu,
             label,
             &self.layout,
             &[

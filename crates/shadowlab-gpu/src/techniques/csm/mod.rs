@@ -91,6 +91,7 @@ pub struct CsmParams {
 const PROBE_BYTES: u64 = 8;
 
 pub struct Cascaded {
+    pub(crate) groups: crate::binding::GroupCache,
     /// `csm` or `sdsm`: the stage names' prefix.
     name: &'static str,
     count: usize,
@@ -178,7 +179,8 @@ impl Cascaded {
         let uniform = gpu.uniform("csm.params", &params);
         let depth_layout = binding::layout(d, "csm.depth", wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
         let depth_uniforms: Vec<_> = (0..count).map(|_| gpu.uniform("csm.cascade", &Mat4::IDENTITY.to_cols_array_2d())).collect();
-        let depth_groups = depth_uniforms.iter().map(|u| binding::group(d, "csm.depth", &depth_layout, &[u.as_entire_binding()])).collect();
+        let depth_groups =
+            depth_uniforms.iter().map(|u| binding::group(gpu, "csm.depth", &depth_layout, &[u.as_entire_binding()])).collect();
         let depth_pipeline =
             raster::depth_pipeline(gpu, "csm.depth", &compose_depth(DEPTH_WGSL), &[&depth_layout, &scene.layout], scene.has_cutouts);
         let eval_layout = view_layout(
@@ -190,6 +192,7 @@ impl Cascaded {
         let sampler = raster::comparison_sampler(gpu, "csm.cmp");
         let counts = gpu.storage("csm.counts", count as u64 * res as u64 * res as u64 * 4);
         Ok(Cascaded {
+            groups: Default::default(),
             name,
             count,
             res,
@@ -369,6 +372,7 @@ impl Cascaded {
             .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
         let group = f.view_group(
             gpu,
+            &self.groups,
             "csm.eval",
             &self.eval_layout,
             &[

@@ -40,7 +40,7 @@ impl FacePasses {
                     face: [f as u32, near.to_bits(), 0, 0],
                 };
                 let buf = gpu.uniform(&format!("cube.face{f}"), &u);
-                binding::group(d, "cube.depth", &face_layout, &[buf.as_entire_binding()])
+                binding::group(gpu, "cube.depth", &face_layout, &[buf.as_entire_binding()])
             })
             .collect();
         let layouts = [&face_layout, &scene.layout];

@@ -32,11 +32,10 @@ pub(super) fn pipelines(gpu: &Gpu, hardware: bool, pcf: u32) -> (wgpu::BindGroup
 impl CubeMap {
     /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
     pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
-        let view = self
-            .map
-            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let view = &self.array_view;
         let group = f.view_group(
             gpu,
+            &self.groups,
             "cube.evaluate",
             &self.eval_layout,
             &[self.params.as_entire_binding(), wgpu::BindingResource::TextureView(&view), self.counts.as_entire_binding()],

@@ -26,11 +26,14 @@ impl CubeMap {
         let params = CubeParams { position: pos.into(), far, res: res as f32, pcf: pcf as f32, near, pad0: 0.0, bias: p.bias.packed() };
         let (eval_layout, eval) = eval::pipelines(gpu, hardware, pcf);
         Ok(CubeMap {
+            groups: Default::default(),
             res,
             far,
             near,
             hardware,
             pcf,
+            array_view: map
+                .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() }),
             map,
             face_groups: faces.groups,
             depth_pipeline: faces.pipeline,

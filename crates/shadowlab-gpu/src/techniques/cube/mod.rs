@@ -230,6 +230,7 @@ pub struct CubeParams {
 
 /// A point light's cube shadow map: six layers of one Depth32Float array texture.
 pub struct CubeMap {
+    pub(crate) groups: crate::binding::GroupCache,
     res: u32,
     near: f32,
     /// `depth=hardware`: the faces hold reversed depth near / z.
@@ -237,6 +238,8 @@ pub struct CubeMap {
     far: f32,
     pcf: u32,
     map: wgpu::Texture,
+    /// The six faces as one array view for the evaluation (made once: its bind group is kept).
+    array_view: wgpu::TextureView,
     face_groups: Vec<wgpu::BindGroup>,
     depth_pipeline: wgpu::RenderPipeline,
     /// The static triangles of each face (vertex indices), culled once on the CPU.

@@ -32,6 +32,7 @@ pub(super) fn split_source() -> String {
 const FACE_IMAGES: &[&str] = &["count map before warping", "count map after warping", "warped shadow map", "row warping", "column warping"];
 
 struct Face {
+    pub(crate) groups: crate::binding::GroupCache,
     warped: Warped,
     /// The scene's triangles clipped to this face (clip.rs).
     scene: GpuScene,
@@ -83,6 +84,7 @@ impl CubeNotw {
             let warped = Warped::new_sharing(gpu, &face_scene, &knobs, &light, shared.as_ref())?;
             shared.get_or_insert_with(|| warped.subdiv_scratch());
             built[f] = Some(Face {
+                groups: Default::default(),
                 warped,
                 scene: face_scene,
                 light,
@@ -122,6 +124,7 @@ impl CubeNotw {
         let (mask, vis) = (face.mask.as_ref().expect("sized in prepare"), face.vis.as_ref().expect("sized in prepare"));
         f.view_group(
             gpu,
+            &face.groups,
             "cube-notw.split",
             &self.layout,
             &[face.sel.as_entire_binding(), mask.as_entire_binding(), vis.as_entire_binding(), self.face_samples.as_entire_binding()],

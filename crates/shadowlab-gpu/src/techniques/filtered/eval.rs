@@ -46,9 +46,10 @@ impl Filtered {
     /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
     pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
         let name = self.kind.name();
-        let map_view = self.map.create_view(&Default::default());
+        let map_view = &self.map_view;
         let group = f.view_group(
             gpu,
+            &self.groups,
             &format!("{name}.eval"),
             &self.eval_layout,
             &[

@@ -20,10 +20,12 @@ impl Filtered {
         let (render_pipeline, render_group) = render::pipeline(gpu, scene, plan.kind.name(), plan.format, &t.uniform);
         let (eval_layout, eval, sampler) = eval::pipelines(gpu, plan.kind.name(), &plan.params);
         Ok(Filtered {
+            groups: Default::default(),
             kind: plan.kind,
             sd: plan.sd,
             res: plan.res,
             params: plan.params,
+            map_view: t.map.create_view(&Default::default()),
             map: t.map,
             depth: t.depth,
             clear: plan.clear,

@@ -47,7 +47,7 @@ impl MipChain {
             .map(|l| {
                 let (src, dst) = (level(l - 1), level(l));
                 let g = binding::group(
-                    d,
+                    gpu,
                     label,
                     &layout,
                     &[wgpu::BindingResource::TextureView(&src), wgpu::BindingResource::TextureView(&dst)],

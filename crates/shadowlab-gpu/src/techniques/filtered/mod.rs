@@ -179,11 +179,14 @@ impl Representation {
 
 /// One light's filterable map (made in map.rs).
 pub struct Filtered {
+    pub(crate) groups: crate::binding::GroupCache,
     kind: Kind,
     sd: bool,
     res: u32,
     params: FilteredParams,
     map: wgpu::Texture,
+    /// The moments' view the evaluation binds (made once: its bind group is kept).
+    map_view: wgpu::TextureView,
     depth: wgpu::Texture,
     clear: wgpu::Color,
     blur: Option<Blur>,

@@ -27,7 +27,7 @@ pub(super) fn pipeline(
 ) -> (wgpu::RenderPipeline, wgpu::BindGroup) {
     let d = &gpu.device;
     let layout = binding::layout(d, name, wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
-    let group = binding::group(d, name, &layout, &[uniform.as_entire_binding()]);
+    let group = binding::group(gpu, name, &layout, &[uniform.as_entire_binding()]);
     let target = wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL };
     let pipeline = raster::scene_pipeline(gpu, &format!("{name}.render"), &render_source(), &[&layout, &scene.layout], &[Some(target)]);
     (pipeline, group)

@@ -18,6 +18,7 @@ pub(super) fn source() -> String {
 
 pub(super) struct AnalysisPass {
     layout: wgpu::BindGroupLayout,
+    groups: crate::binding::GroupCache,
     pipeline: wgpu::ComputePipeline,
 }
 
@@ -25,7 +26,7 @@ impl AnalysisPass {
     pub fn new(gpu: &Gpu) -> AnalysisPass {
         let layout = view_layout(gpu, "iasm.analysis", &[binding::uniform(), binding::storage(false)]);
         let pipeline = gpu.compute_pipeline("iasm.analysis", &source(), "main", &[&layout]);
-        AnalysisPass { layout, pipeline }
+        AnalysisPass { layout, groups: Default::default(), pipeline }
     }
 
     /// Writes `params` into `params_buf` and clears the statistics in `stats_buf` (not the
@@ -40,7 +41,13 @@ impl AnalysisPass {
 
     /// Dispatches the analysis of `f` over the square in `params_buf` into `stats_buf`.
     pub fn dispatch(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, params_buf: &wgpu::Buffer, stats_buf: &wgpu::Buffer) {
-        let group = f.view_group(gpu, "iasm.analysis", &self.layout, &[params_buf.as_entire_binding(), stats_buf.as_entire_binding()]);
+        let group = f.view_group(
+            gpu,
+            &self.groups,
+            "iasm.analysis",
+            &self.layout,
+            &[params_buf.as_entire_binding(), stats_buf.as_entire_binding()],
+        );
         rec.stage("iasm.importance", |enc| {
             gpu.dispatch_2d(enc, "iasm.importance", &self.pipeline, &[&group], f.gbuffer.width, f.gbuffer.height)
         });

@@ -31,7 +31,7 @@ pub(super) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Ve
     );
     let cp = gpu.uniform("iasm.chunk_params", &[chunk, scene.triangle_count, 0, 0]);
     let layout = binding::layout(d, "iasm.bounds", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
-    let group = binding::group(d, "iasm.bounds", &layout, &[cp.as_entire_binding(), boxes.as_entire_binding()]);
+    let group = binding::group(gpu, "iasm.bounds", &layout, &[cp.as_entire_binding(), boxes.as_entire_binding()]);
     let pipeline = gpu.compute_pipeline("iasm.bounds", &source(), "main", &[&layout, &scene.layout]);
     let groups = scene.triangle_count.div_ceil(64).max(1);
     let mut enc = d.create_command_encoder(&Default::default());

@@ -23,6 +23,7 @@ pub(super) fn atlas_source() -> String {
 /// as shipped and counting.
 pub(super) struct EvalPass {
     layout: wgpu::BindGroupLayout,
+    groups: crate::binding::GroupCache,
     timed: wgpu::ComputePipeline,
     counting: wgpu::ComputePipeline,
 }
@@ -42,7 +43,7 @@ impl EvalPass {
         let layout = view_layout(gpu, label, &[binding::uniform(), data, binding::storage(false)]);
         let timed = gpu.compute_pipeline("iasm.evaluate", source, "main", &[&layout]);
         let counting = gpu.compute_pipeline_with("iasm.evaluate", source, "main", &[&layout], crate::context::COUNTING);
-        EvalPass { layout, timed, counting }
+        EvalPass { layout, groups: Default::default(), timed, counting }
     }
 
     /// The bind group over the frame uniform, the shadow data `data` and the counts.
@@ -54,7 +55,7 @@ impl EvalPass {
         data: wgpu::BindingResource,
         counts: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        f.view_group(gpu, "iasm.eval", &self.layout, &[params.as_entire_binding(), data, counts.as_entire_binding()])
+        f.view_group(gpu, &self.groups, "iasm.eval", &self.layout, &[params.as_entire_binding(), data, counts.as_entire_binding()])
     }
 
     /// Stage `iasm.evaluate`.

@@ -131,7 +131,7 @@ impl ViewFit {
         let pipeline = gpu.compute_pipeline_with("iasm.fit.place", &source(), "main", &[&layout], &constants);
         let (uniform, out) = (gpu.uniform("iasm.fit.place", &params), gpu.storage("iasm.fit", SDSM_BOUNDS_BYTES));
         let group = binding::group(
-            &gpu.device,
+            gpu,
             "iasm.fit.place",
             &layout,
             &[uniform.as_entire_binding(), out.as_entire_binding(), params_buf.as_entire_binding(), stats_buf.as_entire_binding()],
@@ -176,11 +176,7 @@ impl ViewFit {
             self.source = FitSource::Fixed;
             return None;
         }
-        self.bounds = Some(SampleBounds {
-            lo: Vec3::new(word(4), word(5), 0.0),
-            hi: Vec3::new(word(6), word(7), 0.0),
-            samples: tail[8],
-        });
+        self.bounds = Some(SampleBounds { lo: Vec3::new(word(4), word(5), 0.0), hi: Vec3::new(word(6), word(7), 0.0), samples: tail[8] });
         self.source = source;
         let side = word(3);
         self.prev = Some(side);

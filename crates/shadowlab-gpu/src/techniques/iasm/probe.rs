@@ -26,7 +26,7 @@ pub(super) fn probe_indices(gpu: &Gpu, mut params: IasmParams, res: &[u32; TILE_
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
     );
     let layout = binding::layout(&gpu.device, "iasm.probe", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
-    let group = binding::group(&gpu.device, "iasm.probe", &layout, &[ub.as_entire_binding(), probe.as_entire_binding()]);
+    let group = binding::group(gpu, "iasm.probe", &layout, &[ub.as_entire_binding(), probe.as_entire_binding()]);
     let pipeline = gpu.compute_pipeline("iasm.probe", &source(), "probe_index", &[&layout]);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     {

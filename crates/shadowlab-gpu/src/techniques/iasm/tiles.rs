@@ -74,7 +74,7 @@ impl TilePass {
         let groups = (0..TILE_COUNT as u64)
             .map(|t| {
                 let tb = wgpu::BufferBinding { buffer: tile_buf, offset: t * TILE_STRIDE, size: wgpu::BufferSize::new(80) };
-                binding::group(d, "iasm.render", &layout, &[wgpu::BindingResource::Buffer(tb), shadow.as_entire_binding()])
+                binding::group(gpu, "iasm.render", &layout, &[wgpu::BindingResource::Buffer(tb), shadow.as_entire_binding()])
             })
             .collect();
         let pipeline = render_pipeline(gpu, &[&layout, &scene.layout]);

@@ -18,6 +18,7 @@ pub(super) fn source() -> String {
 }
 
 pub(super) struct ClassifyPass {
+    pub(crate) groups: crate::binding::GroupCache,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
 }
@@ -41,7 +42,7 @@ impl ClassifyPass {
             ("POINT", flag(p.flags & FLAG_POINT != 0)),
         ];
         let pipeline = gpu.compute_pipeline_with(&format!("{name}.classify"), &source(), "main", &[&layout], &constants);
-        ClassifyPass { layout, pipeline }
+        ClassifyPass { groups: Default::default(), layout, pipeline }
     }
 
     /// The bind group of the frame `s` is at: both maps (the static one again without a dynamic
@@ -56,6 +57,7 @@ impl ClassifyPass {
         use wgpu::BindingResource as R;
         f.view_group(
             gpu,
+            &self.groups,
             &format!("{name}.classify"),
             &self.layout,
             &[

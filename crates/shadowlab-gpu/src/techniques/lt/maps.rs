@@ -22,7 +22,7 @@ impl MapPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, name: &str, uniforms: &[wgpu::Buffer]) -> MapPass {
         let d = &gpu.device;
         let layout = binding::layout(d, name, wgpu::ShaderStages::VERTEX_FRAGMENT, &[binding::uniform()]);
-        let groups = uniforms.iter().map(|u| binding::group(d, name, &layout, &[u.as_entire_binding()])).collect();
+        let groups = uniforms.iter().map(|u| binding::group(gpu, name, &layout, &[u.as_entire_binding()])).collect();
         let target = wgpu::ColorTargetState { format: wgpu::TextureFormat::R32Float, blend: None, write_mask: wgpu::ColorWrites::ALL };
         let pipeline = raster::scene_pipeline(gpu, &format!("{name}.render"), &render_source(), &[&layout, &scene.layout], &[Some(target)]);
         MapPass { groups, pipeline }

@@ -18,6 +18,9 @@ pub(super) fn source() -> String {
 }
 
 pub(super) struct TracePass {
+    /// The trace's group per ping-pong mask, and the arguments' group (kept: no group per frame).
+    pub(crate) groups: [crate::binding::GroupCache; 2],
+    pub(crate) args_groups: crate::binding::GroupCache,
     trace_layout: wgpu::BindGroupLayout,
     trace_pipeline: wgpu::ComputePipeline,
     args_layout: wgpu::BindGroupLayout,
@@ -37,7 +40,7 @@ impl TracePass {
         let trace_pipeline = gpu.compute_pipeline(&format!("{name}.trace"), &source(), "main", &[&trace_layout, &scene.layout]);
         let args_layout = binding::layout(&gpu.device, &format!("{name}.args"), wgpu::ShaderStages::COMPUTE, &[binding::uniform(), ro, rw]);
         let args_pipeline = gpu.compute_pipeline(&format!("{name}.args"), ARGS_WGSL, "main", &[&args_layout]);
-        TracePass { trace_layout, trace_pipeline, args_layout, args_pipeline }
+        TracePass { groups: Default::default(), args_groups: Default::default(), trace_layout, trace_pipeline, args_layout, args_pipeline }
     }
 
     /// This frame's `TraceParams`: the mask's bits per pixel and the pixels.
@@ -50,12 +53,13 @@ impl TracePass {
         let cur = (s.frames % 2) as usize;
         let trace = f.view_group(
             gpu,
+            &self.groups[cur],
             &format!("{name}.trace"),
             &self.trace_layout,
             &[uniform.as_entire_binding(), s.list.as_entire_binding(), s.masks[cur].as_entire_binding()],
         );
-        let args = binding::group(
-            &gpu.device,
+        let args = self.args_groups.get(
+            gpu,
             &format!("{name}.args"),
             &self.args_layout,
             &[uniform.as_entire_binding(), s.list.as_entire_binding(), s.args.as_entire_binding()],

@@ -137,6 +137,7 @@ pub struct MdsmParams {
 }
 
 pub struct MultiDepthMap {
+    pub(crate) groups: crate::binding::GroupCache,
     res: u32,
     k: u32,
     n: u32,
@@ -144,6 +145,8 @@ pub struct MultiDepthMap {
     /// `sm`'s depth pass: the base map.
     depth: DepthPass,
     nsm: wgpu::Texture,
+    /// Its view for the evaluation (made once: the bind group is kept).
+    nsm_view: wgpu::TextureView,
     counts: wgpu::Buffer,
     uniform: wgpu::Buffer,
     select_pipeline: wgpu::ComputePipeline,
@@ -200,7 +203,7 @@ impl MultiDepthMap {
             binding::layout(d, "mdsm.select", wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::texture_depth(), storage_out]);
         let (depth_view, nsm_view) = (depth.map.create_view(&Default::default()), nsm.create_view(&Default::default()));
         let select_group = binding::group(
-            d,
+            gpu,
             "mdsm.select",
             &select_layout,
             &[uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&depth_view), wgpu::BindingResource::TextureView(&nsm_view)],
@@ -209,7 +212,22 @@ impl MultiDepthMap {
         let eval_layout = view_layout(gpu, "mdsm.eval", &[binding::uniform(), binding::texture_float(), binding::storage(false)]);
         let eval = crate::technique::EvalPipelines::new(gpu, "mdsm.eval", &eval_src(), &eval_layout, &[]);
         let counts = gpu.storage("mdsm.counts", res as u64 * res as u64 * 4);
-        Ok(MultiDepthMap { res, k, n, params, depth, nsm, counts, uniform, select_pipeline, select_group, eval, eval_layout })
+        Ok(MultiDepthMap {
+            groups: Default::default(),
+            res,
+            k,
+            n,
+            params,
+            depth,
+            nsm_view: nsm_view.clone(),
+            nsm,
+            counts,
+            uniform,
+            select_pipeline,
+            select_group,
+            eval,
+            eval_layout,
+        })
     }
 
     /// The uniform as uploaded (projection, bias, selection settings).
@@ -260,9 +278,10 @@ impl Technique for MultiDepthMap {
 impl MultiDepthMap {
     /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
     fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
-        let nsm_view = self.nsm.create_view(&Default::default());
+        let nsm_view = &self.nsm_view;
         let group = f.view_group(
             gpu,
+            &self.groups,
             "mdsm.eval",
             &self.eval_layout,
             &[self.uniform.as_entire_binding(), wgpu::BindingResource::TextureView(&nsm_view), self.counts.as_entire_binding()],

@@ -93,6 +93,7 @@ pub struct MsfReduce {
 }
 
 pub struct MinShadowMap {
+    pub(crate) groups: crate::binding::GroupCache,
     /// `sm`'s depth pass and evaluation, pointed at the fitted rectangle every frame.
     pass: MapPass,
     res: u32,
@@ -149,6 +150,7 @@ impl MinShadowMap {
         });
         let pad_texels = p.bias.normal_offset + (pcf as f64 - 1.0) * 0.5 + PAD_MARGIN_TEXELS;
         Ok(MinShadowMap {
+            groups: Default::default(),
             pass,
             res,
             grid,
@@ -192,6 +194,7 @@ impl Technique for MinShadowMap {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let group = f.view_group(
             gpu,
+            &self.groups,
             "min-sm.reduce",
             &self.reduce_layout,
             &[self.reduce_uniform.as_entire_binding(), self.red.as_entire_binding()],

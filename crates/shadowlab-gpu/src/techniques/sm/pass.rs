@@ -31,6 +31,8 @@ pub struct DepthPass {
     name: &'static str,
     pub res: u32,
     pub map: wgpu::Texture,
+    /// The map's view (render target and evaluation binding, made once).
+    pub map_view: wgpu::TextureView,
     /// `SmParams` (the depth pass reads only `light_view_proj`).
     pub uniform: wgpu::Buffer,
     pipeline: wgpu::RenderPipeline,
@@ -45,9 +47,9 @@ impl DepthPass {
         let uniform = gpu.uniform(&format!("{name}.params"), params);
         let label = format!("{name}.depth");
         let layout = binding::layout(d, &label, wgpu::ShaderStages::VERTEX, &[binding::uniform()]);
-        let group = binding::group(d, &label, &layout, &[uniform.as_entire_binding()]);
+        let group = binding::group(gpu, &label, &layout, &[uniform.as_entire_binding()]);
         let pipeline = raster::depth_pipeline(gpu, &label, &depth_source(), &[&layout, &scene.layout], scene.has_cutouts);
-        DepthPass { name, res, map, uniform, pipeline, group }
+        DepthPass { name, res, map_view: map.create_view(&Default::default()), map, uniform, pipeline, group }
     }
 
     /// Uploads a new uniform (projection, texel, bias).
@@ -57,7 +59,7 @@ impl DepthPass {
 
     /// Clears the map and draws the scene into it.
     pub fn render(&self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
-        let map_view = self.map.create_view(&Default::default());
+        let map_view = &self.map_view;
         let stage = format!("{}.render", self.name);
         rec.stage(&stage, |enc| {
             let mut pass = raster::begin_pass(enc, &stage, &[], &map_view);
@@ -85,6 +87,7 @@ pub struct MapPass {
     eval: EvalPipelines,
     eval_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
+    groups: crate::binding::GroupCache,
 }
 
 impl MapPass {
@@ -102,7 +105,7 @@ impl MapPass {
         let eval = EvalPipelines::new(gpu, &label, &eval_source(), &eval_layout, &[("PCF", pcf as f64)]);
         let sampler = raster::comparison_sampler(gpu, &format!("{name}.cmp"));
         let counts = gpu.storage(&format!("{name}.counts"), res as u64 * res as u64 * 4);
-        MapPass { depth, pcf, params, counts, eval, eval_layout, sampler }
+        MapPass { depth, pcf, params, counts, eval, eval_layout, sampler, groups: Default::default() }
     }
 
     pub fn res(&self) -> u32 {
@@ -123,9 +126,10 @@ impl MapPass {
     }
 
     fn eval_group(&self, gpu: &Gpu, f: &FrameInputs) -> wgpu::BindGroup {
-        let map_view = self.depth.map.create_view(&Default::default());
+        let map_view = &self.depth.map_view;
         f.view_group(
             gpu,
+            &self.groups,
             &format!("{}.eval", self.depth.name),
             &self.eval_layout,
             &[

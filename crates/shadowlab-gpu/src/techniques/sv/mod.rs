@@ -99,6 +99,7 @@ struct Targets {
 }
 
 pub struct ShadowVolumes {
+    pub(crate) groups: crate::binding::GroupCache,
     params: SvParams,
     uniform: wgpu::Buffer,
     list: EdgeList,
@@ -157,6 +158,7 @@ impl ShadowVolumes {
         let p = Pipelines::new(gpu, &scene.layout, depth_format, unclipped);
         let uniform = gpu.uniform("sv.params", &params);
         Ok(ShadowVolumes {
+            groups: Default::default(),
             params,
             uniform,
             list,
@@ -231,7 +233,7 @@ impl Technique for ShadowVolumes {
         rec.write_buffer(&self.draw, 0, bytemuck::cast_slice(&[0u32, 1, 0, 0]));
         rec.write_buffer(&self.stats, 0, &[0u8; 16]);
         let group = binding::group(
-            &gpu.device,
+            gpu,
             "sv.silhouettes",
             &self.p.sil_layout,
             &[
@@ -257,9 +259,8 @@ impl Technique for ShadowVolumes {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         self.targets(gpu, w, h);
         let t = self.targets.as_ref().unwrap();
-        let d = &gpu.device;
         let vol_group = binding::group(
-            d,
+            gpu,
             "sv.volumes",
             &self.p.vol_layout,
             &[
@@ -273,7 +274,7 @@ impl Technique for ShadowVolumes {
         );
         let g_depth = f.gbuffer.depth.create_view(&Default::default());
         let res_group = binding::group(
-            d,
+            gpu,
             "sv.resolve",
             &self.p.resolve_layout,
             &[wgpu::BindingResource::TextureView(&g_depth), self.uniform.as_entire_binding()],
@@ -307,7 +308,7 @@ impl Technique for ShadowVolumes {
             pass.draw(0..verts, 0..1);
         });
         self.last = Some((vol_group, f.scene.group.clone(), verts));
-        let eval_group = f.view_group(gpu, "sv.eval", &self.p.eval_layout, &[wgpu::BindingResource::TextureView(&lit)]);
+        let eval_group = f.view_group(gpu, &self.groups, "sv.eval", &self.p.eval_layout, &[wgpu::BindingResource::TextureView(&lit)]);
         rec.stage("sv.resolve", |enc| {
             {
                 let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -205,7 +205,7 @@ impl Pipelines {
         let n = scene.triangle_count as u64 * 3;
         let out = gpu.storage("sv.gather", n * 16);
         let layout = binding::layout(&gpu.device, "sv.gather", wgpu::ShaderStages::COMPUTE, &[binding::storage(false)]);
-        let group = binding::group(&gpu.device, "sv.gather", &layout, &[out.as_entire_binding()]);
+        let group = binding::group(gpu, "sv.gather", &layout, &[out.as_entire_binding()]);
         let pipe = gpu.compute_pipeline("sv.gather", &compose(GATHER_WGSL, true), "main", &[&layout, &scene.layout]);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         dispatch_1d(&mut enc, "sv.gather", &pipe, &[&group, &scene.group], n as u32);

@@ -35,7 +35,7 @@ impl ChunkBounds {
         let boxes = gpu.storage(label, count as u64 * 24);
         let cp = gpu.uniform(label, &[chunk, end, first, 0]);
         let layout = binding::layout(d, label, wgpu::ShaderStages::COMPUTE, &[binding::uniform(), binding::storage(false)]);
-        let group = binding::group(d, label, &layout, &[cp.as_entire_binding(), boxes.as_entire_binding()]);
+        let group = binding::group(gpu, label, &layout, &[cp.as_entire_binding(), boxes.as_entire_binding()]);
         let pipeline = gpu.compute_pipeline(label, &compose(BOUNDS_WGSL, true), "main", &[&layout, &scene.layout]);
         ChunkBounds { first, end, count, boxes, init, group, pipeline }
     }

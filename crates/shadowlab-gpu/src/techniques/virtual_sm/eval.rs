@@ -16,6 +16,7 @@ pub(super) fn source() -> String {
 }
 
 pub(super) struct EvalPass {
+    pub(crate) groups: crate::binding::GroupCache,
     layout: wgpu::BindGroupLayout,
     pipelines: EvalPipelines,
 }
@@ -28,7 +29,7 @@ impl EvalPass {
             &[binding::uniform(), binding::storage(true), binding::texture_depth(), binding::storage(false)],
         );
         let pipelines = EvalPipelines::new(gpu, "virtual.eval", &source(), &layout, &[]);
-        EvalPass { layout, pipelines }
+        EvalPass { groups: Default::default(), layout, pipelines }
     }
 
     /// Stage `virtual.evaluate`, or with `counting` `virtual.analysis`.
@@ -36,6 +37,7 @@ impl EvalPass {
         let atlas_view = r.atlas.create_view(&Default::default());
         let group = f.view_group(
             gpu,
+            &self.groups,
             "virtual.eval",
             &self.layout,
             &[

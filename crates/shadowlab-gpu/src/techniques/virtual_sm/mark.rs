@@ -20,6 +20,7 @@ pub(super) fn source() -> String {
 }
 
 pub(super) struct MarkPass {
+    pub(crate) groups: crate::binding::GroupCache,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
 }
@@ -28,7 +29,7 @@ impl MarkPass {
     pub fn new(gpu: &Gpu) -> MarkPass {
         let layout = view_layout(gpu, "virtual.mark", &[binding::uniform(), binding::storage(false)]);
         let pipeline = gpu.compute_pipeline("virtual.mark", &source(), "main", &[&layout]);
-        MarkPass { layout, pipeline }
+        MarkPass { groups: Default::default(), layout, pipeline }
     }
 
     /// Marks the pages of clipmap `c`, bounds the moving chunks (`dynamic`) and reads both back:
@@ -42,7 +43,8 @@ impl MarkPass {
         c: &Clipmap,
         dynamic: Option<&ChunkBounds>,
     ) -> Vec<u32> {
-        let group = f.view_group(gpu, "virtual.mark", &self.layout, &[r.uniform.as_entire_binding(), r.requests.as_entire_binding()]);
+        let group =
+            f.view_group(gpu, &self.groups, "virtual.mark", &self.layout, &[r.uniform.as_entire_binding(), r.requests.as_entire_binding()]);
         let table_bytes = c.table_len() as u64 * 4;
         rec.stage("virtual.mark", |enc| {
             enc.clear_buffer(&r.requests, 0, None);

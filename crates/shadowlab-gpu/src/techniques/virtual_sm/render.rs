@@ -41,13 +41,13 @@ impl PagePass {
         let (copy_layout, copy_pipeline) = copy_pipeline(gpu);
         let static_view = r.static_atlas.create_view(&Default::default());
         let copy_group = binding::group(
-            d,
+            gpu,
             "virtual.copy",
             &copy_layout,
             &[wgpu::BindingResource::TextureView(&static_view), r.copy_offsets.as_entire_binding()],
         );
         let page_layout = binding::layout(d, "virtual.page", wgpu::ShaderStages::VERTEX, &[binding::storage(true)]);
-        let page_group = binding::group(d, "virtual.page", &page_layout, &[r.page_mats.as_entire_binding()]);
+        let page_group = binding::group(gpu, "virtual.page", &page_layout, &[r.page_mats.as_entire_binding()]);
         let page_pipeline = raster::depth_pipeline(gpu, "virtual.page", &page_source(), &[&page_layout, &scene.layout], scene.has_cutouts);
         let clear_pipeline = clear_pipeline(gpu, &page_source(), &[&page_layout, &scene.layout]);
         PagePass { page_res, page_group, page_pipeline, clear_pipeline, copy_group, copy_pipeline }

@@ -62,6 +62,7 @@ impl Warped {
         let (xv, yv) = self.warp_views();
         let group = f.view_group(
             gpu,
+            &self.analyze_groups,
             &format!("{name}.analyze"),
             &self.analyze_layout,
             &[

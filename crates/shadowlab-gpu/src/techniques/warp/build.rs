@@ -50,6 +50,8 @@ impl Warped {
 
     fn assemble(plan: Plan, r: Resources, p: Pipelines) -> Warped {
         Warped {
+            analyze_groups: Default::default(),
+            eval_groups: Default::default(),
             variant: plan.variant,
             label: plan.name,
             res: plan.res,

@@ -98,11 +98,7 @@ impl Warped {
 
     pub(super) fn depth_group(&self, gpu: &Gpu, xv: &wgpu::TextureView, yv: &wgpu::TextureView) -> wgpu::BindGroup {
         let entries = self.depth_entries(xv, yv);
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(self.name()),
-            layout: &self.lookup_layout,
-            entries: &entries,
-        })
+        gpu.bind_group(&wgpu::BindGroupDescriptor { label: Some(self.name()), layout: &self.lookup_layout, entries: &entries })
     }
 
     /// The `shadow_map` stage: the pieces the subdivision left (drawn indirectly), or the scene.

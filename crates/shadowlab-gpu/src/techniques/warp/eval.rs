@@ -66,7 +66,7 @@ impl Warped {
             wgpu::BindingResource::Sampler(&self.sampler),
             self.counts.as_entire_binding(),
         ]);
-        let group = f.view_group(gpu, &format!("{name}.final_pass"), &self.eval_layout, &extra);
+        let group = f.view_group(gpu, &self.eval_groups, &format!("{name}.final_pass"), &self.eval_layout, &extra);
         self.eval.record(gpu, rec, &format!("{name}.final_pass"), &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
         Ok(())
     }

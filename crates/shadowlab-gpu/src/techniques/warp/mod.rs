@@ -194,6 +194,8 @@ pub struct WarpParams {
 
 /// One light's warped shadow map with its warps and scratch buffers.
 pub struct Warped {
+    pub(crate) analyze_groups: crate::binding::GroupCache,
+    pub(crate) eval_groups: crate::binding::GroupCache,
     variant: Variant,
     /// Prefix of the wgpu labels and stage names.
     label: &'static str,

@@ -66,7 +66,7 @@ impl Occluders {
         let groups = (0..=top_level(res))
             .map(|l| {
                 let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                gpu.bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("hzb"),
                     layout: &layout,
                     entries: &[

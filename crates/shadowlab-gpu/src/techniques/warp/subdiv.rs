@@ -123,7 +123,7 @@ impl Warped {
                 e.push(wgpu::BindGroupEntry { binding: 14, resource: u.as_entire_binding() });
                 let hzb = self.occluders.as_ref().map_or(&self.dv, |o| &o.hzb);
                 e.push(wgpu::BindGroupEntry { binding: 15, resource: hzb.as_entire_binding() });
-                gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &e })
+                gpu.bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &e })
             })
             .collect()
     }
