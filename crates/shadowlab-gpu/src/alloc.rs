@@ -1,7 +1,9 @@
 //! Every buffer shadowlab makes goes through [`Gpu::buffer`] (or the helpers built on it:
-//! `storage`, `uniform`, `buffer_init`), which counts it: the per-frame hygiene test records
-//! each technique's frames and asserts that a frame after the first creates no buffer
-//! (`tests/hygiene.rs`), and a source check keeps `create_buffer` calls out of every other file.
+//! `storage`, `uniform`, `buffer_init`) and every bind group through [`Gpu::bind_group`] (or
+//! `binding::group`), which count them: the per-frame hygiene test records each technique's
+//! frames and asserts that a frame after the first creates no buffer (and, for the techniques
+//! it lists, no bind group; `tests/hygiene.rs`), and a source check keeps `create_buffer` calls
+//! out of every other file.
 //!
 //! What a frame needs afresh each time comes from two pools instead of new buffers:
 //! - uploads ([`Gpu::upload`]): mapped `COPY_SRC` buffers that
@@ -11,8 +13,9 @@
 //!   returned once read.
 //!
 //! Both hand out buffers by power-of-two size class (at least 256 bytes) and keep at most
-//! [`POOL_CAP`] idle buffers and [`POOL_BYTES`] idle bytes each (a report's readback of a large
-//! map is dropped after use, not kept).
+//! [`POOL_CAP`] idle buffers and [`POOL_BYTES`] idle bytes each. A buffer larger than
+//! [`POOL_BYTES`] (a report's readback of a large map) is made at its own size and dropped
+//! after use.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -35,8 +38,12 @@ pub struct Alloc {
     reads: Mutex<Vec<wgpu::Buffer>>,
 }
 
-/// The pools' size class of `size` bytes.
+/// The pools' size class of `size` bytes; above [`POOL_BYTES`] (never kept) the size itself,
+/// in whole words, rather than up to twice it.
 fn class(size: u64) -> u64 {
+    if size > POOL_BYTES {
+        return size.div_ceil(4) * 4;
+    }
     size.max(256).next_power_of_two()
 }
 
@@ -132,5 +139,8 @@ mod tests {
         assert_eq!(super::class(256), 256);
         assert_eq!(super::class(257), 512);
         assert_eq!(super::class(5000), 8192);
+        // too large to keep: its own size, not the next power of two
+        let big = super::POOL_BYTES + 6;
+        assert_eq!(super::class(big), big + 2);
     }
 }

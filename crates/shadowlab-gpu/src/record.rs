@@ -176,7 +176,8 @@ impl<'a> Recorder<'a> {
     }
 
     /// Writes `data` into `buf` at `offset`, ordered with the recorded passes (a copy from a
-    /// staging buffer; `queue.write_buffer` would land before the whole frame).
+    /// pooled upload buffer, `Gpu::upload`; `queue.write_buffer` would land before the whole
+    /// frame).
     pub fn write_buffer(&mut self, buf: &wgpu::Buffer, offset: u64, data: &[u8]) {
         if data.is_empty() {
             return;
@@ -185,9 +186,10 @@ impl<'a> Recorder<'a> {
         let staging = self.gpu.upload(size);
         {
             let mut view = staging.slice(..size).get_mapped_range_mut().expect("an upload buffer is mapped until its copy is recorded");
-            let mut padded = data.to_vec();
-            padded.resize(size as usize, 0);
-            view.copy_from_slice(&padded);
+            view.slice(..data.len()).copy_from_slice(data);
+            if size as usize > data.len() {
+                view.slice(data.len()..).copy_from_slice(&[0; 4][..size as usize - data.len()]);
+            }
         }
         staging.unmap();
         self.enc.copy_buffer_to_buffer(&staging, 0, buf, offset, size);

@@ -2,8 +2,9 @@
 //! suggestion). The light-space x/y bounds of every evaluated sample come from `sdsm`'s bounds
 //! reduction (`csm/sdsm_bounds.wgsl`, ordered-uint atomics: deterministic) run with one cascade
 //! in iasm's light basis; one GPU thread (fit.wgsl) turns them into the square by the rule of
-//! `shadowlab_core::techniques::iasm::fit::fit_square` (the CPU half, which the tests hold it to) and writes it into the frame's
-//! `IasmParams` for the importance analysis, and into the statistics' tail
+//! `shadowlab_core::techniques::iasm::fit::fit_square` (the CPU half, which the tests hold it
+//! to) and writes it into the frame's `IasmParams` for the importance analysis, and into the
+//! statistics' tail
 //! ([`FIT_WORDS`] after `STATS_WORDS`). The square comes back with the statistics, in the one
 //! readback of the frame (`iasm.readback`), as the thesis has it. With `delayed` the fit is
 //! recorded after the shadows for the next frame and read with the statistics without a stall.

@@ -12,7 +12,8 @@
 //! CPU logic (placement, ranking, layout, indices, culling) is in `shadowlab_core::techniques::iasm`.
 //! Stage names (timing keys): `iasm.fit` (fit=view: the samples' bounds and the square, on the
 //! GPU), `iasm.importance` (analysis pass), `iasm.readback` (waiting for and mapping the 16
-//! tiles' stats and the fitted square: the sync cost, one a frame), `iasm.shadows.clear`, `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
+//! tiles' stats and the fitted square: the sync cost, one a frame), `iasm.shadows.clear`,
+//! `iasm.shadows.tNN` (tile NN), `iasm.evaluate`.
 //!
 //! Files: `params.rs` the parameter table; `uniforms.rs` the structs shared with WGSL;
 //! construction in stages, `setup.rs` (the settings read and checked, the chunks' boxes) then
