@@ -78,14 +78,15 @@ fn bound(r: &wgpu::BindingResource) -> Option<Bound> {
 
 /// A bind group kept while its layout and resources stay the same objects, so that a pass
 /// whose inputs do not change makes no bind group after its first frame (tests/hygiene.rs).
-/// One per call site; a change of any resource (another view, a resized target) makes the
-/// group again. Resources held here live as long as the cache (its pass) or until replaced.
+/// One per call site (an array of them where a site binds several sets in turn); a change of
+/// any resource (another view, a resized target) makes the group again. Resources held here
+/// live as long as the cache (its pass) or until replaced.
 #[derive(Default)]
-pub struct GroupCache(std::sync::Mutex<Option<(wgpu::BindGroupLayout, Vec<Bound>, wgpu::BindGroup)>>);
+pub struct GroupCache(std::sync::Mutex<Option<(wgpu::BindGroupLayout, Vec<(u32, Bound)>, wgpu::BindGroup)>>);
 
 impl GroupCache {
-    /// The group of `resources` over `layout`: the kept one when they are the same, else a new one
-    /// ([`group`]), kept.
+    /// The group of `resources` at bindings 0, 1, ... over `layout`: the kept one when they are
+    /// the same, else a new one ([`group`]), kept.
     pub fn get(
         &self,
         gpu: &crate::Gpu,
@@ -93,14 +94,27 @@ impl GroupCache {
         layout: &wgpu::BindGroupLayout,
         resources: &[wgpu::BindingResource],
     ) -> wgpu::BindGroup {
-        let key: Option<Vec<Bound>> = resources.iter().map(bound).collect();
+        let entries: Vec<_> =
+            resources.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() }).collect();
+        self.entries(gpu, label, layout, &entries)
+    }
+
+    /// [`GroupCache::get`] with explicit binding numbers.
+    pub fn entries(
+        &self,
+        gpu: &crate::Gpu,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        entries: &[wgpu::BindGroupEntry],
+    ) -> wgpu::BindGroup {
+        let key: Option<Vec<(u32, Bound)>> = entries.iter().map(|e| bound(&e.resource).map(|b| (e.binding, b))).collect();
         let mut slot = self.0.lock().unwrap();
         if let (Some(k), Some((l, kept, g))) = (&key, slot.as_ref()) {
             if l == layout && k == kept {
                 return g.clone();
             }
         }
-        let g = group(gpu, label, layout, resources);
+        let g = gpu.bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries });
         *slot = key.map(|k| (layout.clone(), k, g.clone()));
         g
     }

@@ -22,7 +22,7 @@ fn reduction_gives_the_exact_min_and_max_view_depth() {
     let v = lab.view(&scene.camera, &scene.camera, &scene.lights[0], 203, 131).unwrap();
     let r = MinMax::new(&gpu, "test.reduce", 3);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    r.record(&gpu, &mut enc, "test.reduce", &v.gbuffer.position, &v.gbuffer.mask);
+    r.record(&gpu, &mut enc, "test.reduce", v.gbuffer.position_input(), &v.gbuffer.mask);
     gpu.queue.submit([enc.finish()]);
     let (lo, hi) = r.read(&gpu).expect("evaluated pixels exist");
     let depths = v.position.iter().zip(&v.mask).filter(|(_, m)| **m != 0).map(|(p, _)| p[3]);
@@ -31,7 +31,7 @@ fn reduction_gives_the_exact_min_and_max_view_depth() {
     // no evaluated pixel: no result
     let empty = gpu.storage("empty mask", v.mask.len() as u64 * 4);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    r.record(&gpu, &mut enc, "test.reduce", &v.gbuffer.position, &empty);
+    r.record(&gpu, &mut enc, "test.reduce", v.gbuffer.position_input(), &empty);
     gpu.queue.submit([enc.finish()]);
     assert_eq!(r.read(&gpu), None);
 }

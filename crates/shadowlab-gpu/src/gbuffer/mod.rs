@@ -35,6 +35,9 @@ pub struct GBuffer {
     pub mask: wgpu::Buffer,
     pub position_view: wgpu::TextureView,
     pub normal_view: wgpu::TextureView,
+    pub albedo_view: wgpu::TextureView,
+    pub motion_view: wgpu::TextureView,
+    pub depth_view: wgpu::TextureView,
 }
 
 impl GBuffer {
@@ -42,6 +45,9 @@ impl GBuffer {
         let c = wgpu::TextureUsages::COPY_SRC;
         let position = raster::render_target(gpu, "gbuffer.position", w, h, POSITION_FORMAT, c);
         let normal = raster::render_target(gpu, "gbuffer.normal", w, h, NORMAL_FORMAT, c);
+        let depth = raster::render_target(gpu, "gbuffer.depth", w, h, raster::DEPTH_FORMAT, wgpu::TextureUsages::empty());
+        let albedo = raster::render_target(gpu, "gbuffer.albedo", w, h, ALBEDO_FORMAT, c);
+        let motion = raster::render_target(gpu, "gbuffer.motion", w, h, MOTION_FORMAT, c);
         GBuffer {
             width: w,
             height: h,
@@ -49,14 +55,21 @@ impl GBuffer {
             normal_view: normal.create_view(&Default::default()),
             position,
             normal,
-            albedo: raster::render_target(gpu, "gbuffer.albedo", w, h, ALBEDO_FORMAT, c),
-            motion: raster::render_target(gpu, "gbuffer.motion", w, h, MOTION_FORMAT, c),
-            depth: raster::render_target(gpu, "gbuffer.depth", w, h, raster::DEPTH_FORMAT, wgpu::TextureUsages::empty()),
+            albedo_view: albedo.create_view(&Default::default()),
+            motion_view: motion.create_view(&Default::default()),
+            albedo,
+            motion,
+            depth_view: depth.create_view(&Default::default()),
+            depth,
             mask: gpu.storage("gbuffer.mask", (w * h * 4) as u64),
         }
     }
     pub fn pixels(&self) -> usize {
         (self.width * self.height) as usize
+    }
+    /// The position target's view with its size (what a reduction over the samples reads).
+    pub fn position_input(&self) -> (&wgpu::TextureView, u32, u32) {
+        (&self.position_view, self.width, self.height)
     }
 }
 
@@ -64,6 +77,7 @@ impl GBuffer {
 pub struct GBufferPass {
     raster: wgpu::RenderPipeline,
     frame_layout: wgpu::BindGroupLayout,
+    groups: binding::GroupCache,
     mask: MaskPass,
 }
 
@@ -71,6 +85,7 @@ pub struct GBufferPass {
 pub struct MaskPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    groups: binding::GroupCache,
 }
 
 impl MaskPass {
@@ -82,22 +97,20 @@ impl MaskPass {
             &[binding::uniform(), binding::uniform(), binding::texture_float(), binding::texture_float(), binding::storage(false)],
         );
         let pipeline = gpu.compute_pipeline("mask", &compose(MASK_WGSL, false), "main", &[&layout]);
-        MaskPass { pipeline, layout }
+        MaskPass { pipeline, layout, groups: Default::default() }
     }
 
     /// Writes `g.mask` for one light (stage `mask`).
     pub fn record(&self, gpu: &Gpu, rec: &mut Recorder, frame: &wgpu::Buffer, light: &wgpu::Buffer, g: &GBuffer) {
-        let pv = g.position.create_view(&Default::default());
-        let nv = g.normal.create_view(&Default::default());
-        let group = binding::group(
+        let group = self.groups.get(
             gpu,
             "mask",
             &self.layout,
             &[
                 frame.as_entire_binding(),
                 light.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&pv),
-                wgpu::BindingResource::TextureView(&nv),
+                wgpu::BindingResource::TextureView(&g.position_view),
+                wgpu::BindingResource::TextureView(&g.normal_view),
                 g.mask.as_entire_binding(),
             ],
         );
@@ -122,18 +135,15 @@ impl GBufferPass {
             &targets,
             &[("DISCARDS", discards)],
         );
-        GBufferPass { raster, frame_layout, mask: MaskPass::new(gpu) }
+        GBufferPass { raster, frame_layout, groups: Default::default(), mask: MaskPass::new(gpu) }
     }
 
     /// Rasterises the scene into `g` (stage `gbuffer`).
     pub fn render(&self, gpu: &Gpu, rec: &mut Recorder, scene: &GpuScene, frame: &wgpu::Buffer, g: &GBuffer) {
-        let group = binding::group(gpu, "gbuffer.frame", &self.frame_layout, &[frame.as_entire_binding()]);
-        let views: Vec<wgpu::TextureView> =
-            [&g.position, &g.normal, &g.albedo, &g.motion].iter().map(|t| t.create_view(&Default::default())).collect();
-        let depth = g.depth.create_view(&Default::default());
+        let group = self.groups.get(gpu, "gbuffer.frame", &self.frame_layout, &[frame.as_entire_binding()]);
         rec.stage("gbuffer", |enc| {
-            let colors: Vec<&wgpu::TextureView> = views.iter().collect();
-            let mut pass = raster::begin_pass(enc, "gbuffer", &colors, &depth);
+            let colors = [&g.position_view, &g.normal_view, &g.albedo_view, &g.motion_view];
+            let mut pass = raster::begin_pass(enc, "gbuffer", &colors, &g.depth_view);
             pass.set_pipeline(&self.raster);
             pass.set_bind_group(0, &group, &[]);
             pass.set_bind_group(1, &scene.group, &[]);

@@ -6,6 +6,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::shaders::compose;
 use crate::{binding, Gpu};
+use std::sync::Arc;
 
 const SCAN_WGSL: &str = include_str!("scan.wgsl");
 
@@ -43,9 +44,9 @@ impl ScanParams {
 pub struct PrefixSum {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
-    /// One uniform per `ScanParams` seen: a map's scans repeat every frame (no buffer per
-    /// frame, tests/hygiene.rs).
-    uniforms: std::sync::Mutex<std::collections::HashMap<[u32; 8], wgpu::Buffer>>,
+    /// One uniform and bind group per `ScanParams` seen: a map's scans repeat every frame (no
+    /// buffer or bind group per frame, tests/hygiene.rs).
+    uniforms: std::sync::Mutex<std::collections::HashMap<[u32; 8], (wgpu::Buffer, Arc<binding::GroupCache>)>>,
 }
 
 impl PrefixSum {
@@ -63,11 +64,11 @@ impl PrefixSum {
     /// Records the scan of `p` from `input` (u32 words) into `output` (f32); they must be
     /// different buffers.
     pub fn encode(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, input: &wgpu::Buffer, output: &wgpu::Buffer, p: ScanParams) {
-        let uniform = {
+        let (uniform, groups) = {
             let mut made = self.uniforms.lock().unwrap();
-            made.entry(bytemuck::cast(p)).or_insert_with(|| gpu.uniform("prefix_sum.params", &p)).clone()
+            made.entry(bytemuck::cast(p)).or_insert_with(|| (gpu.uniform("prefix_sum.params", &p), Default::default())).clone()
         };
-        let group = binding::group(
+        let group = groups.get(
             gpu,
             "prefix_sum",
             &self.layout,

@@ -33,6 +33,7 @@ pub struct MinMax {
     params: wgpu::Buffer,
     /// Two u32 words: the complement of the min's order key, the max's order key.
     pub result: wgpu::Buffer,
+    groups: binding::GroupCache,
 }
 
 impl MinMax {
@@ -46,25 +47,32 @@ impl MinMax {
         let pipeline = gpu.compute_pipeline(label, &format!("{ORDER_KEY_WGSL}{REDUCE_WGSL}"), "main", &[&layout]);
         let params = gpu.uniform(label, &ReduceParams { channel: channel.min(3), _pad: [0; 3] });
         let result = gpu.storage(label, 8);
-        MinMax { pipeline, layout, params, result }
+        MinMax { pipeline, layout, params, result, groups: Default::default() }
     }
 
-    /// Records the reduction of `src` (a `w x h` texture) under `mask` (one u32 per pixel).
-    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str, src: &wgpu::Texture, mask: &wgpu::Buffer) {
-        let view = src.create_view(&Default::default());
-        let group = binding::group(
+    /// Records the reduction of `view` (of a `w x h` texture) under `mask` (one u32 per pixel);
+    /// the bind group is kept while the view and mask stay.
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        label: &str,
+        (view, w, h): (&wgpu::TextureView, u32, u32),
+        mask: &wgpu::Buffer,
+    ) {
+        let group = self.groups.get(
             gpu,
             label,
             &self.layout,
             &[
                 self.params.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::TextureView(view),
                 mask.as_entire_binding(),
                 self.result.as_entire_binding(),
             ],
         );
         enc.clear_buffer(&self.result, 0, None);
-        gpu.dispatch_2d(enc, label, &self.pipeline, &[&group], src.width().div_ceil(PER_THREAD), src.height().div_ceil(PER_THREAD));
+        gpu.dispatch_2d(enc, label, &self.pipeline, &[&group], w.div_ceil(PER_THREAD), h.div_ceil(PER_THREAD));
     }
 
     /// Reads the result back (blocking: a device sync).

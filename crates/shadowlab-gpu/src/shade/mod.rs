@@ -16,6 +16,8 @@ pub fn shaders() -> Vec<(&'static str, String)> {
 pub struct ShadePass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    /// The last group, kept while the view's buffers stay.
+    groups: binding::GroupCache,
 }
 
 impl ShadePass {
@@ -28,7 +30,7 @@ impl ShadePass {
             &[uniform(), uniform(), texture_float(), texture_float(), texture_float(), storage(true), storage(true), storage(false)],
         );
         let pipeline = gpu.compute_pipeline("shade", &compose(SHADE_WGSL, false), "main", &[&layout]);
-        ShadePass { pipeline, layout }
+        ShadePass { pipeline, layout, groups: Default::default() }
     }
 
     /// A colour buffer (one packed RGBA8 word per pixel) for views of `g`'s size.
@@ -39,17 +41,16 @@ impl ShadePass {
     /// Records the shading of `f.visibility` into `out` (see [`ShadePass::output`]; stage `shade`).
     pub fn record(&self, gpu: &Gpu, rec: &mut Recorder, f: &FrameInputs, out: &wgpu::Buffer) {
         let g = f.gbuffer;
-        let views: Vec<_> = [&g.position, &g.normal, &g.albedo].iter().map(|t| t.create_view(&Default::default())).collect();
-        let group = binding::group(
+        let group = self.groups.get(
             gpu,
             "shade",
             &self.layout,
             &[
                 f.frame.as_entire_binding(),
                 f.light_buf.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&views[0]),
-                wgpu::BindingResource::TextureView(&views[1]),
-                wgpu::BindingResource::TextureView(&views[2]),
+                wgpu::BindingResource::TextureView(&g.position_view),
+                wgpu::BindingResource::TextureView(&g.normal_view),
+                wgpu::BindingResource::TextureView(&g.albedo_view),
                 g.mask.as_entire_binding(),
                 f.visibility.as_entire_binding(),
                 out.as_entire_binding(),

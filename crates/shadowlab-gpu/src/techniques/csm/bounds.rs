@@ -58,6 +58,7 @@ pub(crate) fn decode_bounds(w: &[u32], c: usize) -> Option<SampleBounds> {
 pub(crate) struct BoundsReduce {
     pub pipeline: wgpu::ComputePipeline,
     pub layout: wgpu::BindGroupLayout,
+    groups: binding::GroupCache,
 }
 
 impl BoundsReduce {
@@ -69,7 +70,7 @@ impl BoundsReduce {
             &[binding::uniform(), binding::texture_float(), binding::storage(true), binding::storage(true), binding::storage(false)],
         );
         let pipeline = gpu.compute_pipeline(label, &source(), "main", &[&layout]);
-        BoundsReduce { pipeline, layout }
+        BoundsReduce { pipeline, layout, groups: Default::default() }
     }
 
     /// Clears `out` (OUT_BYTES) and reduces the evaluated samples of `f` into it with the
@@ -84,14 +85,13 @@ impl BoundsReduce {
         depth_mm: &wgpu::Buffer,
         out: &wgpu::Buffer,
     ) {
-        let view = f.gbuffer.position.create_view(&Default::default());
-        let group = binding::group(
+        let group = self.groups.get(
             gpu,
             label,
             &self.layout,
             &[
                 uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::TextureView(&f.gbuffer.position_view),
                 f.gbuffer.mask.as_entire_binding(),
                 depth_mm.as_entire_binding(),
                 out.as_entire_binding(),

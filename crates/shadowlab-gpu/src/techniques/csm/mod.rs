@@ -109,6 +109,9 @@ pub struct Cascaded {
     boxes: Vec<CascadeBox>,
     depth_range: Option<(f32, f32)>,
     maps: wgpu::Texture,
+    /// Views of `maps`, made once: the array (evaluation), each layer (its depth pass).
+    maps_view: wgpu::TextureView,
+    layer_views: Vec<wgpu::TextureView>,
     counts: wgpu::Buffer,
     /// Per pixel cascade tags of the last evaluation, with its size.
     chosen: Option<(wgpu::Buffer, u32, u32)>,
@@ -207,6 +210,9 @@ impl Cascaded {
             params,
             boxes: Vec::new(),
             depth_range: None,
+            maps_view: maps
+                .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() }),
+            layer_views: (0..count as u32).map(|c| layer_view(&maps, c)).collect(),
             maps,
             counts,
             chosen: None,
@@ -278,15 +284,16 @@ impl Cascaded {
         self.upload(rec, used, splits);
         self.boxes = slices;
     }
+}
 
-    fn layer_view(&self, layer: u32) -> wgpu::TextureView {
-        self.maps.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2),
-            base_array_layer: layer,
-            array_layer_count: Some(1),
-            ..Default::default()
-        })
-    }
+/// A view of one layer of `maps` (a cascade's depth target).
+fn layer_view(maps: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
+    maps.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
 }
 
 impl Technique for Cascaded {
@@ -297,11 +304,11 @@ impl Technique for Cascaded {
             // the previous frame's range (None on the first frame: the whole frustum), then this
             // frame's reduction for the next one
             self.depth_range = d.take::<u32>(gpu, 2).and_then(|w| decode([w[0], w[1]]));
-            rec.stage("csm.analyze", |enc| self.reduce.record(gpu, enc, "csm.reduce", &f.gbuffer.position, &f.gbuffer.mask));
+            rec.stage("csm.analyze", |enc| self.reduce.record(gpu, enc, "csm.reduce", f.gbuffer.position_input(), &f.gbuffer.mask));
             d.record(rec, &self.reduce.result);
         } else if self.tighten {
             rec.stage("csm.analyze", |enc| {
-                self.reduce.record(gpu, enc, "csm.reduce", &f.gbuffer.position, &f.gbuffer.mask);
+                self.reduce.record(gpu, enc, "csm.reduce", f.gbuffer.position_input(), &f.gbuffer.mask);
                 enc.copy_buffer_to_buffer(&self.reduce.result, 0, &self.probe, 0, PROBE_BYTES);
             });
             let t0 = std::time::Instant::now();
@@ -328,10 +335,9 @@ impl Technique for Cascaded {
     }
 
     fn render(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let views: Vec<_> = (0..self.count as u32).map(|c| self.layer_view(c)).collect();
         let stage = format!("{}.render", self.name);
         rec.stage(&stage, |enc| {
-            for (c, view) in views.iter().enumerate() {
+            for (c, view) in self.layer_views.iter().enumerate() {
                 let mut pass = raster::begin_pass(enc, &stage, &[], view);
                 pass.set_pipeline(&self.depth_pipeline);
                 pass.set_bind_group(0, &self.depth_groups[c], &[]);
@@ -367,9 +373,6 @@ impl Cascaded {
             self.chosen = Some((gpu.storage("csm.chosen", w as u64 * h as u64 * 4), w, h));
         }
         let chosen = &self.chosen.as_ref().expect("allocated above").0;
-        let maps_view = self
-            .maps
-            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
         let group = f.view_group(
             gpu,
             &self.groups,
@@ -377,7 +380,7 @@ impl Cascaded {
             &self.eval_layout,
             &[
                 self.uniform.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&maps_view),
+                wgpu::BindingResource::TextureView(&self.maps_view),
                 wgpu::BindingResource::Sampler(&self.sampler),
                 self.counts.as_entire_binding(),
                 chosen.as_entire_binding(),

@@ -18,7 +18,8 @@ pub(super) fn source() -> String {
 }
 
 pub(super) struct ClassifyPass {
-    pub(crate) groups: crate::binding::GroupCache,
+    /// One kept group per frame parity (the masks swap roles each frame).
+    pub(crate) groups: [crate::binding::GroupCache; 2],
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
 }
@@ -47,25 +48,27 @@ impl ClassifyPass {
 
     /// The bind group of the frame `s` is at: both maps (the static one again without a dynamic
     /// map), the motion vectors, last frame's mask and history (read), this frame's (written)
-    /// and the ray list.
+    /// and the ray list. Both parities' groups are made on the first frame.
     pub fn group(&self, gpu: &Gpu, f: &FrameInputs, name: &str, r: &Resources, s: &Screen) -> wgpu::BindGroup {
-        let (cur, prev) = ((s.frames % 2) as usize, ((s.frames + 1) % 2) as usize);
-        let array = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
-        let static_view = r.static_map.create_view(&array);
-        let dynamic_view = r.dynamic_map.as_ref().unwrap_or(&r.static_map).create_view(&array);
-        let motion_view = f.gbuffer.motion.create_view(&Default::default());
+        let cur = (s.frames % 2) as usize;
+        let [now, _next] = [cur, 1 - cur].map(|p| self.parity_group(gpu, f, name, r, s, p));
+        now
+    }
+
+    fn parity_group(&self, gpu: &Gpu, f: &FrameInputs, name: &str, r: &Resources, s: &Screen, cur: usize) -> wgpu::BindGroup {
+        let prev = 1 - cur;
         use wgpu::BindingResource as R;
         f.view_group(
             gpu,
-            &self.groups,
+            &self.groups[cur],
             &format!("{name}.classify"),
             &self.layout,
             &[
                 r.uniform.as_entire_binding(),
-                R::TextureView(&static_view),
-                R::TextureView(&dynamic_view),
+                R::TextureView(&r.map_views[0]),
+                R::TextureView(&r.map_views[1]),
                 R::Sampler(&r.sampler),
-                R::TextureView(&motion_view),
+                R::TextureView(&f.gbuffer.motion_view),
                 s.masks[prev].as_entire_binding(),
                 s.masks[cur].as_entire_binding(),
                 s.history[prev].as_entire_binding(),

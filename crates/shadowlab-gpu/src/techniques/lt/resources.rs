@@ -9,6 +9,9 @@ pub(super) struct Resources {
     /// One layer per hybrid level.
     pub static_map: wgpu::Texture,
     pub dynamic_map: Option<wgpu::Texture>,
+    /// Array views of the static and the dynamic map (the static one again without a dynamic
+    /// map), made once.
+    pub map_views: [wgpu::TextureView; 2],
     /// The raster's depth target, shared by every layer's draw.
     pub depth: wgpu::Texture,
     /// Per level: the raster's `FilteredParams`.
@@ -52,6 +55,8 @@ impl Resources {
             ..Default::default()
         });
         let uniform = gpu.uniform(&format!("{name}.params"), &s.params);
-        Resources { static_map, dynamic_map, depth, map_uniforms, uniform, sampler }
+        let array = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
+        let map_views = [static_map.create_view(&array), dynamic_map.as_ref().unwrap_or(&static_map).create_view(&array)];
+        Resources { static_map, dynamic_map, map_views, depth, map_uniforms, uniform, sampler }
     }
 }

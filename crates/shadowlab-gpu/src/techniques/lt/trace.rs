@@ -48,16 +48,19 @@ impl TracePass {
         gpu.uniform(&format!("{name}.trace_params"), &TraceParams { cfg: [mask_bits, pixels, 0, 0] })
     }
 
-    /// The groups of the frame `s` is at, over its `uniform`.
+    /// The groups of the frame `s` is at, over its `uniform` (both parities' made on the first
+    /// frame).
     pub fn groups(&self, gpu: &Gpu, f: &FrameInputs, name: &str, uniform: &wgpu::Buffer, s: &Screen) -> TraceGroups {
         let cur = (s.frames % 2) as usize;
-        let trace = f.view_group(
-            gpu,
-            &self.groups[cur],
-            &format!("{name}.trace"),
-            &self.trace_layout,
-            &[uniform.as_entire_binding(), s.list.as_entire_binding(), s.masks[cur].as_entire_binding()],
-        );
+        let [trace, _next] = [cur, 1 - cur].map(|p| {
+            f.view_group(
+                gpu,
+                &self.groups[p],
+                &format!("{name}.trace"),
+                &self.trace_layout,
+                &[uniform.as_entire_binding(), s.list.as_entire_binding(), s.masks[p].as_entire_binding()],
+            )
+        });
         let args = self.args_groups.get(
             gpu,
             &format!("{name}.args"),

@@ -115,7 +115,7 @@ impl SampleFit {
 
     /// Records the bounds reduction (after `depth`'s min/max reduction of the same frame).
     fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, f: &FrameInputs, depth: &MinMax) {
-        depth.record(gpu, enc, "sdsm.reduce", &f.gbuffer.position, &f.gbuffer.mask);
+        depth.record(gpu, enc, "sdsm.reduce", f.gbuffer.position_input(), &f.gbuffer.mask);
         self.reduce.record(gpu, enc, "sdsm.bounds", f, &self.uniform, &depth.result, &self.out);
     }
 

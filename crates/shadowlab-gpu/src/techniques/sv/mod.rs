@@ -23,7 +23,7 @@ use shadowlab_core::techniques::sv::EdgeList;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::{binding, raster, Gpu, GpuError};
+use crate::{raster, Gpu, GpuError};
 use pipelines::{dispatch_1d, Pipelines, LIT_FORMAT};
 
 pub use pipelines::shaders;
@@ -94,12 +94,15 @@ pub struct SvParams {
 struct Targets {
     width: u32,
     height: u32,
-    depth: wgpu::Texture,
-    lit: wgpu::Texture,
+    /// The depth-stencil and lit targets' views.
+    depth: wgpu::TextureView,
+    lit: wgpu::TextureView,
 }
 
 pub struct ShadowVolumes {
+    /// The evaluation's, the silhouette pass's, the volumes' and the resolve's bind groups, kept.
     pub(crate) groups: crate::binding::GroupCache,
+    kept: [crate::binding::GroupCache; 3],
     params: SvParams,
     uniform: wgpu::Buffer,
     list: EdgeList,
@@ -158,6 +161,7 @@ impl ShadowVolumes {
         let p = Pipelines::new(gpu, &scene.layout, depth_format, unclipped);
         let uniform = gpu.uniform("sv.params", &params);
         Ok(ShadowVolumes {
+            kept: Default::default(),
             groups: Default::default(),
             params,
             uniform,
@@ -180,6 +184,7 @@ impl ShadowVolumes {
         if self.targets.as_ref().is_none_or(|t| (t.width, t.height) != (w, h)) {
             let depth = raster::render_target(gpu, "sv.depth_stencil", w, h, self.depth_format, wgpu::TextureUsages::empty());
             let lit = raster::render_target(gpu, "sv.lit", w, h, LIT_FORMAT, wgpu::TextureUsages::empty());
+            let (depth, lit) = (depth.create_view(&Default::default()), lit.create_view(&Default::default()));
             self.targets = Some(Targets { width: w, height: h, depth, lit });
         }
         self.targets.as_ref().unwrap()
@@ -200,13 +205,13 @@ impl ShadowVolumes {
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let ds = t.depth.create_view(&Default::default());
+        let ds = &t.depth;
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("sv.fill"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: &ds, depth_ops: None, stencil_ops: None }),
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: ds, depth_ops: None, stencil_ops: None }),
                 timestamp_writes: None,
                 occlusion_query_set: Some(&set),
                 multiview_mask: None,
@@ -232,7 +237,7 @@ impl Technique for ShadowVolumes {
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         rec.write_buffer(&self.draw, 0, bytemuck::cast_slice(&[0u32, 1, 0, 0]));
         rec.write_buffer(&self.stats, 0, &[0u8; 16]);
-        let group = binding::group(
+        let group = self.kept[0].get(
             gpu,
             "sv.silhouettes",
             &self.p.sil_layout,
@@ -259,7 +264,7 @@ impl Technique for ShadowVolumes {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         self.targets(gpu, w, h);
         let t = self.targets.as_ref().unwrap();
-        let vol_group = binding::group(
+        let vol_group = self.kept[1].get(
             gpu,
             "sv.volumes",
             &self.p.vol_layout,
@@ -272,22 +277,20 @@ impl Technique for ShadowVolumes {
                 self.sides.as_entire_binding(),
             ],
         );
-        let g_depth = f.gbuffer.depth.create_view(&Default::default());
-        let res_group = binding::group(
+        let res_group = self.kept[2].get(
             gpu,
             "sv.resolve",
             &self.p.resolve_layout,
-            &[wgpu::BindingResource::TextureView(&g_depth), self.uniform.as_entire_binding()],
+            &[wgpu::BindingResource::TextureView(&f.gbuffer.depth_view), self.uniform.as_entire_binding()],
         );
-        let ds = t.depth.create_view(&Default::default());
-        let lit = t.lit.create_view(&Default::default());
+        let (ds, lit) = (&t.depth, &t.lit);
         let verts = f.scene.triangle_count * 3;
         rec.stage("sv.stencil", |enc| {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("sv.stencil"),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &ds,
+                    view: ds,
                     depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
                     stencil_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0), store: wgpu::StoreOp::Store }),
                 }),
@@ -308,22 +311,18 @@ impl Technique for ShadowVolumes {
             pass.draw(0..verts, 0..1);
         });
         self.last = Some((vol_group, f.scene.group.clone(), verts));
-        let eval_group = f.view_group(gpu, &self.groups, "sv.eval", &self.p.eval_layout, &[wgpu::BindingResource::TextureView(&lit)]);
+        let eval_group = f.view_group(gpu, &self.groups, "sv.eval", &self.p.eval_layout, &[wgpu::BindingResource::TextureView(lit)]);
         rec.stage("sv.resolve", |enc| {
             {
                 let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("sv.lit"),
                     color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &lit,
+                        view: lit,
                         depth_slice: None,
                         resolve_target: None,
                         ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
                     })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &ds,
-                        depth_ops: None,
-                        stencil_ops: None,
-                    }),
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: ds, depth_ops: None, stencil_ops: None }),
                     timestamp_writes: None,
                     occlusion_query_set: None,
                     multiview_mask: None,

@@ -34,7 +34,6 @@ impl EvalPass {
 
     /// Stage `virtual.evaluate`, or with `counting` `virtual.analysis`.
     pub fn record(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, r: &Resources, counting: bool) {
-        let atlas_view = r.atlas.create_view(&Default::default());
         let group = f.view_group(
             gpu,
             &self.groups,
@@ -43,7 +42,7 @@ impl EvalPass {
             &[
                 r.uniform.as_entire_binding(),
                 r.page_table.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&atlas_view),
+                wgpu::BindingResource::TextureView(&r.atlas_view),
                 r.counts.as_entire_binding(),
             ],
         );

@@ -10,6 +10,8 @@ use crate::{raster, Gpu};
 pub(super) struct Resources {
     /// The physical pool: `cols x rows` page slots.
     pub atlas: wgpu::Texture,
+    /// `atlas`'s view, made once.
+    pub atlas_view: wgpu::TextureView,
     /// The static copies of pages under moving geometry (at least one slot, unused without).
     pub static_atlas: wgpu::Texture,
     /// Per rendered page: its static slot's origin minus its atlas slot's origin (texels).
@@ -40,6 +42,7 @@ impl Resources {
         );
         let slots = (p.cols * p.rows) as u64;
         Resources {
+            atlas_view: atlas.create_view(&Default::default()),
             atlas,
             static_atlas,
             copy_offsets: gpu.storage("virtual.copy_offsets", slots * 16),

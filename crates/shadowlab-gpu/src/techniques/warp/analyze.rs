@@ -59,10 +59,9 @@ impl Warped {
     pub(super) fn fit_warps(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let name = self.name();
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
-        let (xv, yv) = self.warp_views();
         let group = f.view_group(
             gpu,
-            &self.analyze_groups,
+            &self.groups.analyze,
             &format!("{name}.analyze"),
             &self.analyze_layout,
             &[
@@ -70,8 +69,8 @@ impl Warped {
                 self.dv.as_entire_binding(),
                 self.work.as_entire_binding(),
                 self.fwork.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&xv),
-                wgpu::BindingResource::TextureView(&yv),
+                wgpu::BindingResource::TextureView(&self.views[0]),
+                wgpu::BindingResource::TextureView(&self.views[1]),
                 // the occluder pyramid (`edge_importance`), or a stand-in never read
                 self.occluders.as_ref().map_or(&self.counts, |o| &o.hzb).as_entire_binding(),
             ],
@@ -86,7 +85,7 @@ impl Warped {
         // `edge_importance`: the occluder map of this frame's DV crop before the count map
         // (render then reuses it for `cull_hidden`)
         if let (Some(o), true) = (&self.occluders, self.params.edge_importance > 0) {
-            let depth_group = self.depth_group(gpu, &xv, &yv);
+            let depth_group = self.depth_group(gpu);
             rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, &depth_group, f.scene));
         }
         rec.stage(&format!("{name}.importance_map"), |enc| {

@@ -8,7 +8,7 @@ use shadowlab_core::lightspace;
 use shadowlab_core::techniques::dpsm::Hemisphere;
 
 use super::{analyze, depth, eval, occluders, subdiv};
-use super::{Knobs, Projection, SubdivScratch, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
+use super::{Groups, Knobs, Projection, SubdivScratch, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
 use crate::prefix_sum::PrefixSum;
 use crate::scene_gpu::GpuScene;
 use crate::technique::EvalPipelines;
@@ -50,8 +50,8 @@ impl Warped {
 
     fn assemble(plan: Plan, r: Resources, p: Pipelines) -> Warped {
         Warped {
-            analyze_groups: Default::default(),
-            eval_groups: Default::default(),
+            groups: Groups { levels: (0..=r.level_uniforms.len()).map(|_| Default::default()).collect(), ..Default::default() },
+            views: [&r.warp_x, &r.warp_y, &r.map].map(|t| t.create_view(&Default::default())),
             variant: plan.variant,
             label: plan.name,
             res: plan.res,

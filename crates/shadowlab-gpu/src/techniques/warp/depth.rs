@@ -72,42 +72,37 @@ pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) 
 }
 
 impl Warped {
-    /// Views of the two warp textures.
-    pub(super) fn warp_views(&self) -> (wgpu::TextureView, wgpu::TextureView) {
-        (self.warp_x.create_view(&Default::default()), self.warp_y.create_view(&Default::default()))
-    }
-
-    pub(super) fn lookup_resources<'a>(&'a self, xv: &'a wgpu::TextureView, yv: &'a wgpu::TextureView) -> [wgpu::BindingResource<'a>; 4] {
+    /// The uniform, the DV bounds and the two warps' views.
+    pub(super) fn lookup_resources(&self) -> [wgpu::BindingResource<'_>; 4] {
         [
             self.uniform.as_entire_binding(),
             self.dv.as_entire_binding(),
-            wgpu::BindingResource::TextureView(xv),
-            wgpu::BindingResource::TextureView(yv),
+            wgpu::BindingResource::TextureView(&self.views[0]),
+            wgpu::BindingResource::TextureView(&self.views[1]),
         ]
     }
 
     /// The depth pass's bindings: the lookup resources and the pieces (binding 10).
-    pub(super) fn depth_entries<'a>(&'a self, xv: &'a wgpu::TextureView, yv: &'a wgpu::TextureView) -> Vec<wgpu::BindGroupEntry<'a>> {
+    pub(super) fn depth_entries(&self) -> Vec<wgpu::BindGroupEntry<'_>> {
         let pieces = if self.params.subdiv > 0.0 { &self.pieces } else { &self.counters };
-        let look = self.lookup_resources(xv, yv);
+        let look = self.lookup_resources();
         let mut entries: Vec<wgpu::BindGroupEntry> =
             look.iter().enumerate().map(|(i, r)| wgpu::BindGroupEntry { binding: 6 + i as u32, resource: r.clone() }).collect();
         entries.push(wgpu::BindGroupEntry { binding: 10, resource: pieces.as_entire_binding() });
         entries
     }
 
-    pub(super) fn depth_group(&self, gpu: &Gpu, xv: &wgpu::TextureView, yv: &wgpu::TextureView) -> wgpu::BindGroup {
-        let entries = self.depth_entries(xv, yv);
-        gpu.bind_group(&wgpu::BindGroupDescriptor { label: Some(self.name()), layout: &self.lookup_layout, entries: &entries })
+    /// The depth pass's group (kept).
+    pub(super) fn depth_group(&self, gpu: &Gpu) -> wgpu::BindGroup {
+        self.groups.depth.entries(gpu, self.name(), &self.lookup_layout, &self.depth_entries())
     }
 
     /// The `shadow_map` stage: the pieces the subdivision left (drawn indirectly), or the scene.
     pub(super) fn draw_shadow_map(&self, f: &FrameInputs, rec: &mut Recorder, depth_group: &wgpu::BindGroup) {
         let name = self.name();
         let subdiv = self.params.subdiv > 0.0;
-        let map_view = self.map.create_view(&Default::default());
         rec.stage(&format!("{name}.shadow_map"), |enc| {
-            let mut pass = raster::begin_pass(enc, &format!("{name}.shadow_map"), &[], &map_view);
+            let mut pass = raster::begin_pass(enc, &format!("{name}.shadow_map"), &[], &self.views[2]);
             pass.set_pipeline(&self.depth_pipeline);
             pass.set_bind_group(0, depth_group, &[]);
             pass.set_bind_group(1, &f.scene.group, &[]);

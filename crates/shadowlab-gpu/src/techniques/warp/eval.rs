@@ -58,15 +58,13 @@ impl Warped {
     /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
     pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
         let name = self.name();
-        let (xv, yv) = self.warp_views();
-        let map_view = self.map.create_view(&Default::default());
-        let mut extra: Vec<wgpu::BindingResource> = self.lookup_resources(&xv, &yv).to_vec();
+        let mut extra: Vec<wgpu::BindingResource> = self.lookup_resources().to_vec();
         extra.extend([
-            wgpu::BindingResource::TextureView(&map_view),
+            wgpu::BindingResource::TextureView(&self.views[2]),
             wgpu::BindingResource::Sampler(&self.sampler),
             self.counts.as_entire_binding(),
         ]);
-        let group = f.view_group(gpu, &self.eval_groups, &format!("{name}.final_pass"), &self.eval_layout, &extra);
+        let group = f.view_group(gpu, &self.groups.eval, &format!("{name}.final_pass"), &self.eval_layout, &extra);
         self.eval.record(gpu, rec, &format!("{name}.final_pass"), &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
         Ok(())
     }

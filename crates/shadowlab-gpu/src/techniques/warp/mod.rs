@@ -194,8 +194,9 @@ pub struct WarpParams {
 
 /// One light's warped shadow map with its warps and scratch buffers.
 pub struct Warped {
-    pub(crate) analyze_groups: crate::binding::GroupCache,
-    pub(crate) eval_groups: crate::binding::GroupCache,
+    /// The bind groups, made on the first frame and kept while their resources stay (one per
+    /// call site; `level_groups`: one per subdivision level, 0 the root).
+    pub(crate) groups: Groups,
     variant: Variant,
     /// Prefix of the wgpu labels and stage names.
     label: &'static str,
@@ -210,6 +211,8 @@ pub struct Warped {
     warp_x: wgpu::Texture,
     warp_y: wgpu::Texture,
     map: wgpu::Texture,
+    /// Views of `warp_x`, `warp_y` and `map`, made once.
+    views: [wgpu::TextureView; 3],
     counts: wgpu::Buffer,
     /// Subdivision: finished pieces, counters + draw/dispatch args, two queues, one uniform per level.
     pieces: wgpu::Buffer,
@@ -237,7 +240,15 @@ pub struct Warped {
     sampler: wgpu::Sampler,
 }
 
-/// A bind group layout of `entries` (binding, type), all visible to `vis`.
+/// The kept bind groups of a warped map's passes.
+#[derive(Default)]
+pub(crate) struct Groups {
+    analyze: crate::binding::GroupCache,
+    depth: crate::binding::GroupCache,
+    levels: Vec<crate::binding::GroupCache>,
+    eval: crate::binding::GroupCache,
+}
+
 /// The pipeline constants of every warp shader (params.wgsl): the projection and whether the map
 /// warps, from the map's uniform. Each pass adds its own.
 fn base_constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
@@ -277,10 +288,9 @@ impl Technique for Warped {
     }
 
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let (xv, yv) = self.warp_views();
-        let depth_group = self.depth_group(gpu, &xv, &yv);
+        let depth_group = self.depth_group(gpu);
         if self.params.subdiv > 0.0 {
-            self.subdivide(gpu, f, rec, &xv, &yv, &depth_group);
+            self.subdivide(gpu, f, rec, &depth_group);
         }
         self.draw_shadow_map(f, rec, &depth_group);
         Ok(())

@@ -23,6 +23,8 @@ pub(super) fn hzb_src() -> String {
 pub(super) struct Occluders {
     res: u32,
     depth: wgpu::Texture,
+    /// `depth`'s view, made once.
+    view: wgpu::TextureView,
     /// The pyramid, level 0 (res x res) first (params.wgsl `hzb_offset`).
     pub hzb: wgpu::Buffer,
     raster: wgpu::RenderPipeline,
@@ -83,6 +85,7 @@ impl Occluders {
             base: gpu.compute_pipeline_with(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout], &constants),
             reduce: gpu.compute_pipeline_with(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout], &constants),
             groups,
+            view,
             depth,
             raster,
         }
@@ -99,9 +102,8 @@ impl Occluders {
 
     /// The occluder pass and the pyramid; `lookup` is the depth pass's group (the DV rectangle).
     pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, lookup: &wgpu::BindGroup, scene: &GpuScene) {
-        let view = self.depth.create_view(&Default::default());
         {
-            let mut pass = raster::begin_pass(enc, "occluders", &[], &view);
+            let mut pass = raster::begin_pass(enc, "occluders", &[], &self.view);
             pass.set_pipeline(&self.raster);
             pass.set_bind_group(0, lookup, &[]);
             pass.set_bind_group(1, &scene.group, &[]);

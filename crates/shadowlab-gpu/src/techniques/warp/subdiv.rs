@@ -67,17 +67,9 @@ impl Warped {
 
     /// The `subdivide` stage (after the `occluders` stage when `cull_hidden` draws them here);
     /// `depth_group` is the depth pass's group, which the occluder pass shares.
-    pub(super) fn subdivide(
-        &self,
-        gpu: &Gpu,
-        f: &FrameInputs,
-        rec: &mut Recorder,
-        xv: &wgpu::TextureView,
-        yv: &wgpu::TextureView,
-        depth_group: &wgpu::BindGroup,
-    ) {
+    pub(super) fn subdivide(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, depth_group: &wgpu::BindGroup) {
         let name = self.name();
-        let groups = self.level_groups(gpu, xv, yv);
+        let groups = self.level_groups(gpu);
         if let (Some(o), true) = (&self.occluders, self.params.edge_importance == 0) {
             rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, depth_group, f.scene));
         }
@@ -108,9 +100,9 @@ impl Warped {
 
     /// One group per level (0: the root): the depth pass's bindings, the counters, the level's
     /// input and output queues, its uniform and the occluder pyramid (or a stand-in).
-    fn level_groups(&self, gpu: &Gpu, xv: &wgpu::TextureView, yv: &wgpu::TextureView) -> Vec<wgpu::BindGroup> {
+    fn level_groups(&self, gpu: &Gpu) -> Vec<wgpu::BindGroup> {
         let name = self.name();
-        let mut entries = self.depth_entries(xv, yv);
+        let mut entries = self.depth_entries();
         entries.push(wgpu::BindGroupEntry { binding: 11, resource: self.counters.as_entire_binding() });
         // level l reads queue (l + 1) % 2 and writes the other; the root writes queue 0
         (0..=self.level_uniforms.len())
@@ -123,7 +115,7 @@ impl Warped {
                 e.push(wgpu::BindGroupEntry { binding: 14, resource: u.as_entire_binding() });
                 let hzb = self.occluders.as_ref().map_or(&self.dv, |o| &o.hzb);
                 e.push(wgpu::BindGroupEntry { binding: 15, resource: hzb.as_entire_binding() });
-                gpu.bind_group(&wgpu::BindGroupDescriptor { label: Some(name), layout: &self.split_layout, entries: &e })
+                self.groups.levels[l].entries(gpu, name, &self.split_layout, &e)
             })
             .collect()
     }
