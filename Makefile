@@ -3,7 +3,7 @@ CARGO ?= cargo
 # Mesa's WSI complains without it; nothing here opens a window.
 export XDG_RUNTIME_DIR ?= /tmp
 
-.PHONY: run test setup build bench clean
+.PHONY: run test check-web setup build bench clean
 
 setup:
 	@bash scripts/setup.sh
@@ -15,9 +15,14 @@ build: setup
 run: build
 	./target/release/shadowlab compare --out report
 
-# The whole suite, GPU tests included (lavapipe where there is no GPU).
+# The whole suite, GPU tests included (lavapipe where there is no GPU), then the web build's
+# check: the library crates compile for wasm32 (WebGPU), docs/web.md.
 test: setup
 	$(CARGO) test --workspace --locked
+	$(MAKE) --no-print-directory check-web
+
+check-web: setup
+	$(CARGO) check --locked --target wasm32-unknown-unknown -p shadowlab-core -p shadowlab-gpu
 
 bench: build
 	./target/release/shadowlab bench --out bench.md

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Makes sure a Vulkan driver is present (Mesa's lavapipe on machines without a GPU), Xvfb
-# with xvfb-run and xauth (the viewer's smoke test opens its window on a virtual display), and
-# Debian's Chromium (the report's browser test loads it headless).
+# with xvfb-run and xauth (the viewer's smoke test opens its window on a virtual display),
+# Debian's Chromium (the report's browser test loads it headless) and Rust's wasm32 target.
 # Installs them with apt when running as root or with password-less sudo; otherwise prints the
 # exact command and fails.
 set -euo pipefail
@@ -33,6 +33,18 @@ have_xvfb() {
 have_chromium() {
     [ -x /usr/bin/chromium ]
 }
+
+# The browser build (issue 40): `make test` checks that shadowlab-core and shadowlab-gpu compile
+# for wasm32, which needs the target's standard library (a rustup component).
+if ! rustc --print sysroot >/dev/null 2>&1 || [ ! -d "$(rustc --print sysroot)/lib/rustlib/wasm32-unknown-unknown" ]; then
+    if command -v rustup >/dev/null 2>&1; then
+        echo "setup: adding the wasm32-unknown-unknown target (rustup) for the web build's check" >&2
+        rustup target add wasm32-unknown-unknown >&2
+    else
+        echo "error: the wasm32-unknown-unknown standard library is missing and rustup is not available; install it with your toolchain's installer" >&2
+        exit 1
+    fi
+fi
 
 if have_driver && have_xvfb && have_chromium; then
     exit 0

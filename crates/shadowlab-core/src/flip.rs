@@ -11,6 +11,12 @@
 //! mean over **all** pixels of the image (FLIP's own pooling), not only the evaluated pixels of
 //! the other metrics. The reference implementation's CPU code runs on one thread here (its
 //! OpenMP pragmas are not compiled in): callers parallelise over image pairs (rayon).
+//!
+//! The C++ does not build for wasm32: there ([`AVAILABLE`] is false) a computed map holds NaN
+//! (FLIP "n/a"; its mean is NaN, null in JSON) and [`FlipMap::magma_rgba`] is black.
+
+/// Whether this build computes FLIP (false on wasm32, where NVIDIA's C++ does not build).
+pub const AVAILABLE: bool = cfg!(not(target_arch = "wasm32"));
 
 /// Pixels per degree of visual angle: FLIP's reference default, an observer 0.7 m from a
 /// 0.7 m wide monitor with 3840 pixels across (`nv_flip::pixels_per_degree(0.7, 3840, 0.7)`
@@ -40,7 +46,10 @@ impl FlipMap {
     /// and orange to light yellow = 1), as RGBA8 with opaque alpha. The map index is
     /// `round(255 * error)`, as the reference's `colorMap`.
     pub fn magma_rgba(&self) -> Vec<u8> {
+        #[cfg(not(target_arch = "wasm32"))]
         let lut = nv_flip::magma_lut().to_vec();
+        #[cfg(target_arch = "wasm32")]
+        let lut = vec![0u8; 3 * 256];
         let mut out = Vec::with_capacity(self.values.len() * 4);
         for &v in &self.values {
             let i = (255.0 * v.clamp(0.0, 1.0)).round() as usize;
@@ -50,6 +59,7 @@ impl FlipMap {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 fn rgb8(rgba: &[u8]) -> Vec<u8> {
     rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
 }
@@ -79,10 +89,18 @@ pub fn flip_computed(reference: &[u8], test: &[u8], width: u32, height: u32) -> 
     if n == 0 {
         return FlipMap { width, height, values: Vec::new() };
     }
-    let r = nv_flip::FlipImageRgb8::with_data(width, height, &rgb8(reference));
-    let t = nv_flip::FlipImageRgb8::with_data(width, height, &rgb8(test));
-    let map = nv_flip::flip(r, t, PIXELS_PER_DEGREE);
-    FlipMap { width, height, values: map.to_vec() }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let r = nv_flip::FlipImageRgb8::with_data(width, height, &rgb8(reference));
+        let t = nv_flip::FlipImageRgb8::with_data(width, height, &rgb8(test));
+        let map = nv_flip::flip(r, t, PIXELS_PER_DEGREE);
+        FlipMap { width, height, values: map.to_vec() }
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = (reference, test);
+        FlipMap { width, height, values: vec![f32::NAN; n] }
+    }
 }
 
 #[cfg(test)]
