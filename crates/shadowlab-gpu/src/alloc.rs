@@ -34,6 +34,7 @@ pub const POOL_BYTES: u64 = 64 << 20;
 pub struct Alloc {
     buffers: AtomicU64,
     bind_groups: AtomicU64,
+    dispatches: AtomicU64,
     uploads: Arc<Mutex<Vec<wgpu::Buffer>>>,
     reads: Mutex<Vec<wgpu::Buffer>>,
 }
@@ -70,6 +71,23 @@ impl Gpu {
     /// Bind groups created through this device wrapper so far.
     pub fn bind_groups_created(&self) -> u64 {
         self.alloc.bind_groups.load(Ordering::Relaxed)
+    }
+
+    /// Compute dispatches recorded through this device wrapper so far (direct and indirect).
+    pub fn dispatches(&self) -> u64 {
+        self.alloc.dispatches.load(Ordering::Relaxed)
+    }
+
+    /// Records a dispatch of `groups` workgroups into `pass` (counted).
+    pub fn dispatch(&self, pass: &mut wgpu::ComputePass, [x, y, z]: [u32; 3]) {
+        self.alloc.dispatches.fetch_add(1, Ordering::Relaxed);
+        pass.dispatch_workgroups(x, y, z);
+    }
+
+    /// Records an indirect dispatch (arguments at `offset` in `args`) into `pass` (counted).
+    pub fn dispatch_indirect(&self, pass: &mut wgpu::ComputePass, args: &wgpu::Buffer, offset: u64) {
+        self.alloc.dispatches.fetch_add(1, Ordering::Relaxed);
+        pass.dispatch_workgroups_indirect(args, offset);
     }
 
     /// A new bind group (counted).

@@ -283,6 +283,6 @@ impl Gpu {
         for (i, g) in groups.iter().enumerate() {
             pass.set_bind_group(i as u32, *g, &[]);
         }
-        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        self.dispatch(&mut pass, [w.div_ceil(8), h.div_ceil(8), 1]);
     }
 }

@@ -17,6 +17,18 @@ pub fn scene_pipeline(
     scene_pipeline_with(gpu, label, source, layouts, targets, true, &[])
 }
 
+/// [`depth_pipeline_with`] with the depth test and writes off: every fragment that its
+/// fragment stage keeps passes, for an occlusion query to count them (a report's counter).
+pub fn counting_pipeline(
+    gpu: &Gpu,
+    label: &str,
+    source: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
+    pipeline(gpu, label, source, layouts, &[], true, constants, (false, wgpu::CompareFunction::Always))
+}
+
 /// [`scene_pipeline`] with WGSL `override` constants (both stages: one module).
 pub fn scene_pipeline_constants(
     gpu: &Gpu,
@@ -58,6 +70,20 @@ fn scene_pipeline_with(
     fragment: bool,
     constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
+    pipeline(gpu, label, source, layouts, targets, fragment, constants, (true, wgpu::CompareFunction::Less))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn pipeline(
+    gpu: &Gpu,
+    label: &str,
+    source: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    targets: &[Option<wgpu::ColorTargetState>],
+    fragment: bool,
+    constants: &[(&str, f64)],
+    (write, compare): (bool, wgpu::CompareFunction),
+) -> wgpu::RenderPipeline {
     let module = gpu.shader(label, source);
     let layout = gpu.pipeline_layout(label, layouts);
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -72,8 +98,8 @@ fn scene_pipeline_with(
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
+            depth_write_enabled: Some(write),
+            depth_compare: Some(compare),
             stencil: Default::default(),
             bias: Default::default(),
         }),

@@ -50,8 +50,25 @@ fn no_frame_after_the_first_creates_a_buffer() {
 }
 
 #[test]
-fn every_buffer_is_made_through_the_counting_wrapper() {
-    // device.create_buffer outside alloc.rs would escape the count above
+fn the_lab_counts_the_dispatches_of_one_frame() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("planebox").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 64);
+    // known from the code: `sm` and `rt` evaluate in one compute dispatch each, their maps
+    // (sm) and rays (rt's trace is that dispatch) need no other; three timed repetitions must
+    // not add up
+    for (spec, expected) in [("sm", 1.0), ("rt", 1.0)] {
+        let run = lab.run(&v, &TechniqueSpec::parse(spec).unwrap(), 3).unwrap();
+        assert_eq!(run.report.counters.get("dispatches_per_frame"), Some(&expected), "{spec}");
+    }
+    let rtw = lab.run(&v, &TechniqueSpec::parse("rtw").unwrap(), 2).unwrap();
+    let n = rtw.report.counters["dispatches_per_frame"];
+    assert!(n > 6.0, "rtw's desired view, importance, prefix sums, subdivision and evaluation: {n}");
+}
+
+/// `file:line` of every line of the crate's sources (but `allowed`) that calls one of `calls`.
+fn calls_outside(calls: &[&str], allowed: &str) -> Vec<String> {
     let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut found = Vec::new();
     let mut stack = vec![src];
@@ -60,15 +77,29 @@ fn every_buffer_is_made_through_the_counting_wrapper() {
             let p = e.unwrap().path();
             if p.is_dir() {
                 stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "rs") && !p.ends_with("alloc.rs") {
+            } else if p.extension().is_some_and(|x| x == "rs") && !p.ends_with(allowed) {
                 let text = std::fs::read_to_string(&p).unwrap();
                 for (i, line) in text.lines().enumerate() {
-                    if line.contains(".create_buffer(") || line.contains(".create_buffer_init(") {
+                    if calls.iter().any(|c| line.contains(c)) {
                         found.push(format!("{}:{}", p.display(), i + 1));
                     }
                 }
             }
         }
     }
+    found
+}
+
+#[test]
+fn every_buffer_is_made_through_the_counting_wrapper() {
+    // device.create_buffer outside alloc.rs would escape the count above
+    let found = calls_outside(&[".create_buffer(", ".create_buffer_init("], "alloc.rs");
     assert!(found.is_empty(), "buffers made around Gpu::buffer: {found:?}");
+}
+
+#[test]
+fn every_dispatch_is_counted() {
+    // the lab's `dispatches_per_frame` counts Gpu::dispatch and Gpu::dispatch_indirect
+    let found = calls_outside(&[".dispatch_workgroups(", ".dispatch_workgroups_indirect("], "alloc.rs");
+    assert!(found.is_empty(), "dispatches around Gpu::dispatch: {found:?}");
 }

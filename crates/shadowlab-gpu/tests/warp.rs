@@ -80,6 +80,27 @@ fn run_direct(gpu: &shadowlab_gpu::Gpu, lab: &Lab, v: &View, spec: &str, variant
     t
 }
 
+#[test]
+fn the_exact_depth_pass_counts_its_fragments_and_keeps_the_map() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 96);
+    let mut t = run_direct(&gpu, &lab, &v, "notw:res=256", Variant::Notw);
+    let map = t.read_map(&gpu);
+    let r = technique::Technique::report(&mut t, &gpu);
+    gpu.take_error().unwrap();
+    assert_eq!(t.read_map(&gpu), map, "the counting redraw left the map as the frame drew it");
+    // every texel the pass wrote came from at least one fragment it kept
+    let written = map.iter().filter(|&&d| d < 1.0).count() as f64;
+    let frags = r.counters["exact_depth_fragments"];
+    assert!(written > 1000.0 && frags >= written, "{frags} fragments for {written} texels written");
+    assert_eq!(r.counters["exact_depth_fragments_per_texel"], frags / (256.0 * 256.0));
+    let mut plain = run_direct(&gpu, &lab, &v, "notw:res=256,exact_depth=false", Variant::Notw);
+    let r = technique::Technique::report(&mut plain, &gpu);
+    assert!(!r.counters.contains_key("exact_depth_fragments"), "no inversion without exact_depth");
+}
+
 /// The evaluated samples' base map coordinates (the CPU half of the DV and count passes).
 fn base_points(lab: &Lab, v: &View, res: u32) -> (Vec<[f32; 2]>, Vec<f32>) {
     let lp = lightspace::fit(&v.light, &lab.gscene.bounds, res).unwrap();

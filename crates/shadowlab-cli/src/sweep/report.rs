@@ -83,9 +83,9 @@ const QUALITIES: &[Quality] = &[
 ];
 
 /// Counters that measure work or memory (fetches, rays, pieces, bytes, reads, texels, map
-/// renders), offered as hardware-independent costs; the others (split distances, box sizes,
-/// depth ranges) describe a result, not its cost.
-pub const COST_COUNTERS: &[&str] = &["fetch", "ray", "pieces", "bytes", "reads", "texels", "renders"];
+/// renders, compute dispatches), offered as hardware-independent costs; the others (split
+/// distances, box sizes, depth ranges) describe a result, not its cost.
+pub const COST_COUNTERS: &[&str] = &["fetch", "ray", "pieces", "bytes", "reads", "texels", "renders", "dispatches"];
 
 fn is_cost_counter(name: &str) -> bool {
     COST_COUNTERS.iter().any(|c| name.contains(c)) && !name.starts_with("ray_traced_cascade")

@@ -302,9 +302,9 @@ impl<'a> Lab<'a> {
         let mut totals = Vec::new();
         let mut stamped: BTreeMap<String, Vec<f64>> = BTreeMap::new();
         let mut stalls = Vec::new();
-        let mut submits = 0;
+        let (mut submits, mut dispatches) = (0, 0);
         for _ in 0..repeat.max(1) {
-            let before = gpu.submit_count();
+            let (before, before_dispatches) = (gpu.submit_count(), gpu.dispatches());
             let mut frame_stalls = Vec::new();
             let (ms, stages) = self.timed_frame(|rec| {
                 technique::run_frame(tech, gpu, &inputs, rec)?;
@@ -312,6 +312,7 @@ impl<'a> Lab<'a> {
                 Ok(())
             })?;
             submits = gpu.submit_count() - before;
+            dispatches = gpu.dispatches() - before_dispatches;
             stalls = frame_stalls;
             // a timestamped frame's time is the sum of its stages' GPU time
             totals.push(stages.as_ref().map_or(ms, |s| s.values().sum()));
@@ -326,7 +327,10 @@ impl<'a> Lab<'a> {
         // lab-only analysis passes, after the timed frames
         record::drive(gpu, "analysis", Clock::Wall, |rec| tech.analyze(gpu, &inputs, rec))?;
         gpu.take_error()?;
-        let report = tech.report(gpu);
+        let mut report = tech.report(gpu);
+        // compute dispatches of the last timed frame (Gpu::dispatch counts them): a cost any
+        // GPU pays per frame, whatever its speed
+        report.counters.insert("dispatches_per_frame".into(), dispatches as f64);
         let shaded = self.shade_pass.shade(gpu, &inputs, &view.color);
         gpu.take_error()?;
         Ok(Run {

@@ -77,6 +77,6 @@ impl PrefixSum {
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("prefix_sum"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(p.rows.min(65535), p.rows.div_ceil(65535), 1);
+        gpu.dispatch(&mut pass, [p.rows.min(65535), p.rows.div_ceil(65535), 1]);
     }
 }

@@ -40,7 +40,7 @@ pub(super) fn chunk_bounds(gpu: &Gpu, scene: &GpuScene, chunk: u32) -> Result<Ve
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &group, &[]);
         pass.set_bind_group(1, &scene.group, &[]);
-        pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+        gpu.dispatch(&mut pass, [groups.min(65535), groups.div_ceil(65535), 1]);
     }
     gpu.submit(enc.finish());
     gpu.take_error()?;

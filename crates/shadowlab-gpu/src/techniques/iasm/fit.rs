@@ -164,7 +164,7 @@ impl ViewFit {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("iasm.fit.place"), timestamp_writes: None });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.group, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
+            gpu.dispatch(&mut pass, [1, 1, 1]);
         });
     }
 

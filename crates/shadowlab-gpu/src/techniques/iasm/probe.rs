@@ -33,7 +33,7 @@ pub(super) fn probe_indices(gpu: &Gpu, mut params: IasmParams, res: &[u32; TILE_
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((uvs.len() as u32).div_ceil(64), 1, 1);
+        gpu.dispatch(&mut pass, [(uvs.len() as u32).div_ceil(64), 1, 1]);
     }
     gpu.submit(enc.finish());
     let out: Vec<[f32; 4]> = gpu.read_buffer_as(&probe, uvs.len());

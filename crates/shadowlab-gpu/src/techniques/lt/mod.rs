@@ -261,7 +261,7 @@ impl Technique for LeakTracing {
         let classify = self.classify.group(gpu, f, name, &self.resources, s);
         let trace_groups = self.trace.groups(gpu, f, name, trace, s);
         self.classify.record(gpu, rec, name, &classify, s);
-        self.trace.record(rec, name, f, &trace_groups, s);
+        self.trace.record(gpu, rec, name, f, &trace_groups, s);
         self.screen.as_mut().expect("allocated above").frames += 1;
         Ok(())
     }

@@ -71,20 +71,20 @@ impl TracePass {
     }
 
     /// Stage `<name>.trace`: the arguments from the list's count, then the rays (indirect).
-    pub fn record(&self, rec: &mut Recorder, name: &str, f: &FrameInputs, g: &TraceGroups, s: &Screen) {
+    pub fn record(&self, gpu: &Gpu, rec: &mut Recorder, name: &str, f: &FrameInputs, g: &TraceGroups, s: &Screen) {
         let label = format!("{name}.trace");
         rec.stage(&label, |enc| {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&label), timestamp_writes: None });
                 pass.set_pipeline(&self.args_pipeline);
                 pass.set_bind_group(0, &g.args, &[]);
-                pass.dispatch_workgroups(1, 1, 1);
+                gpu.dispatch(&mut pass, [1, 1, 1]);
             }
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&label), timestamp_writes: None });
             pass.set_pipeline(&self.trace_pipeline);
             pass.set_bind_group(0, &g.trace, &[]);
             pass.set_bind_group(1, &f.scene.group, &[]);
-            pass.dispatch_workgroups_indirect(&s.args, 0);
+            gpu.dispatch_indirect(&mut pass, &s.args, 0);
         });
     }
 }

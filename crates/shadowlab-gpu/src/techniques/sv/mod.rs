@@ -254,8 +254,8 @@ impl Technique for ShadowVolumes {
         );
         let (tris, edges) = (self.params.triangles, self.params.edges);
         rec.stage("sv.silhouettes", |enc| {
-            dispatch_1d(enc, "sv.facing", &self.p.facing, &[&group, &f.scene.group], tris);
-            dispatch_1d(enc, "sv.edges", &self.p.edges, &[&group, &f.scene.group], edges);
+            dispatch_1d(gpu, enc, "sv.facing", &self.p.facing, &[&group, &f.scene.group], tris);
+            dispatch_1d(gpu, enc, "sv.edges", &self.p.edges, &[&group, &f.scene.group], edges);
         });
         Ok(())
     }

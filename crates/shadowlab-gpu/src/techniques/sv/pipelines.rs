@@ -208,7 +208,7 @@ impl Pipelines {
         let group = binding::group(gpu, "sv.gather", &layout, &[out.as_entire_binding()]);
         let pipe = gpu.compute_pipeline("sv.gather", &compose(GATHER_WGSL, true), "main", &[&layout, &scene.layout]);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        dispatch_1d(&mut enc, "sv.gather", &pipe, &[&group, &scene.group], n as u32);
+        dispatch_1d(gpu, &mut enc, "sv.gather", &pipe, &[&group, &scene.group], n as u32);
         gpu.submit(enc.finish());
         let p: Vec<[f32; 4]> = gpu.read_buffer_as(&out, n as usize);
         p.into_iter().map(|v| [v[0], v[1], v[2]]).collect()
@@ -217,7 +217,7 @@ impl Pipelines {
 
 /// One thread per item in groups of 64, spread over y beyond 65535 groups (the shaders fold
 /// the index back with `num_workgroups`).
-pub fn dispatch_1d(enc: &mut wgpu::CommandEncoder, label: &str, pipe: &wgpu::ComputePipeline, groups: &[&wgpu::BindGroup], n: u32) {
+pub fn dispatch_1d(gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str, pipe: &wgpu::ComputePipeline, groups: &[&wgpu::BindGroup], n: u32) {
     if n == 0 {
         return;
     }
@@ -228,5 +228,5 @@ pub fn dispatch_1d(enc: &mut wgpu::CommandEncoder, label: &str, pipe: &wgpu::Com
     for (i, b) in groups.iter().enumerate() {
         pass.set_bind_group(i as u32, *b, &[]);
     }
-    pass.dispatch_workgroups(x, g.div_ceil(x), 1);
+    gpu.dispatch(&mut pass, [x, g.div_ceil(x), 1]);
 }

@@ -41,14 +41,14 @@ impl ChunkBounds {
     }
 
     /// Resets and recomputes the boxes.
-    pub fn record(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene) {
+    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene: &GpuScene) {
         enc.copy_buffer_to_buffer(&self.init, 0, &self.boxes, 0, self.count as u64 * 24);
         let groups = (self.end - self.first).div_ceil(64).max(1);
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.group, &[]);
         pass.set_bind_group(1, &scene.group, &[]);
-        pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+        gpu.dispatch(&mut pass, [groups.min(65535), groups.div_ceil(65535), 1]);
     }
 
     /// The boxes from their words (an empty chunk reads as an empty box).

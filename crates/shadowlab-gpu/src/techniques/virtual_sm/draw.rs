@@ -83,7 +83,7 @@ impl Chunks {
         if split > 0 {
             let b = ChunkBounds::new(gpu, scene, "virtual.static_bounds", 0, split, CHUNK_TRIANGLES);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
-            b.record(&mut enc, scene);
+            b.record(gpu, &mut enc, scene);
             gpu.submit(enc.finish());
             gpu.take_error()?;
             let boxes = ChunkBounds::parse(&gpu.read_buffer_as::<u32>(&b.boxes, b.count as usize * 6));

@@ -51,7 +51,7 @@ impl MarkPass {
             gpu.dispatch_2d(enc, "virtual.mark", &self.pipeline, &[&group], f.gbuffer.width, f.gbuffer.height);
             enc.copy_buffer_to_buffer(&r.requests, 0, &r.probe, 0, table_bytes);
             if let Some(b) = dynamic {
-                b.record(enc, f.scene);
+                b.record(gpu, enc, f.scene);
                 enc.copy_buffer_to_buffer(&b.boxes, 0, &r.probe, table_bytes, b.count as u64 * 24);
             }
         });

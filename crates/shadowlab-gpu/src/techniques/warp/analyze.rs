@@ -125,7 +125,7 @@ impl Warped {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(e), timestamp_writes: None });
             pass.set_pipeline(self.pipeline(e));
             pass.set_bind_group(0, group, &[]);
-            pass.dispatch_workgroups((2 * res).div_ceil(64), 1, 1);
+            gpu.dispatch(&mut pass, [(2 * res).div_ceil(64), 1, 1]);
         };
         one_d(enc, "rtw_collapse");
         one_d(enc, "rtw_blur");

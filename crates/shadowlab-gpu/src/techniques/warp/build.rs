@@ -45,11 +45,13 @@ impl Warped {
         let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size)?;
         let resources = Resources::new(gpu, &plan);
         let pipelines = Pipelines::new(gpu, scene, &plan);
-        Ok(Warped::assemble(plan, resources, pipelines))
+        let scene = depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None };
+        Ok(Warped::assemble(plan, resources, pipelines, scene))
     }
 
-    fn assemble(plan: Plan, r: Resources, p: Pipelines) -> Warped {
+    fn assemble(plan: Plan, r: Resources, p: Pipelines, scene: depth::SceneBinding) -> Warped {
         Warped {
+            scene,
             groups: Groups { levels: (0..=r.level_uniforms.len()).map(|_| Default::default()).collect(), ..Default::default() },
             views: [&r.warp_x, &r.warp_y, &r.map].map(|t| t.create_view(&Default::default())),
             variant: plan.variant,

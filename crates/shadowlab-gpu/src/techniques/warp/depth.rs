@@ -71,6 +71,21 @@ pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) 
     (layout, pipeline)
 }
 
+/// The exact-depth pass with the depth test and writes off ([`raster::counting_pipeline`]): the
+/// report counts its fragments, each one inversion of the warp.
+pub(super) fn counting_pipeline(gpu: &Gpu, name: &str, lookup: &wgpu::BindGroupLayout, scene: &SceneBinding, p: &WarpParams) -> wgpu::RenderPipeline {
+    let label = format!("{name}.exact_depth_count");
+    raster::counting_pipeline(gpu, &label, &source(true), &[lookup, &scene.layout], &constants(p, scene.cutouts))
+}
+
+/// What a pass needs of the scene after the frame: its bind group layout and cut-outs, and the
+/// last frame's group and triangle count (set by `render`).
+pub(crate) struct SceneBinding {
+    pub layout: wgpu::BindGroupLayout,
+    pub cutouts: bool,
+    pub last: Option<(wgpu::BindGroup, u32)>,
+}
+
 impl Warped {
     /// The uniform, the DV bounds and the two warps' views.
     pub(super) fn lookup_resources(&self) -> [wgpu::BindingResource<'_>; 4] {
@@ -98,19 +113,63 @@ impl Warped {
     }
 
     /// The `shadow_map` stage: the pieces the subdivision left (drawn indirectly), or the scene.
-    pub(super) fn draw_shadow_map(&self, f: &FrameInputs, rec: &mut Recorder, depth_group: &wgpu::BindGroup) {
+    pub(super) fn draw_shadow_map(&mut self, f: &FrameInputs, rec: &mut Recorder, depth_group: &wgpu::BindGroup) {
         let name = self.name();
-        let subdiv = self.params.subdiv > 0.0;
         rec.stage(&format!("{name}.shadow_map"), |enc| {
             let mut pass = raster::begin_pass(enc, &format!("{name}.shadow_map"), &[], &self.views[2]);
             pass.set_pipeline(&self.depth_pipeline);
-            pass.set_bind_group(0, depth_group, &[]);
-            pass.set_bind_group(1, &f.scene.group, &[]);
-            if subdiv {
-                pass.draw_indirect(&self.counters, 16);
-            } else {
-                pass.draw(0..f.scene.triangle_count * 3, 0..1);
-            }
+            self.draw_pieces(&mut pass, depth_group, &f.scene.group, f.scene.triangle_count);
         });
+        self.scene.last = Some((f.scene.group.clone(), f.scene.triangle_count));
+    }
+
+    /// The map's draw after its pipeline is set: the pieces (indirect) or the scene.
+    fn draw_pieces(&self, pass: &mut wgpu::RenderPass, depth_group: &wgpu::BindGroup, scene_group: &wgpu::BindGroup, triangles: u32) {
+        pass.set_bind_group(0, depth_group, &[]);
+        pass.set_bind_group(1, scene_group, &[]);
+        if self.params.subdiv > 0.0 {
+            pass.draw_indirect(&self.counters, 16);
+        } else {
+            pass.draw(0..triangles * 3, 0..1);
+        }
+    }
+
+    /// Fragments the last frame's exact-depth pass shaded and kept (each one inversion of the
+    /// warp; discarded ones, behind a paraboloid's split plane or cut out, not counted): its
+    /// draw again, with the depth test off, under an occlusion query (the map is kept).
+    /// None without `exact_depth` or before a frame.
+    pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
+        let (scene_group, triangles) = self.scene.last.as_ref().filter(|_| self.params.exact_depth != 0)?;
+        let pipeline = counting_pipeline(gpu, self.name(), &self.lookup_layout, &self.scene, &self.params);
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("warp.exact_count"), ty: wgpu::QueryType::Occlusion, count: 1 });
+        let resolve = gpu.buffer(&wgpu::BufferDescriptor {
+            label: Some("warp.exact_count"),
+            size: 8,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let depth_group = self.depth_group(gpu);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("warp.exact_count"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.views[2],
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: Some(&set),
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.begin_occlusion_query(0);
+            self.draw_pieces(&mut pass, &depth_group, scene_group, *triangles);
+            pass.end_occlusion_query();
+        }
+        enc.resolve_query_set(&set, 0..1, &resolve, 0);
+        gpu.submit(enc.finish());
+        Some(gpu.read_buffer_as::<u64>(&resolve, 1)[0])
     }
 }

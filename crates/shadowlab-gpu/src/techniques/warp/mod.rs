@@ -228,6 +228,8 @@ pub struct Warped {
     analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
     lookup_layout: wgpu::BindGroupLayout,
     depth_pipeline: wgpu::RenderPipeline,
+    /// The scene's layout and cut-outs, and its last frame's group (the report's redraw).
+    scene: depth::SceneBinding,
     /// `cull_hidden`, `edge_importance`: the occluder pass and its pyramid; else none (a
     /// stand-in is bound).
     occluders: Option<occluders::Occluders>,

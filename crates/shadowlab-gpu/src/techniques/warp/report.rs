@@ -32,7 +32,7 @@ pub(super) fn report(t: &Warped, gpu: &Gpu) -> TechniqueReport {
     let res = t.res;
     let n = (res * res) as usize;
     let after: Vec<u32> = gpu.read_buffer_as(&t.counts, n);
-    let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&t.map, 4));
+    let depth = t.read_map(gpu);
     let map_bytes = n as u64 * 4;
     let mut r = TechniqueReport {
         shadow_data_bytes: map_bytes + t.warp_bytes() + 32,
@@ -49,6 +49,10 @@ pub(super) fn report(t: &Warped, gpu: &Gpu) -> TechniqueReport {
     c.insert("dv_area_fraction".into(), ((dv[2] - dv[0]) * (dv[3] - dv[1])) as f64);
     if t.params.subdiv > 0.0 {
         subdivision(t, gpu, &mut r);
+    }
+    if let Some(frags) = t.exact_depth_fragments(gpu) {
+        r.counters.insert("exact_depth_fragments".into(), frags as f64);
+        r.counters.insert("exact_depth_fragments_per_texel".into(), frags as f64 / n as f64);
     }
     if t.variant != Variant::Dv {
         let before = t.read_counts_before(gpu);
@@ -118,6 +122,11 @@ fn warp_images(t: &Warped, gpu: &Gpu, r: &mut TechniqueReport) {
 }
 
 impl Warped {
+    /// The warped shadow map's depths (res x res, 1 where nothing was drawn).
+    pub fn read_map(&self, gpu: &Gpu) -> Vec<f32> {
+        bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4))
+    }
+
     /// The DV rectangle (lo x, lo y, hi x, hi y) in base map coordinates, as the shaders use it.
     pub fn read_dv_rect(&self, gpu: &Gpu) -> [f32; 4] {
         let b: Vec<u32> = gpu.read_buffer_as(&self.dv, 4);

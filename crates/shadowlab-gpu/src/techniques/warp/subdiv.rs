@@ -83,8 +83,8 @@ impl Warped {
                 pass.set_bind_group(0, g, &[]);
                 pass.set_pipeline(&self.split[p]);
                 match groups {
-                    Some(n) => pass.dispatch_workgroups(n.min(65535), n.div_ceil(65535), 1),
-                    None => pass.dispatch_workgroups_indirect(&self.dispatch, 0),
+                    Some(n) => gpu.dispatch(&mut pass, [n.min(65535), n.div_ceil(65535), 1]),
+                    None => gpu.dispatch_indirect(&mut pass, &self.dispatch, 0),
                 }
             };
             pass(enc, &groups[0], 0, Some(n));
