@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Makes sure a Vulkan driver is present (Mesa's lavapipe on machines without a GPU), Xvfb
 # with xvfb-run and xauth (the viewer's smoke test opens its window on a virtual display),
-# Debian's Chromium (the report's browser test loads it headless) and Rust's wasm32 target.
+# Debian's Chromium (the report's and the web page's browser tests load it headless), Rust's
+# wasm32 target and wasm-bindgen's CLI (`make web`).
 # Installs them with apt when running as root or with password-less sudo; otherwise prints the
 # exact command and fails.
 set -euo pipefail
@@ -44,6 +45,14 @@ if ! rustc --print sysroot >/dev/null 2>&1 || [ ! -d "$(rustc --print sysroot)/l
         echo "error: the wasm32-unknown-unknown standard library is missing and rustup is not available; install it with your toolchain's installer" >&2
         exit 1
     fi
+fi
+
+# `make web`: wasm-bindgen's CLI at the version Cargo.lock pins for the library (their versions
+# must match). Not --locked: the CLI's own lock names crates some registry mirrors lack.
+want_bindgen=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/version = |"/, ""); print; exit }' "$(dirname "$0")/../Cargo.lock")
+if [ "$(wasm-bindgen --version 2>/dev/null | cut -d' ' -f2)" != "$want_bindgen" ]; then
+    echo "setup: installing wasm-bindgen-cli $want_bindgen (cargo install) for the web build" >&2
+    cargo install --quiet wasm-bindgen-cli --version "$want_bindgen" >&2
 fi
 
 if have_driver && have_xvfb && have_chromium; then

@@ -4,11 +4,29 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
-use obvhs::{aabb::Aabb, bvh2::builder::build_bvh2, bvh2::Bvh2, BvhBuildParams};
+use obvhs::bvh2::{leaf_collapser::collapse, reinsertion::ReinsertionOptimizer};
+use obvhs::{aabb::Aabb, bvh2::Bvh2, ploc::PlocBuilder, Boundable, BvhBuildParams};
 use rayon::prelude::*;
 
 use crate::light::Light;
 use crate::scene::Scene;
+
+/// `obvhs::bvh2::builder::build_bvh2` step for step (PLOC, reinsertion, leaf collapse,
+/// reinsertion), without its build timer: `std::time::Instant` panics on wasm32 (docs/web.md).
+fn build_bvh2<T: Boundable>(prims: &[T], config: BvhBuildParams) -> Bvh2 {
+    let mut bvh2 = PlocBuilder::with_capacity(prims.len()).build(
+        config.ploc_search_distance,
+        prims,
+        (0..prims.len() as u32).collect::<Vec<_>>(),
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh2, config.reinsertion_batch_ratio, None);
+    collapse(&mut bvh2, config.max_prims_per_leaf.clamp(1, 255), config.collapse_traversal_cost);
+    reinsertion.run(&mut bvh2, config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier, None);
+    bvh2
+}
 
 /// Traversal stack depth of both traversals; the build fails if the tree is deeper.
 pub const MAX_DEPTH: usize = 64;
@@ -54,16 +72,15 @@ impl Bvh {
     /// over a balanced subtree with leaves of at most [`LEAF_PRIMS`] ([`expand`]). Without such
     /// repeats the tree is the plain `obvhs` build, node for node.
     pub fn from_triangles(tris: &[[Vec3; 3]], first: u32) -> Result<Bvh, String> {
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         if tris.is_empty() {
             return Err("scene has no triangles".into());
         }
         let boxes: Vec<Aabb> = tris.iter().map(|&[a, b, c]| Aabb::from_points(&[a.into(), b.into(), c.into()])).collect();
         let groups = Groups::of(&boxes);
-        let mut core = std::time::Duration::ZERO;
         let reps: Vec<Aabb> =
             groups.starts[..groups.starts.len() - 1].iter().map(|&s| boxes[groups.members[s as usize] as usize]).collect();
-        let b = build_bvh2(&reps, BvhBuildParams::medium_build(), &mut core);
+        let b = build_bvh2(&reps, BvhBuildParams::medium_build());
         let (nodes, local) = expand(&b, &groups, &boxes);
         let depth = tree_depth(&nodes);
         if depth >= MAX_DEPTH {

@@ -198,7 +198,7 @@ mod tests {
         let dir = std::path::PathBuf::from(dir);
         let load = |f: &str| image::open(dir.join(f)).expect("reference image").into_rgba8();
         let (r, t) = (load("tree-ref.png"), load("tree-test.png"));
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         let m = flip_rgba8(r.as_raw(), t.as_raw(), r.width(), r.height());
         eprintln!("{}x{}: {:.0} ms", r.width(), r.height(), t0.elapsed().as_secs_f64() * 1e3);
         assert!((m.mean() - 0.133285).abs() < 1e-4, "mean {}", m.mean());

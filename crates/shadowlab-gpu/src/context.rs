@@ -31,18 +31,26 @@ pub struct Gpu {
 
 impl Gpu {
     /// Opens the first high-performance adapter (any backend; lavapipe on GPU-less machines).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new() -> Result<Gpu, GpuError> {
+        pollster::block_on(Gpu::open())
+    }
+
+    /// [`Gpu::new`] as a future (the browser's adapter: WebGPU's `requestAdapter`, awaited).
+    pub async fn open() -> Result<Gpu, GpuError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter: false,
+                compatible_surface: None,
+                apply_limit_buckets: false,
+            })
+            .await
+            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
         let (device, queue) =
-            pollster::block_on(adapter.request_device(&Gpu::device_descriptor(&adapter))).map_err(|e| GpuError::Device(e.to_string()))?;
+            adapter.request_device(&Gpu::device_descriptor(&adapter)).await.map_err(|e| GpuError::Device(e.to_string()))?;
         Gpu::from_device(device, queue, info)
     }
 
@@ -160,8 +168,18 @@ impl Gpu {
         self.device.features().contains(wgpu::Features::CLIP_DISTANCES)
     }
 
+    /// Waits until the work submitted so far is done (in the browser: yields to the event loop
+    /// under JSPI until it is, [`crate::web`]).
     pub fn wait(&self) {
+        #[cfg(not(target_arch = "wasm32"))]
         let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+        #[cfg(target_arch = "wasm32")]
+        {
+            let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+            let flag = done.clone();
+            self.queue.on_submitted_work_done(move || flag.store(true, std::sync::atomic::Ordering::Release));
+            crate::web::block_until(&done);
+        }
     }
 
     /// Copies a buffer back to the CPU (blocking).
@@ -214,13 +232,22 @@ impl Gpu {
     }
 
     fn map_and_take(&self, staging: &wgpu::Buffer) -> Vec<u8> {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        use std::sync::{Arc, Mutex};
         let slice = staging.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
+        let (done, result) = (Arc::new(AtomicBool::new(false)), Arc::new(Mutex::new(None)));
+        let (flag, slot) = (done.clone(), result.clone());
         slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
+            *slot.lock().unwrap() = Some(r);
+            flag.store(true, Ordering::Release);
         });
+        // natively the device wait runs the callback; the browser runs it from its event loop
+        #[cfg(not(target_arch = "wasm32"))]
         self.wait();
-        rx.recv().expect("map callback").expect("buffer map failed");
+        #[cfg(target_arch = "wasm32")]
+        crate::web::block_until(&done);
+        assert!(done.load(Ordering::Acquire), "map callback");
+        result.lock().unwrap().take().expect("map callback").expect("buffer map failed");
         let data = slice.get_mapped_range().expect("mapped range").to_vec();
         staging.unmap();
         data

@@ -27,5 +27,7 @@ pub mod shaders;
 pub mod technique;
 pub mod techniques;
 pub mod timing;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
 pub use context::{Gpu, GpuError};

@@ -21,7 +21,7 @@
 //! the declared stalls) and one wait, and the frame's times.
 
 use std::collections::BTreeMap;
-use std::time::Instant;
+use web_time::Instant;
 
 use crate::Gpu;
 

@@ -231,6 +231,9 @@ pub struct TechniqueInfo {
     pub stalls: &'static str,
     /// Device features and limits needed beyond WebGPU's defaults (empty: none).
     pub needs: &'static str,
+    /// The most storage buffers one shader stage of it binds (WebGPU's default limit is 8):
+    /// a device that offers fewer cannot run it ([`TechniqueInfo::check_limits`]).
+    pub storage_buffers: u32,
     /// The specs `compare` runs when it is given none, as arguments (`""` = the defaults,
     /// `"pcf=3"` = `name:pcf=3`); empty: not in the default set (the reference, variants the
     /// default set already covers).
@@ -242,6 +245,19 @@ pub struct TechniqueInfo {
 }
 
 impl TechniqueInfo {
+    /// Refuses a device whose limits the technique exceeds, naming the limit (before anything
+    /// is made: a browser's adapter may offer WebGPU's default 8 storage buffers a stage).
+    pub fn check_limits(&self, limits: &wgpu::Limits) -> Result<(), crate::GpuError> {
+        let have = limits.max_storage_buffers_per_shader_stage;
+        if self.storage_buffers > have {
+            return Err(crate::GpuError::Invalid(format!(
+                "'{}' is unavailable on this device: it needs {} storage buffers per shader stage, the device offers {have} (max_storage_buffers_per_shader_stage)",
+                self.name, self.storage_buffers
+            )));
+        }
+        Ok(())
+    }
+
     /// The parameter table, in listing order.
     pub fn params(&self) -> &'static [ParamDef] {
         (self.params.defs)()

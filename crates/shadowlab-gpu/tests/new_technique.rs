@@ -47,6 +47,7 @@ static INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<ThresholdSettings>(),
     stalls: "",
     needs: "",
+    storage_buffers: 8,
     compare: &[],
     shaders,
     create: |gpu, _scene, p, _light| Ok(Box::new(Threshold::new(gpu, &ThresholdSettings::from_values(p)))),

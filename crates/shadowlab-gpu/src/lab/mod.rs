@@ -152,7 +152,7 @@ impl<'a> Lab<'a> {
         if self.time.get() == (t, prev_t) && t.is_finite() {
             return Ok(());
         }
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         self.gscene.set_time(self.gpu, self.scene, t, prev_t)?;
         self.animate_ms.set(t0.elapsed().as_secs_f64() * 1e3);
         self.time.set((t, prev_t));
@@ -274,7 +274,8 @@ impl<'a> Lab<'a> {
     /// [`Lab::step`] (camera paths: techniques that keep state across frames see them in order).
     pub fn instantiate(&self, spec: &Resolved, light: &Light) -> Result<Instance, GpuError> {
         spec.check_light(light)?;
-        let t0 = std::time::Instant::now();
+        spec.info.check_limits(&self.gpu.limits)?;
+        let t0 = web_time::Instant::now();
         let tech = spec.info.create(self.gpu, &self.gscene, &spec.values, light)?;
         self.gpu.take_error()?;
         Ok(Instance {

@@ -33,6 +33,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::NONE,
     stalls: "",
     needs: "9 storage buffers per shader stage (WebGPU default: 8)",
+    storage_buffers: 9,
     compare: &[],
     shaders,
     create: |gpu, scene, _params, _light| Ok(Box::new(RayTraced::new(gpu, scene))),

@@ -54,6 +54,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stalls:
         "with tighten=true (default): csm.readback, the view depth range read back before the fit; tighten=false, or delayed=true (the previous frame's range), records without a stall",
     needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Cascaded::new(gpu, scene, &CsmSettings::from_values(p), light)?)),
@@ -311,13 +312,13 @@ impl Technique for Cascaded {
                 self.reduce.record(gpu, enc, "csm.reduce", f.gbuffer.position_input(), &f.gbuffer.mask);
                 enc.copy_buffer_to_buffer(&self.reduce.result, 0, &self.probe, 0, PROBE_BYTES);
             });
-            let t0 = std::time::Instant::now();
+            let t0 = web_time::Instant::now();
             let words: Vec<u32> = rec.read_buffer_as(&self.probe, 2, "csm.readback");
             rec.cpu("csm.readback", t0.elapsed().as_secs_f64() * 1e3);
             self.depth_range = decode([words[0], words[1]]);
         }
 
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         let view_proj = f.camera.view_proj(f.gbuffer.width, f.gbuffer.height);
         let frustum = ViewFrustum::from_view_proj(view_proj, f.camera.position)
             .ok_or_else(|| GpuError::Invalid("csm: the view's projection is not a perspective frustum".into()))?;

@@ -66,6 +66,7 @@ pub const VSM_INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<VsmSettings>(),
     stalls: "",
     needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| {
@@ -83,6 +84,7 @@ pub const ESM_INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<EsmSettings>(),
     stalls: "",
     needs: "",
+    storage_buffers: 8,
     compare: &[],
     shaders,
     create: |gpu, scene, p, light| {
@@ -100,6 +102,7 @@ pub const EVSM_INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<EvsmSettings>(),
     stalls: "",
     needs: "",
+    storage_buffers: 8,
     compare: &["", "sd=true"],
     shaders,
     create: |gpu, scene, p, light| {
@@ -118,6 +121,7 @@ pub const MSM_INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<MsmSettings>(),
     stalls: "",
     needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| {

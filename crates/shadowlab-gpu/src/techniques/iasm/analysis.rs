@@ -57,7 +57,7 @@ impl AnalysisPass {
 /// The statistics in `stats_buf` and the fit's tail ([`READ_WORDS`]), read back now (the
 /// sync `iasm.readback`, the frame's only one).
 pub(super) fn read_stats(rec: &mut Recorder, stats_buf: &wgpu::Buffer) -> Vec<u32> {
-    let t0 = std::time::Instant::now();
+    let t0 = web_time::Instant::now();
     let words: Vec<u32> = rec.read_buffer_as(stats_buf, READ_WORDS, "iasm.readback");
     rec.cpu("iasm.readback", t0.elapsed().as_secs_f64() * 1e3);
     words

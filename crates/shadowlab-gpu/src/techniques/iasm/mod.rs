@@ -82,6 +82,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<IasmSettings>(),
     stalls: "iasm.readback: the tile statistics are read back for the plan, with fit=view's square (placed on the GPU) in the same readback; delayed=true plans with the previous frame's statistics and square, read back without a stall (a sync only on the first frame, or when the previous frame has not finished)",
     needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Iasm::new(gpu, scene, &IasmSettings::from_values(p), light)?)),

@@ -84,6 +84,7 @@ pub const LT_INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<LtSettings>(),
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
+    storage_buffers: 10,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, &Variant::Lt(LtSettings::from_values(p)), light)?)),
@@ -98,6 +99,7 @@ pub const LTT_INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<LttSettings>(),
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
+    storage_buffers: 10,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, &Variant::Ltt(LttSettings::from_values(p)), light)?)),
@@ -112,6 +114,7 @@ pub const HYBRID_INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<HybridSettings>(),
     stalls: "",
     needs: "10 storage buffers per shader stage (WebGPU default: 8)",
+    storage_buffers: 10,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(LeakTracing::new(gpu, scene, &Variant::HybridPcf(HybridSettings::from_values(p)), light)?)),
@@ -205,7 +208,7 @@ impl LeakTracing {
 impl Technique for LeakTracing {
     /// Cascades: fit this frame's slices, keep or replace each level's box (section 3.3).
     fn prepare(&mut self, _gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         if let Some(c) = self.cascades.as_mut() {
             let dirty = c.update(f, self.res, self.reuse, &mut self.params)?;
             for (l, d) in dirty.into_iter().enumerate() {

@@ -112,6 +112,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<MdsmSettings>(),
     stalls: "",
     needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(MultiDepthMap::new(gpu, scene, &MdsmSettings::from_values(p), light)?)),

@@ -78,6 +78,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<MinSmSettings>(),
     stalls: "min-sm.readback: the band reduction of the view samples is read back for the CPU hull and calipers",
     needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(MinShadowMap::new(gpu, scene, &MinSmSettings::from_values(p), light)?)),
@@ -215,13 +216,13 @@ impl Technique for MinShadowMap {
             }
             enc.copy_buffer_to_buffer(&self.red, 0, &self.staging, 0, self.red.size());
         });
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         rec.sync("min-sm.readback");
         let words = self.read_reduction(gpu)?;
         rec.cpu("min-sm.readback", t0.elapsed().as_secs_f64() * 1e3);
 
         // CPU: hull, calipers, projection
-        let t1 = std::time::Instant::now();
+        let t1 = web_time::Instant::now();
         let red = Reduction::from_words(&words, self.grid as usize, prior);
         self.last_count = red.as_ref().map_or(0, |r| r.count);
         self.prior = red.as_ref().map(|r| (r.lo.y as f32, r.hi.y as f32));

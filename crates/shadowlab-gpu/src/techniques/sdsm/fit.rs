@@ -129,7 +129,7 @@ impl SampleFit {
         self.reduce_params.far = frustum.far;
         rec.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&self.reduce_params));
         let reduced = self.reduce_and_read(gpu, f, rec, c.depth_reduce());
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         self.fit_boxes(c, rec, f, &frustum, reduced);
         rec.cpu("sdsm.fit", t0.elapsed().as_secs_f64() * 1e3);
         Ok(())
@@ -149,7 +149,7 @@ impl SampleFit {
             Reduced { words: prev, source: Source::PreviousFrame, camera: read_camera }
         } else {
             rec.stage("sdsm.analyze", |enc| self.record(gpu, enc, f, depth));
-            let t0 = std::time::Instant::now();
+            let t0 = web_time::Instant::now();
             let w: Vec<u32> = rec.read_buffer_as(&self.out, OUT_WORDS, "sdsm.readback");
             rec.cpu("sdsm.readback", t0.elapsed().as_secs_f64() * 1e3);
             Reduced { words: Some(w), source: Source::ThisFrame, camera: None }

@@ -37,6 +37,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<SdsmSettings>(),
     stalls: "with delayed=false (default): sdsm.readback, the depth range, splits and per-cascade sample bounds read back before the fit; delayed=true (the previous frame's, frame 0 the frustum-slice fit) records without a stall",
     needs: "",
+    storage_buffers: 8,
     // not in the default compare set (its cost is csm's, but the set's time is documented)
     compare: &[""],
     shaders,

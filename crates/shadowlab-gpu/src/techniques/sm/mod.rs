@@ -62,6 +62,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<MapSettings>(),
     stalls: "",
     needs: "",
+    storage_buffers: 8,
     compare: &["", "pcf=3"],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(ShadowMap::new(gpu, scene, &MapSettings::from_values(p), light)?)),

@@ -68,6 +68,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<SvSettings>(),
     stalls: "",
     needs: "12 storage buffers per shader stage (WebGPU default: 8); optional: DEPTH_CLIP_CONTROL (unclipped depth for the infinite extrusion) and DEPTH32FLOAT_STENCIL8, used where offered",
+    storage_buffers: 12,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(ShadowVolumes::new(gpu, scene, &SvSettings::from_values(p), light)?)),

@@ -217,7 +217,14 @@ impl Pipelines {
 
 /// One thread per item in groups of 64, spread over y beyond 65535 groups (the shaders fold
 /// the index back with `num_workgroups`).
-pub fn dispatch_1d(gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str, pipe: &wgpu::ComputePipeline, groups: &[&wgpu::BindGroup], n: u32) {
+pub fn dispatch_1d(
+    gpu: &Gpu,
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipe: &wgpu::ComputePipeline,
+    groups: &[&wgpu::BindGroup],
+    n: u32,
+) {
     if n == 0 {
         return;
     }

@@ -83,6 +83,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: ParamTable::of::<VirtualSettings>(),
     stalls: "virtual.readback: the page requests read back for the CPU allocation (every frame; with resolution_bias=auto once more per quarter step coarser while the pages do not fit the pool)",
     needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(VirtualShadows::new(gpu, scene, &VirtualSettings::from_values(p), light)?)),
@@ -205,7 +206,7 @@ impl Technique for VirtualShadows {
             }
             Auto::Auto => self.mark_auto(gpu, f, rec, &c),
         };
-        let t0 = std::time::Instant::now();
+        let t0 = web_time::Instant::now();
         let (flags, boxes) = probe.split_at(c.table_len());
         // a chunk that moved invalidates the resident pages its old and new boxes cover
         let swept = self.chunks.update(boxes, &c);

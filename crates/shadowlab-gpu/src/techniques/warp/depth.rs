@@ -73,7 +73,13 @@ pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) 
 
 /// The exact-depth pass with the depth test and writes off ([`raster::counting_pipeline`]): the
 /// report counts its fragments, each one inversion of the warp.
-pub(super) fn counting_pipeline(gpu: &Gpu, name: &str, lookup: &wgpu::BindGroupLayout, scene: &SceneBinding, p: &WarpParams) -> wgpu::RenderPipeline {
+pub(super) fn counting_pipeline(
+    gpu: &Gpu,
+    name: &str,
+    lookup: &wgpu::BindGroupLayout,
+    scene: &SceneBinding,
+    p: &WarpParams,
+) -> wgpu::RenderPipeline {
     let label = format!("{name}.exact_depth_count");
     raster::counting_pipeline(gpu, &label, &source(true), &[lookup, &scene.layout], &constants(p, scene.cutouts))
 }
@@ -141,7 +147,11 @@ impl Warped {
     pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
         let (scene_group, triangles) = self.scene.last.as_ref().filter(|_| self.params.exact_depth != 0)?;
         let pipeline = counting_pipeline(gpu, self.name(), &self.lookup_layout, &self.scene, &self.params);
-        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("warp.exact_count"), ty: wgpu::QueryType::Occlusion, count: 1 });
+        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("warp.exact_count"),
+            ty: wgpu::QueryType::Occlusion,
+            count: 1,
+        });
         let resolve = gpu.buffer(&wgpu::BufferDescriptor {
             label: Some("warp.exact_count"),
             size: 8,
