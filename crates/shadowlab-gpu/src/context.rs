@@ -36,8 +36,19 @@ impl Gpu {
         pollster::block_on(Gpu::open())
     }
 
+    /// [`Gpu::new`] with the device descriptor edited by `edit` first (tests: the same adapter
+    /// with a feature left out or a limit lowered).
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn new_with(edit: impl FnOnce(&mut wgpu::DeviceDescriptor<'static>)) -> Result<Gpu, GpuError> {
+        pollster::block_on(Gpu::open_with(edit))
+    }
+
     /// [`Gpu::new`] as a future (the browser's adapter: WebGPU's `requestAdapter`, awaited).
     pub async fn open() -> Result<Gpu, GpuError> {
+        Gpu::open_with(|_| {}).await
+    }
+
+    async fn open_with(edit: impl FnOnce(&mut wgpu::DeviceDescriptor<'static>)) -> Result<Gpu, GpuError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
@@ -49,8 +60,9 @@ impl Gpu {
             .await
             .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
-        let (device, queue) =
-            adapter.request_device(&Gpu::device_descriptor(&adapter)).await.map_err(|e| GpuError::Device(e.to_string()))?;
+        let mut desc = Gpu::device_descriptor(&adapter);
+        edit(&mut desc);
+        let (device, queue) = adapter.request_device(&desc).await.map_err(|e| GpuError::Device(e.to_string()))?;
         Gpu::from_device(device, queue, info)
     }
 

@@ -14,7 +14,7 @@ pub fn scene_pipeline(
     layouts: &[&wgpu::BindGroupLayout],
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
-    scene_pipeline_with(gpu, label, source, layouts, targets, true, &[])
+    pipeline(gpu, label, source, layouts, targets, true, &[], DEPTH_TEST)
 }
 
 /// [`depth_pipeline_with`] with the depth test and writes off: every fragment that its
@@ -38,14 +38,14 @@ pub fn scene_pipeline_constants(
     targets: &[Option<wgpu::ColorTargetState>],
     constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
-    scene_pipeline_with(gpu, label, source, layouts, targets, true, constants)
+    pipeline(gpu, label, source, layouts, targets, true, constants, DEPTH_TEST)
 }
 
 /// A depth-only scene pipeline: with a fragment stage (`fs_main`, the alpha cut-out test) only
 /// where `scene.has_cutouts`; otherwise none, the same depths without fragment shading (llvmpipe
 /// then runs no shader per fragment, as a GL depth pass with an empty fragment shader).
 pub fn depth_pipeline(gpu: &Gpu, label: &str, source: &str, layouts: &[&wgpu::BindGroupLayout], has_cutouts: bool) -> wgpu::RenderPipeline {
-    scene_pipeline_with(gpu, label, source, layouts, &[], has_cutouts, &[])
+    pipeline(gpu, label, source, layouts, &[], has_cutouts, &[], DEPTH_TEST)
 }
 
 /// A depth-only scene pipeline with a fragment stage where `fragment`, and WGSL `override`
@@ -58,20 +58,11 @@ pub fn depth_pipeline_with(
     fragment: bool,
     constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
-    scene_pipeline_with(gpu, label, source, layouts, &[], fragment, constants)
+    pipeline(gpu, label, source, layouts, &[], fragment, constants, DEPTH_TEST)
 }
 
-fn scene_pipeline_with(
-    gpu: &Gpu,
-    label: &str,
-    source: &str,
-    layouts: &[&wgpu::BindGroupLayout],
-    targets: &[Option<wgpu::ColorTargetState>],
-    fragment: bool,
-    constants: &[(&str, f64)],
-) -> wgpu::RenderPipeline {
-    pipeline(gpu, label, source, layouts, targets, fragment, constants, (true, wgpu::CompareFunction::Less))
-}
+/// The depth test of every scene pass: written, nearer wins.
+const DEPTH_TEST: (bool, wgpu::CompareFunction) = (true, wgpu::CompareFunction::Less);
 
 #[allow(clippy::too_many_arguments)]
 fn pipeline(

@@ -137,20 +137,8 @@ fn dpsm_rejects_other_lights() {
 /// The same adapter opened without `CLIP_DISTANCES`: the paraboloid depth passes discard behind
 /// the split plane in a fragment stage instead of clipping there.
 fn gpu_without_clip_distances(gpu: &shadowlab_gpu::Gpu) -> Option<shadowlab_gpu::Gpu> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter =
-        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            ..Default::default()
-        }))
-        .ok()?;
-    if adapter.get_info().name != gpu.info.name {
-        return None;
-    }
-    let mut desc = shadowlab_gpu::Gpu::device_descriptor(&adapter);
-    desc.required_features.remove(wgpu::Features::CLIP_DISTANCES);
-    let (device, queue) = pollster::block_on(adapter.request_device(&desc)).ok()?;
-    shadowlab_gpu::Gpu::from_device(device, queue, adapter.get_info()).ok()
+    let other = shadowlab_gpu::Gpu::new_with(|d| d.required_features.remove(wgpu::Features::CLIP_DISTANCES)).ok()?;
+    (other.info.name == gpu.info.name).then_some(other)
 }
 
 #[test]

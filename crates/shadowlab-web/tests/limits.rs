@@ -16,19 +16,10 @@ use shadowlab_gpu::{registry, Gpu};
 const SWIFTSHADER_ICD: &str = "/usr/lib/chromium/vk_swiftshader_icd.json";
 
 /// The test adapter again, its device limited to `n` storage buffers per shader stage.
-fn gpu_with_storage_buffers(gpu: &Gpu, n: u32) -> Option<Gpu> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter =
-        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            ..Default::default()
-        }))
-        .ok()?;
-    assert_eq!(adapter.get_info().name, gpu.info.name, "the same adapter");
-    let mut desc = Gpu::device_descriptor(&adapter);
-    desc.required_limits.max_storage_buffers_per_shader_stage = n;
-    let (device, queue) = pollster::block_on(adapter.request_device(&desc)).unwrap_or_else(|e| panic!("{n} storage buffers: {e}"));
-    Gpu::from_device(device, queue, adapter.get_info()).ok()
+fn gpu_with_storage_buffers(gpu: &Gpu, n: u32) -> Gpu {
+    let other = Gpu::new_with(|d| d.required_limits.max_storage_buffers_per_shader_stage = n).unwrap_or_else(|e| panic!("{n}: {e}"));
+    assert_eq!(other.info.name, gpu.info.name, "the same adapter");
+    other
 }
 
 /// One frame of `name` on `gpu` (planebox's sun, or room's point light for point-only
@@ -72,7 +63,7 @@ fn each_technique_binds_the_storage_buffers_it_declares() {
         // at its declared limit it runs a frame (above this adapter's most: checked on lavapipe's
         // larger limit by the GPU suite, which runs every technique)
         if n <= max {
-            let at = gpu_with_storage_buffers(&gpu, n).unwrap();
+            let at = gpu_with_storage_buffers(&gpu, n);
             if let Err(e) = frame(&at, name) {
                 wrong.push(format!("{name} fails with its declared {n}: {e}"));
             }
@@ -80,7 +71,7 @@ fn each_technique_binds_the_storage_buffers_it_declares() {
         // one below (or this adapter's most), the lab refuses it by name, and its own layouts
         // overflow: it declares no more than it binds
         if n > 8 {
-            let below = gpu_with_storage_buffers(&gpu, (n - 1).min(max)).unwrap();
+            let below = gpu_with_storage_buffers(&gpu, (n - 1).min(max));
             match info.check_limits(&below.limits) {
                 Err(e) => assert!(e.to_string().contains(&format!("needs {n} storage buffers per shader stage")), "{e}"),
                 Ok(()) => wrong.push(format!("{name}: the lab accepts a device below its {n}")),
