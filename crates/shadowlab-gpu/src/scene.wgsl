@@ -1,6 +1,7 @@
 // Scene data, bind group 1 (scene_gpu.rs): triangles as vertex triples, materials, packed
 // RGBA8 texels of all textures, and the BVH. Triangles `scene_info.dynamic_first..` move
-// (rewritten every frame); their previous-frame positions are `dynamic_prev`; the BVH arrays
+// (rewritten every frame); their previous-frame vertices follow all the current ones in
+// `vertices` (3 * triangle_count onwards, one storage buffer fewer); the BVH arrays
 // hold the static tree (root 0, absent when dynamic_first == 0) and then the dynamic tree
 // (root `scene_info.dynamic_root`, absent when dynamic_first == triangle_count).
 
@@ -24,13 +25,12 @@ struct BvhNode {
 @group(1) @binding(3) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(1) @binding(4) var<storage, read> prim_indices: array<u32>;
 @group(1) @binding(5) var<uniform> scene_info: SceneInfo;
-@group(1) @binding(6) var<storage, read> dynamic_prev: array<vec4<f32>>;
 
 // World position of vertex `vi` in the previous frame (moving objects; others stand still).
 fn previous_position(vi: u32) -> vec3<f32> {
     let first = 3u * scene_info.dynamic_first;
     if vi >= first {
-        return dynamic_prev[vi - first].xyz;
+        return vertices[3u * scene_info.triangle_count + vi - first].pos;
     }
     return vertices[vi].pos;
 }

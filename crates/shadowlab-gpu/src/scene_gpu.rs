@@ -2,8 +2,9 @@
 //! group (group 1 of every pass, `scene.wgsl`).
 //!
 //! Moving objects: triangles `dynamic_first..triangle_count` are rewritten by [`GpuScene::set_time`]
-//! (one `write_buffer` of the dynamic vertex range), their positions at the previous frame go to
-//! `dynamic_prev` (the G-buffer's motion vectors), and a second BVH over the dynamic triangles
+//! (one `write_buffer` of the dynamic vertex range), their vertices at the previous frame go
+//! behind all the current ones in the same buffer (the G-buffer's motion vectors: one storage
+//! buffer fewer a stage, WebGPU's default limit), and a second BVH over the dynamic triangles
 //! only is rebuilt on the CPU (obvhs) and written behind the static one in the same node and
 //! index buffers (fixed capacity: the dynamic triangle count never changes). `occluded()` in
 //! `reference/trace.wgsl` traverses the static tree from node 0, then the dynamic one from
@@ -70,8 +71,6 @@ pub struct GpuScene {
     pub info: SceneInfo,
     nodes: wgpu::Buffer,
     prims: wgpu::Buffer,
-    /// Previous-frame positions of the dynamic vertices (binding 6; one vec4 each).
-    prev: wgpu::Buffer,
     materials: wgpu::Buffer,
     texels: wgpu::Buffer,
     static_prims: u32,
@@ -122,7 +121,10 @@ impl GpuScene {
             })
             .collect();
         let max = gpu.limits.max_storage_buffer_binding_size as usize;
-        let vbytes = std::mem::size_of_val(scene.vertices.as_slice());
+        // the current vertices, then the dynamic ones again: their previous frame's (set_time)
+        let mut all_vertices = scene.vertices.clone();
+        all_vertices.extend_from_slice(&scene.vertices[3 * dynamic_first..]);
+        let vbytes = std::mem::size_of_val(all_vertices.as_slice());
         let dynamic_node_capacity = if dyn_tris > 0 { Bvh::max_nodes(dyn_tris) } else { 0 };
         let node_count = bvh.nodes.len() + dynamic_node_capacity;
         for (what, bytes) in [("vertex data", vbytes), ("texture data", texels.len() * 4), ("BVH", node_count * 32)] {
@@ -132,7 +134,7 @@ impl GpuScene {
         }
         let st = BufferUsages::STORAGE | BufferUsages::COPY_DST;
         let vertices =
-            gpu.buffer_init("scene.vertices", bytemuck::cast_slice(&scene.vertices), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
+            gpu.buffer_init("scene.vertices", bytemuck::cast_slice(&all_vertices), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
         let mats = gpu.buffer_init("scene.materials", bytemuck::cast_slice(&materials), st);
         let tex = gpu.buffer_init("scene.texels", bytemuck::cast_slice(&texels), st);
         // static tree first, then room for the dynamic one (written by `set_time`)
@@ -149,9 +151,8 @@ impl GpuScene {
             _pad: 0,
         };
         let info_buf = gpu.uniform("scene.info", &info);
-        let prev = gpu.storage("scene.dynamic_prev", (dyn_tris * 3 * 16).max(16) as u64);
         let vis = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let mut types = [binding::storage(true); 7];
+        let mut types = [binding::storage(true); 6];
         types[5] = binding::uniform();
         let layout = binding::layout(&gpu.device, "scene", vis, &types);
         let group = binding::group(
@@ -165,7 +166,6 @@ impl GpuScene {
                 nodes.as_entire_binding(),
                 prims.as_entire_binding(),
                 info_buf.as_entire_binding(),
-                prev.as_entire_binding(),
             ],
         );
         let g = GpuScene {
@@ -183,7 +183,6 @@ impl GpuScene {
             info,
             nodes,
             prims,
-            prev,
             materials: mats,
             texels: tex,
             static_prims: bvh.prim_indices.len() as u32,
@@ -222,7 +221,6 @@ impl GpuScene {
             gpu.buffer_init(&format!("{label}.vertices"), bytemuck::cast_slice(tris), st | BufferUsages::VERTEX | BufferUsages::COPY_SRC);
         let nodes = gpu.buffer_init(&format!("{label}.no_bvh"), bytemuck::cast_slice(&[BvhNode::default()]), st);
         let prims = gpu.storage(&format!("{label}.no_prims"), 16);
-        let prev = gpu.storage(&format!("{label}.no_prev"), 16);
         let info = SceneInfo { triangle_count: count, dynamic_first: count, dynamic_root: 0, _pad: 0 };
         let info_buf = gpu.uniform(&format!("{label}.info"), &info);
         let group = binding::group(
@@ -236,7 +234,6 @@ impl GpuScene {
                 nodes.as_entire_binding(),
                 prims.as_entire_binding(),
                 info_buf.as_entire_binding(),
-                prev.as_entire_binding(),
             ],
         );
         GpuScene {
@@ -254,7 +251,6 @@ impl GpuScene {
             info,
             nodes,
             prims,
-            prev,
             materials: self.materials.clone(),
             texels: self.texels.clone(),
             static_prims: 0,
@@ -281,7 +277,7 @@ impl GpuScene {
             return Err(GpuError::Invalid(format!("animation time must be finite (t = {t}, previous {prev_t})")));
         }
         let moved = scene.animated_vertices(t);
-        let prev: Vec<[f32; 4]> = scene.animated_vertices(prev_t).iter().map(|v| Vec3::from(v.pos).extend(1.0).into()).collect();
+        let prev = scene.animated_vertices(prev_t);
         let tris: Vec<[Vec3; 3]> = moved.chunks_exact(3).map(|v| [v[0].pos.into(), v[1].pos.into(), v[2].pos.into()]).collect();
         let dynamic = Bvh::from_triangles(&tris, self.dynamic_first).map_err(GpuError::Invalid)?;
         if dynamic.nodes.len() > self.dynamic_node_capacity {
@@ -295,7 +291,8 @@ impl GpuScene {
         let q = &gpu.queue;
         let vertex_size = std::mem::size_of::<shadowlab_core::scene::Vertex>() as u64;
         q.write_buffer(&self.vertices, self.dynamic_first as u64 * 3 * vertex_size, bytemuck::cast_slice(&moved));
-        q.write_buffer(&self.prev, 0, bytemuck::cast_slice(&prev));
+        // behind every current vertex (scene.wgsl `previous_position`)
+        q.write_buffer(&self.vertices, self.triangle_count as u64 * 3 * vertex_size, bytemuck::cast_slice(&prev));
         let nodes = dynamic.relocated_nodes(self.info.dynamic_root, self.static_prims);
         q.write_buffer(&self.nodes, self.info.dynamic_root as u64 * node_size, bytemuck::cast_slice(&nodes));
         q.write_buffer(&self.prims, self.static_prims as u64 * 4, bytemuck::cast_slice(&dynamic.prim_indices));

@@ -407,19 +407,16 @@ fn lt_params_layout_matches_wgsl() {
     }
 }
 
-/// WebGPU's default limit of storage buffers per shader stage; `TechniqueInfo::needs` must
-/// declare more where a technique's pipelines bind more. The count is the storage buffers a
+/// WebGPU's default limit of storage buffers per shader stage; `TechniqueInfo::needs` and
+/// `storage_buffers` must declare more where a technique's pipelines bind more (the reference,
+/// `rt`, binds 8 since the scene's previous-frame vertices share its vertex buffer). The count is the storage buffers a
 /// module declares (its bind group layouts declare the same bindings, and the limit counts
 /// the layout's bindings, used or not).
 const DEFAULT_STORAGE_BUFFERS: usize = 8;
 
 /// Shader folders (or files) and the registry techniques whose pipelines they are.
-const FOLDERS: &[(&str, &[&str])] = &[
-    ("rt.wgsl", &["rt"]),
-    ("lt", &["lt", "ltt", "hybrid-pcf"]),
-    ("warp", &["rtw", "notw", "notw-dv", "dpsm", "dpsm-notw", "cube-notw"]),
-    ("sv", &["sv"]),
-];
+const FOLDERS: &[(&str, &[&str])] =
+    &[("lt", &["lt", "ltt", "hybrid-pcf"]), ("warp", &["rtw", "notw", "notw-dv", "dpsm", "dpsm-notw", "cube-notw"]), ("sv", &["sv"])];
 
 #[test]
 fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {
@@ -440,6 +437,7 @@ fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {
         for t in shadowlab_gpu::registry::REGISTRY.iter().filter(|t| names.contains(&t.name)) {
             let want = format!("{n} storage buffers per shader stage");
             assert!(t.needs.contains(&want), "{} binds {n} storage buffers ({folder}); its needs say: {:?}", t.name, t.needs);
+            assert_eq!(t.storage_buffers as usize, *n, "{}: TechniqueInfo::storage_buffers", t.name);
         }
     }
     assert_eq!(most.len(), FOLDERS.len(), "a folder of FOLDERS no longer needs more than the default: {most:?}");

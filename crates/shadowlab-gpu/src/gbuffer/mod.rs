@@ -73,6 +73,30 @@ impl GBuffer {
     }
 }
 
+/// The G-buffer's colour targets, in attachment order.
+pub const TARGET_FORMATS: [F; 4] = [POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT, MOTION_FORMAT];
+
+/// Bytes per sample of the G-buffer's colour attachments as WebGPU counts them (each target's
+/// cost, aligned to its component size): 48, above WebGPU's default limit of 32.
+pub fn bytes_per_sample() -> u32 {
+    TARGET_FORMATS.iter().fold(0, |total, f| {
+        let align = f.target_component_alignment().expect("a colour format");
+        total.div_ceil(align) * align + f.target_pixel_byte_cost().expect("a colour format")
+    })
+}
+
+/// Refuses a device whose colour-attachment limit the G-buffer exceeds, naming the limit (a
+/// browser at WebGPU's default limits: nothing can be compared there).
+pub fn check_limits(limits: &wgpu::Limits) -> Result<(), crate::GpuError> {
+    let (need, have) = (bytes_per_sample(), limits.max_color_attachment_bytes_per_sample);
+    if need > have {
+        return Err(crate::GpuError::Invalid(format!(
+            "the G-buffer needs {need} colour attachment bytes per sample, this device offers {have} (max_color_attachment_bytes_per_sample)"
+        )));
+    }
+    Ok(())
+}
+
 /// Pipelines for the G-buffer and mask passes.
 pub struct GBufferPass {
     raster: wgpu::RenderPipeline,
@@ -123,8 +147,7 @@ impl GBufferPass {
         let d = &gpu.device;
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame_layout = binding::layout(d, "gbuffer.frame", vf, &[binding::uniform()]);
-        let targets: Vec<Option<wgpu::ColorTargetState>> =
-            [POSITION_FORMAT, NORMAL_FORMAT, ALBEDO_FORMAT, MOTION_FORMAT].iter().map(|f| Some((*f).into())).collect();
+        let targets: Vec<Option<wgpu::ColorTargetState>> = TARGET_FORMATS.iter().map(|f| Some((*f).into())).collect();
         // nothing to discard: the same fragments survive, without shading the hidden ones
         let discards = flag(scene.has_cutouts || scene.single_sided);
         let raster = raster::scene_pipeline_constants(

@@ -125,6 +125,7 @@ pub struct Run {
 
 impl<'a> Lab<'a> {
     pub fn new(gpu: &'a Gpu, scene: &'a Scene) -> Result<Lab<'a>, GpuError> {
+        crate::gbuffer::check_limits(&gpu.limits)?;
         let bvh = Bvh::build(scene).map_err(GpuError::Invalid)?;
         let gscene = GpuScene::from_scene(gpu, scene, &bvh)?;
         let gbuffer_pass = GBufferPass::new(gpu, &gscene);
