@@ -47,13 +47,23 @@ fn makes_without_error(gpu: &Gpu, name: &str) -> Result<(), String> {
     made.and_then(|_| gpu.take_error().map_err(|e| e.to_string()))
 }
 
-#[test]
-fn each_technique_binds_the_storage_buffers_it_declares() {
+/// Points this process's Vulkan loader at SwiftShader (once, before any device: the two tests
+/// run on threads of one process); false when GPU tests are skipped.
+fn on_swiftshader() -> bool {
+    static ONCE: std::sync::Once = std::sync::Once::new();
     if std::env::var_os("SHADOWLAB_SKIP_GPU_TESTS").is_some() {
-        return;
+        return false;
     }
     assert!(std::path::Path::new(SWIFTSHADER_ICD).exists(), "{SWIFTSHADER_ICD} missing: Debian's chromium package ships it");
-    std::env::set_var("VK_ICD_FILENAMES", SWIFTSHADER_ICD);
+    ONCE.call_once(|| std::env::set_var("VK_ICD_FILENAMES", SWIFTSHADER_ICD));
+    true
+}
+
+#[test]
+fn each_technique_binds_the_storage_buffers_it_declares() {
+    if !on_swiftshader() {
+        return;
+    }
     let gpu = Gpu::new().expect("SwiftShader's Vulkan device");
     assert!(!shadowlab_gpu::quirks::uniforms_as_storage(&gpu.info), "{}", gpu.adapter_summary());
     let max = gpu.limits.max_storage_buffers_per_shader_stage;
@@ -94,11 +104,9 @@ fn each_technique_binds_the_storage_buffers_it_declares() {
 /// reference among them.
 #[test]
 fn techniques_within_the_default_storage_buffers_run_under_webgpus_default_limits() {
-    if std::env::var_os("SHADOWLAB_SKIP_GPU_TESTS").is_some() {
+    if !on_swiftshader() {
         return;
     }
-    assert!(std::path::Path::new(SWIFTSHADER_ICD).exists(), "{SWIFTSHADER_ICD} missing: Debian's chromium package ships it");
-    std::env::set_var("VK_ICD_FILENAMES", SWIFTSHADER_ICD);
     let plain = Gpu::new_with(|d| d.required_limits = wgpu::Limits::default()).expect("SwiftShader at WebGPU's default limits");
     let scene = builtin("planebox").unwrap();
     let refused = Lab::new(&plain, &scene).err().expect("the G-buffer exceeds the default colour limit").to_string();
