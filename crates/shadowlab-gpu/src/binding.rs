@@ -82,7 +82,10 @@ fn bound(r: &wgpu::BindingResource) -> Option<Bound> {
 /// any resource (another view, a resized target) makes the group again. Resources held here
 /// live as long as the cache (its pass) or until replaced.
 #[derive(Default)]
-pub struct GroupCache(std::sync::Mutex<Option<(wgpu::BindGroupLayout, Vec<(u32, Bound)>, wgpu::BindGroup)>>);
+pub struct GroupCache(std::sync::Mutex<Option<Kept>>);
+
+/// A kept group with what it was made of: its layout and its resources by binding.
+type Kept = (wgpu::BindGroupLayout, Vec<(u32, Bound)>, wgpu::BindGroup);
 
 impl GroupCache {
     /// The group of `resources` at bindings 0, 1, ... over `layout`: the kept one when they are

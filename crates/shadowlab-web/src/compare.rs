@@ -68,8 +68,8 @@ pub fn run(gpu: &Gpu, req: &Request) -> Result<(Outcome, Vec<Pictures>), String>
     let light = scene
         .lights
         .get(req.light)
-        .ok_or_else(|| format!("scene '{}' has {} light(s); light {} does not exist", req.scene, scene.lights.len(), req.light))?
-        .clone();
+        .copied()
+        .ok_or_else(|| format!("scene '{}' has {} light(s); light {} does not exist", req.scene, scene.lights.len(), req.light))?;
     if req.width == 0 || req.height == 0 || req.width > MAX_SIDE || req.height > MAX_SIDE {
         return Err(format!("size {}x{} must be between 1x1 and {MAX_SIDE}x{MAX_SIDE}", req.width, req.height));
     }
@@ -88,7 +88,15 @@ pub fn run(gpu: &Gpu, req: &Request) -> Result<(Outcome, Vec<Pictures>), String>
     let mut pictures = Vec::new();
     let mut evaluated = 0;
     for (spec, text) in specs.iter().zip(&req.techniques) {
-        let r = lab.run(&view, spec, 1).map_err(|e| format!("technique '{text}': {e}"))?;
+        let r = lab.run(&view, spec, 1).map_err(|e| {
+            // the lab's own message may name the technique already ("'sv' is unavailable ...")
+            let e = e.to_string();
+            if e.starts_with(&format!("'{}'", spec.name)) {
+                format!("{e} (spec '{text}')")
+            } else {
+                format!("technique '{text}': {e}")
+            }
+        })?;
         let m = compare(&r.visibility, &rt.visibility, &view.mask);
         evaluated = m.evaluated_pixels;
         techniques.push(TechniqueResult {

@@ -46,8 +46,11 @@ pub struct PrefixSum {
     pipeline: wgpu::ComputePipeline,
     /// One uniform and bind group per `ScanParams` seen: a map's scans repeat every frame (no
     /// buffer or bind group per frame, tests/hygiene.rs).
-    uniforms: std::sync::Mutex<std::collections::HashMap<[u32; 8], (wgpu::Buffer, Arc<binding::GroupCache>)>>,
+    uniforms: std::sync::Mutex<std::collections::HashMap<[u32; 8], Scan>>,
 }
+
+/// A scan shape's uniform and its kept bind group.
+type Scan = (wgpu::Buffer, Arc<binding::GroupCache>);
 
 impl PrefixSum {
     pub fn new(gpu: &Gpu) -> PrefixSum {
