@@ -14,7 +14,7 @@ use shadowlab_core::techniques::iasm::fit::snap_divisions;
 use shadowlab_core::techniques::iasm::{light_basis, Placement};
 use shadowlab_core::techniques::sdsm::{step_fractions, SampleBounds, SHRINK_STEPS, SIZE_STEPS_PER_OCTAVE};
 
-use super::plan::STATS_WORDS;
+use super::plan::{FIT_WORDS, STATS_WORDS};
 use crate::record::Recorder;
 use crate::reduce::ORDER_KEY_WGSL;
 use crate::shaders::flag;
@@ -24,9 +24,6 @@ use crate::{binding, Gpu};
 
 const FIT_WGSL: &str = include_str!("fit.wgsl");
 
-/// Words the fit writes after the statistics: a flag (1: fitted, 0: no sample), the square's
-/// origin x, y and side, the samples' bounds x0, y0, x1, y1 (f32 bits) and their count.
-pub(super) const FIT_WORDS: usize = 9;
 
 /// The composed placement shader, listed as `iasm/fit.wgsl`.
 pub(super) fn source() -> String {

@@ -8,9 +8,12 @@ use shadowlab_core::techniques::iasm::{self as core, Placement, THESIS_RESOLUTIO
 
 /// Words of the analysis's statistics (analysis.wgsl): 8 per tile, then the samples outside.
 pub(super) const STATS_WORDS: usize = TILE_COUNT * 8 + 1;
-/// Words read back a frame: the statistics, then `fit=view`'s square (fit.rs, unused
-/// without it).
-pub(super) const READ_WORDS: usize = STATS_WORDS + super::fit::FIT_WORDS;
+/// Words the fit (fit.rs, fit.wgsl) writes after the statistics: a flag (1: fitted, 0: no
+/// sample), the square's origin x, y and side, the samples' bounds x0, y0, x1, y1 (f32 bits)
+/// and their count.
+pub(super) const FIT_WORDS: usize = 9;
+/// Words read back a frame: the statistics, then `fit=view`'s square (unused without it).
+pub(super) const READ_WORDS: usize = STATS_WORDS + FIT_WORDS;
 
 /// What the analysis found per tile.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
