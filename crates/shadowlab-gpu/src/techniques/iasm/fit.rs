@@ -24,7 +24,6 @@ use crate::{binding, Gpu};
 
 const FIT_WGSL: &str = include_str!("fit.wgsl");
 
-
 /// The composed placement shader, listed as `iasm/fit.wgsl`.
 pub(super) fn source() -> String {
     format!("{ORDER_KEY_WGSL}const TAIL: u32 = {STATS_WORDS}u;\n{FIT_WGSL}")

@@ -45,7 +45,8 @@ impl Warped {
         let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size)?;
         let resources = Resources::new(gpu, &plan);
         let pipelines = Pipelines::new(gpu, scene, &plan);
-        let scene = depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None };
+        let scene =
+            depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None, counting: Default::default() };
         Ok(Warped::assemble(plan, resources, pipelines, scene))
     }
 

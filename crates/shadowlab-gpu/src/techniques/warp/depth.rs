@@ -90,6 +90,9 @@ pub(crate) struct SceneBinding {
     pub layout: wgpu::BindGroupLayout,
     pub cutouts: bool,
     pub last: Option<(wgpu::BindGroup, u32)>,
+    /// The report's fragment count: its pipeline, query set and resolve buffer, made on the
+    /// first report and kept (the viewer reports after every evaluation).
+    pub counting: std::sync::OnceLock<(wgpu::RenderPipeline, wgpu::QuerySet, wgpu::Buffer)>,
 }
 
 impl Warped {
@@ -146,17 +149,20 @@ impl Warped {
     /// None without `exact_depth` or before a frame.
     pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
         let (scene_group, triangles) = self.scene.last.as_ref().filter(|_| self.params.exact_depth != 0)?;
-        let pipeline = counting_pipeline(gpu, self.name(), &self.lookup_layout, &self.scene, &self.params);
-        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("warp.exact_count"),
-            ty: wgpu::QueryType::Occlusion,
-            count: 1,
-        });
-        let resolve = gpu.buffer(&wgpu::BufferDescriptor {
-            label: Some("warp.exact_count"),
-            size: 8,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
+        let (pipeline, set, resolve) = self.scene.counting.get_or_init(|| {
+            let pipeline = counting_pipeline(gpu, self.name(), &self.lookup_layout, &self.scene, &self.params);
+            let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("warp.exact_count"),
+                ty: wgpu::QueryType::Occlusion,
+                count: 1,
+            });
+            let resolve = gpu.buffer(&wgpu::BufferDescriptor {
+                label: Some("warp.exact_count"),
+                size: 8,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (pipeline, set, resolve)
         });
         let depth_group = self.depth_group(gpu);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -170,16 +176,16 @@ impl Warped {
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
-                occlusion_query_set: Some(&set),
+                occlusion_query_set: Some(set),
                 multiview_mask: None,
             });
-            pass.set_pipeline(&pipeline);
+            pass.set_pipeline(pipeline);
             pass.begin_occlusion_query(0);
             self.draw_pieces(&mut pass, &depth_group, scene_group, *triangles);
             pass.end_occlusion_query();
         }
-        enc.resolve_query_set(&set, 0..1, &resolve, 0);
+        enc.resolve_query_set(set, 0..1, resolve, 0);
         gpu.submit(enc.finish());
-        Some(gpu.read_buffer_as::<u64>(&resolve, 1)[0])
+        Some(gpu.read_buffer_as::<u64>(resolve, 1)[0])
     }
 }
