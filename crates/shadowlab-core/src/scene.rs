@@ -178,11 +178,21 @@ impl TriangleSink {
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let scale = (p[1] - p[0]).length_squared().max((p[2] - p[0]).length_squared());
         let area2 = n.length_squared();
-        if area2 == 0.0 || area2 <= scale * scale * 1e-14 {
+        let n = if area2.is_finite() && (scale * scale).is_finite() {
+            (area2 != 0.0 && area2 > scale * scale * 1e-14).then(|| n.normalize())
+        } else {
+            // coordinates whose products leave f32's range (edges beyond about 1e9): the same
+            // test in f64 (every ordinary triangle takes the f32 path above, bit for bit)
+            let q = p.map(|v| v.as_dvec3());
+            let n = (q[1] - q[0]).cross(q[2] - q[0]);
+            let scale = (q[1] - q[0]).length_squared().max((q[2] - q[0]).length_squared());
+            let area2 = n.length_squared();
+            (area2 != 0.0 && area2 > scale * scale * 1e-14).then(|| n.normalize().as_vec3())
+        };
+        let Some(n) = n.filter(|n| n.is_finite()) else {
             self.report.degenerate_triangles_skipped += 1;
             return false;
-        }
-        let n = n.normalize();
+        };
         for k in 0..3 {
             self.vertices.push(Vertex { pos: p[k].into(), material, normal: n.into(), _pad0: 0.0, uv: uv[k].into(), _pad1: [0.0; 2] });
         }
@@ -205,6 +215,21 @@ mod tests {
         assert_eq!(s.report.degenerate_triangles_skipped, 1);
         assert_eq!(s.report.nan_triangles_skipped, 1);
         assert_eq!(Vec3::from(s.vertices[0].normal), Vec3::Z);
+    }
+
+    #[test]
+    fn huge_coordinates_get_a_unit_normal_or_are_skipped() {
+        // found by the glTF fuzz target: products beyond f32's range gave NaN normals
+        let mut s = TriangleSink::default();
+        let z = [Vec2::ZERO; 3];
+        let big = 3e38;
+        assert!(s.push([Vec3::new(-big, 0.0, 0.0), Vec3::new(big, 0.0, 0.0), Vec3::new(0.0, big, 0.0)], z, 0));
+        assert!(s.push([Vec3::ZERO, Vec3::X * 1e20, Vec3::Y * 1e20], z, 0));
+        for v in &s.vertices {
+            assert!((Vec3::from(v.normal) - Vec3::Z).length() < 1e-6, "{:?}", v.normal);
+        }
+        assert!(!s.push([Vec3::ZERO, Vec3::X * 1e20, Vec3::X * 2e20], z, 0), "collinear");
+        assert_eq!(s.report.degenerate_triangles_skipped, 1);
     }
 
     #[test]

@@ -23,7 +23,7 @@ use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use gltf::Semantic;
 
-use super::{texture_from_image, LoadError};
+use super::{texture_from_image, Files, LoadError};
 use crate::camera::Camera;
 use crate::scene::{LoadReport, Material, Scene, Texture, TriangleSink};
 
@@ -34,9 +34,9 @@ const MAX_SYNTHETIC_COMPONENTS: usize = 1 << 24;
 /// Node instances visited at most (guards against shared-children blow-ups in invalid files).
 const MAX_NODE_VISITS: usize = 1 << 20;
 
-pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
+pub fn load(files: &dyn Files, path: &Path, m: Mat4) -> Result<Scene, LoadError> {
     let fail = |msg: String| LoadError::invalid(path, msg);
-    let data = std::fs::read(path).map_err(|e| fail(format!("cannot read glTF file: {e}")))?;
+    let data = files.read(path).map_err(|e| fail(format!("cannot read glTF file: {e}")))?;
     if data.is_empty() {
         return Err(fail("empty glTF file".into()));
     }
@@ -47,10 +47,10 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
     precheck(&json).map_err(fail)?;
     let doc = gltf::Document::from_json(json).map_err(|e| fail(format!("{e}")))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let buffers = load_buffers(&doc, &base, blob).map_err(fail)?;
+    let buffers = load_buffers(files, &doc, &base, blob).map_err(fail)?;
 
     let mut warnings = Vec::new();
-    let mut loader = Loader { base: &base, buffers: &buffers, images: HashMap::new(), textures: Vec::new() };
+    let mut loader = Loader { files, base: &base, buffers: &buffers, images: HashMap::new(), textures: Vec::new() };
 
     // Materials: index i is glTF material i; the spec's default material is appended on demand.
     let mut materials = Vec::new();
@@ -226,14 +226,14 @@ fn precheck(json: &gltf::json::Root) -> Result<(), String> {
     Ok(())
 }
 
-fn load_buffers(doc: &gltf::Document, base: &Path, mut blob: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>, String> {
+fn load_buffers(files: &dyn Files, doc: &gltf::Document, base: &Path, mut blob: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>, String> {
     let mut buffers = Vec::new();
     for b in doc.buffers() {
         let data = match b.source() {
             gltf::buffer::Source::Bin => {
                 blob.take().ok_or_else(|| format!("buffers[{}]: refers to the GLB binary chunk, which is missing", b.index()))?
             }
-            gltf::buffer::Source::Uri(uri) => read_uri(uri, base).map_err(|e| format!("buffers[{}]: {e}", b.index()))?.bytes,
+            gltf::buffer::Source::Uri(uri) => read_uri(files, uri, base).map_err(|e| format!("buffers[{}]: {e}", b.index()))?.bytes,
         };
         if data.len() < b.length() {
             return Err(format!("buffers[{}]: declares {} bytes but has {}", b.index(), b.length(), data.len()));
@@ -253,7 +253,7 @@ struct UriData {
 }
 
 /// Bytes of a data URI or of a file relative to `base`.
-fn read_uri(uri: &str, base: &Path) -> Result<UriData, String> {
+fn read_uri(files: &dyn Files, uri: &str, base: &Path) -> Result<UriData, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (meta, payload) = rest.split_once(',').ok_or("malformed data URI (no ',')")?;
         let mime = meta.split(';').next().filter(|s| !s.is_empty()).map(str::to_string);
@@ -272,7 +272,7 @@ fn read_uri(uri: &str, base: &Path) -> Result<UriData, String> {
     };
     let decoded = String::from_utf8(percent_decode(rel)).map_err(|_| format!("URI '{uri}' is not valid UTF-8"))?;
     let path = base.join(decoded);
-    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read '{}': {e}", path.display()))?;
+    let bytes = files.read(&path).map_err(|e| format!("cannot read '{}': {e}", path.display()))?;
     Ok(UriData { bytes, mime: None, file: Some(path) })
 }
 
@@ -525,6 +525,7 @@ fn read_indices(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, S
 }
 
 struct Loader<'a> {
+    files: &'a dyn Files,
     base: &'a Path,
     buffers: &'a [Vec<u8>],
     /// glTF image index -> scene texture index (None: could not be loaded, already warned).
@@ -561,7 +562,7 @@ impl Loader<'_> {
                 (bytes, Some(mime_type.to_string()), None, name)
             }
             gltf::image::Source::Uri { uri, mime_type } => {
-                let UriData { bytes, mime: data_mime, file } = read_uri(uri, self.base)?;
+                let UriData { bytes, mime: data_mime, file } = read_uri(self.files, uri, self.base)?;
                 let name = match &file {
                     Some(p) => p.display().to_string(),
                     None => image.name().map(str::to_string).unwrap_or_else(|| format!("image{} (data URI)", image.index())),

@@ -2,8 +2,11 @@
 //! and `image` crates. Scenes load in the file's own coordinates; the only transform is the
 //! user's [`SceneTransform`] (up axis, uniform scale, offset), recorded in the outputs.
 
+mod files;
 mod gltf_loader;
 mod obj_loader;
+
+pub use files::{Disk, Files, InMemory};
 
 use std::path::Path;
 
@@ -65,14 +68,19 @@ impl SceneTransform {
 /// Loads a scene file by extension, applies `xf`, and gives it a default camera and light
 /// fitted to its bounds (setups normally override both).
 pub fn load(path: &Path, xf: &SceneTransform) -> Result<Scene, LoadError> {
+    load_from(&Disk, path, xf)
+}
+
+/// [`load`], reading `path` and the files it names (MTL, textures, buffers) from `files`.
+pub fn load_from(files: &dyn Files, path: &Path, xf: &SceneTransform) -> Result<Scene, LoadError> {
     if !(xf.scale.is_finite() && xf.scale > 0.0 && xf.offset.is_finite()) {
         return Err(LoadError::invalid(path, "scale must be a positive finite number and offset finite"));
     }
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let m = xf.matrix();
     let mut scene = match ext.as_str() {
-        "gltf" | "glb" => gltf_loader::load(path, m)?,
-        "obj" => obj_loader::load(path, m)?,
+        "gltf" | "glb" => gltf_loader::load(files, path, m)?,
+        "obj" => obj_loader::load(files, path, m)?,
         _ => return Err(LoadError::UnsupportedFormat { path: path.display().to_string() }),
     };
     if scene.vertices.is_empty() {
@@ -82,6 +90,9 @@ pub fn load(path: &Path, xf: &SceneTransform) -> Result<Scene, LoadError> {
     let b = scene.bounds();
     let c = b.center();
     let d = b.diagonal();
+    if !(d.is_finite() && c.is_finite()) {
+        return Err(LoadError::invalid(path, format!("the scene spans more than f32 can hold (bounds {:?} to {:?})", b.min, b.max)));
+    }
     scene.camera = Camera::new(c + Vec3::new(0.6, 0.35, 0.6) * d, c, 55.0, d * 1e-3, d * 3.0);
     scene.lights = vec![Light::Directional { direction: Vec3::new(0.35, -1.0, 0.25) }];
     scene.name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string();

@@ -24,7 +24,7 @@ use std::path::{Component, Path, PathBuf};
 use glam::{Mat4, Vec2, Vec3};
 use image::{DynamicImage, GrayImage};
 
-use super::{texture_from_image, LoadError, MAX_TEXTURE_SIZE};
+use super::{texture_from_image, Files, LoadError, MAX_TEXTURE_SIZE};
 use crate::camera::Camera;
 use crate::scene::{LoadReport, Material, Scene, Texture, TriangleSink};
 
@@ -35,8 +35,8 @@ pub const OBJ_ALPHA_CUTOFF: f32 = 0.5;
 /// At most this many MTL syntax warnings per file are listed (then a count).
 const MAX_MTL_WARNINGS: usize = 8;
 
-pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
-    let bytes = std::fs::read(path).map_err(|e| LoadError::invalid(path, format!("cannot open OBJ file: {e}")))?;
+pub fn load(files: &dyn Files, path: &Path, m: Mat4) -> Result<Scene, LoadError> {
+    let bytes = files.read(path).map_err(|e| LoadError::invalid(path, format!("cannot open OBJ file: {e}")))?;
     if bytes.is_empty() {
         return Err(LoadError::invalid(path, "empty OBJ file"));
     }
@@ -45,21 +45,21 @@ pub fn load(path: &Path, m: Mat4) -> Result<Scene, LoadError> {
     check_face_indices(&bytes).map_err(|e| LoadError::invalid(path, e))?;
     let obj_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
 
-    let mtl = RefCell::new(MtlState::default());
+    let mtl = RefCell::new(MtlState { files, materials: Vec::new(), warnings: Vec::new() });
     // more fields exist when tobj's `merging`/`reordering` features are on
     #[allow(clippy::needless_update)]
     let options =
         tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true, ..Default::default() };
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &options, |lib| mtl.borrow_mut().load_lib(&obj_dir, lib))
         .map_err(|e| LoadError::invalid(path, located(&bytes, &options, &e)))?;
-    let MtlState { materials: mtl_materials, warnings } = mtl.into_inner();
+    let MtlState { materials: mtl_materials, warnings, .. } = mtl.into_inner();
 
     if models.iter().all(|md| md.mesh.indices.is_empty()) {
         return Err(LoadError::invalid(path, "OBJ file has no faces"));
     }
 
     // Materials: one per MTL material (tobj's material ids index this list), default last.
-    let mut textures = TextureCache::default();
+    let mut textures = TextureCache::new(files);
     let mut materials: Vec<Material> = mtl_materials.iter().map(|mm| build_material(mm, &obj_dir, &mut textures)).collect();
     let mut default_material: Option<u32> = None;
 
@@ -187,33 +187,33 @@ struct MtlMaterial {
     dir: PathBuf,
 }
 
-#[derive(Default)]
-struct MtlState {
+struct MtlState<'f> {
+    files: &'f dyn Files,
     /// All materials of all `mtllib`s, in the order tobj numbers them.
     materials: Vec<MtlMaterial>,
     warnings: Vec<String>,
 }
 
-impl MtlState {
+impl MtlState<'_> {
     /// tobj's material loader: parses one `mtllib` statement's file(s). Never fails (a missing
     /// or unreadable MTL is a warning), so that the geometry still loads.
     fn load_lib(&mut self, obj_dir: &Path, lib: &Path) -> tobj::MTLLoadResult {
         let lib_str = lib.to_string_lossy();
         // `mtllib a.mtl b.mtl` is legal; a single name with spaces is common too.
         let mut names = vec![lib_str.to_string()];
-        if resolve_path(&lib_str, &[obj_dir.to_path_buf()]).is_none() && lib_str.contains(char::is_whitespace) {
+        if resolve_path(self.files, &lib_str, &[obj_dir.to_path_buf()]).is_none() && lib_str.contains(char::is_whitespace) {
             names = lib_str.split_whitespace().map(str::to_string).collect();
         }
         let mut tobj_materials = Vec::new();
         let mut map: Vec<(String, usize)> = Vec::new();
         for name in names {
-            let Some(file) = resolve_path(&name, &[obj_dir.to_path_buf()]) else {
+            let Some(file) = resolve_path(self.files, &name, &[obj_dir.to_path_buf()]) else {
                 self.warnings.push(format!(
                     "material library '{name}' not found next to the OBJ file; its materials are replaced by the default material"
                 ));
                 continue;
             };
-            let text = match std::fs::read(&file) {
+            let text = match self.files.read(&file) {
                 Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
                 Err(e) => {
                     self.warnings.push(format!("material library '{}' cannot be read ({e}); using the default material", file.display()));
@@ -333,58 +333,58 @@ fn strip_map_options(s: &str) -> &str {
 
 /// Finds `rel` (an MTL/OBJ path, possibly with Windows separators or in the wrong case) under
 /// one of `dirs`; as a last resort, looks for the bare file name there.
-fn resolve_path(rel: &str, dirs: &[PathBuf]) -> Option<PathBuf> {
+fn resolve_path(files: &dyn Files, rel: &str, dirs: &[PathBuf]) -> Option<PathBuf> {
     let rel = rel.trim().trim_matches('"').replace('\\', "/");
     if rel.is_empty() {
         return None;
     }
     let p = Path::new(&rel);
-    if p.is_absolute() && p.is_file() {
+    if p.is_absolute() && files.is_file(p) {
         return Some(p.to_path_buf());
     }
     for dir in dirs {
         let q = dir.join(p);
-        if q.is_file() {
+        if files.is_file(&q) {
             return Some(q);
         }
     }
     for dir in dirs {
-        if let Some(q) = find_case_insensitive(dir, p) {
+        if let Some(q) = find_case_insensitive(files, dir, p) {
             return Some(q);
         }
     }
     let file_name = p.file_name()?;
-    dirs.iter().map(|d| d.join(file_name)).find(|q| q.is_file())
+    dirs.iter().map(|d| d.join(file_name)).find(|q| files.is_file(q))
 }
 
-fn find_case_insensitive(dir: &Path, rel: &Path) -> Option<PathBuf> {
+fn find_case_insensitive(files: &dyn Files, dir: &Path, rel: &Path) -> Option<PathBuf> {
     let mut cur = if dir.as_os_str().is_empty() { PathBuf::from(".") } else { dir.to_path_buf() };
     for comp in rel.components() {
         match comp {
             Component::Normal(name) => {
                 let direct = cur.join(name);
-                if direct.exists() {
+                if files.exists(&direct) {
                     cur = direct;
                     continue;
                 }
                 let want = name.to_string_lossy().to_lowercase();
-                let entry = std::fs::read_dir(&cur)
+                cur = files
+                    .list(&cur)
                     .ok()?
-                    .filter_map(Result::ok)
-                    .find(|e| e.file_name().to_string_lossy().to_lowercase() == want)?;
-                cur = entry.path();
+                    .into_iter()
+                    .find(|e| e.file_name().is_some_and(|n| n.to_string_lossy().to_lowercase() == want))?;
             }
             Component::ParentDir => cur.push(".."),
             Component::CurDir => {}
             _ => return None,
         }
     }
-    cur.is_file().then_some(cur)
+    files.is_file(&cur).then_some(cur)
 }
 
 /// Decoded source images and finished textures, shared by all materials of one load.
-#[derive(Default)]
-struct TextureCache {
+struct TextureCache<'f> {
+    files: &'f dyn Files,
     images: HashMap<PathBuf, Option<DynamicImage>>,
     /// (map_Kd file, map_d file) -> texture index.
     combined: HashMap<(Option<PathBuf>, Option<PathBuf>), u32>,
@@ -392,10 +392,14 @@ struct TextureCache {
     warnings: Vec<String>,
 }
 
-impl TextureCache {
+impl<'f> TextureCache<'f> {
+    fn new(files: &'f dyn Files) -> Self {
+        TextureCache { files, images: HashMap::new(), combined: HashMap::new(), textures: Vec::new(), warnings: Vec::new() }
+    }
+
     /// Resolves and decodes a `map_*` file; None (with one warning per file) when it cannot be used.
     fn image(&mut self, material: &str, rel: &str, dirs: &[PathBuf]) -> Option<(PathBuf, DynamicImage)> {
-        let Some(path) = resolve_path(rel, dirs) else {
+        let Some(path) = resolve_path(self.files, rel, dirs) else {
             self.warnings.push(format!(
                 "material '{material}': texture '{rel}' not found (looked in {}); the material is untextured",
                 dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
@@ -403,7 +407,7 @@ impl TextureCache {
             return None;
         };
         if !self.images.contains_key(&path) {
-            let decoded = decode_image(&path);
+            let decoded = decode_image(self.files, &path);
             if let Err(e) = &decoded {
                 self.warnings.push(format!(
                     "material '{material}': texture '{}' cannot be decoded ({e}); the material is untextured",
@@ -417,13 +421,14 @@ impl TextureCache {
     }
 }
 
-fn decode_image(path: &Path) -> Result<DynamicImage, String> {
-    image::ImageReader::open(path)
-        .map_err(|e| e.to_string())?
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?
-        .decode()
-        .map_err(|e| e.to_string())
+/// Decodes an image by its content, else by its file name's extension.
+fn decode_image(files: &dyn Files, path: &Path) -> Result<DynamicImage, String> {
+    let bytes = files.read(path).map_err(|e| e.to_string())?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes[..]));
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    reader.with_guessed_format().map_err(|e| e.to_string())?.decode().map_err(|e| e.to_string())
 }
 
 /// The map_d image as one alpha byte per texel: its alpha channel if it has one, else its luminance.
@@ -436,7 +441,7 @@ fn alpha_of(img: &DynamicImage) -> GrayImage {
     }
 }
 
-fn build_material(mm: &MtlMaterial, obj_dir: &Path, cache: &mut TextureCache) -> Material {
+fn build_material(mm: &MtlMaterial, obj_dir: &Path, cache: &mut TextureCache<'_>) -> Material {
     let mut dirs = vec![mm.dir.clone()];
     if mm.dir != obj_dir {
         dirs.push(obj_dir.to_path_buf());
