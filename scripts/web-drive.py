@@ -144,6 +144,11 @@ def main():
         cdp.call("Page.enable", session=session)
         for i, q in enumerate(a.queries):
             t0 = time.time()
+            if q.startswith("eval:"):
+                # a script for the page (window.shadowlab.loseDevice()), not a run
+                value = cdp.evaluate(session, q[len("eval:"):], True, a.timeout)
+                out.append({"query": q, "value": value})
+                continue
             if i == 0:
                 cdp.call("Page.navigate", {"url": f"{base}?{q}"}, session)
                 title = ""

@@ -1,7 +1,7 @@
 // shadowlab's page: the form, the automation contract (docs/web.md) and the pictures. The work
 // runs in Rust (pkg/shadowlab_web.js, built by `make web`); `run` is a JSPI export, so it
 // returns a promise while the GPU's waits suspend inside it.
-import init, { open, run, picture, catalogue } from './pkg/shadowlab_web.js';
+import init, { open, run, picture, catalogue, lose_device } from './pkg/shadowlab_web.js';
 
 const $ = (id) => document.getElementById(id);
 let catalog = { techniques: [], scenes: [] };
@@ -114,8 +114,14 @@ async function go(params) {
   status(`Running ${req.techniques.join(', ') || '(nothing)'} on ${req.scene} at ${req.width}x${req.height}...`);
   let out;
   try {
-    const text = await run(JSON.stringify(req));
-    out = JSON.parse(text);
+    out = JSON.parse(await run(JSON.stringify(req)));
+    if (out.lost) {
+      // the device was lost (a GPU reset, a frozen tab): open a new one and run again, once
+      status(`${out.error}: opening the GPU again...`);
+      adapterLabel = await describeAdapter(await open());
+      out = JSON.parse(await run(JSON.stringify(req)));
+      if (!out.error) out.recovered = true;
+    }
     if (out.adapter !== undefined) out.adapter = adapterLabel;
   } catch (e) {
     // a panic in Rust: its message (globalThis.shadowlabPanic) says more than the trap
@@ -149,7 +155,8 @@ async function main() {
     go(requestFromForm());
   };
   // for drivers: window.shadowlab.run('scene=courtyard&t=sm&size=256x256') resolves to the result
-  window.shadowlab = { run: (query) => go(new URLSearchParams(query)) };
+  // and window.shadowlab.loseDevice() destroys the device, as a GPU reset would (for tests)
+  window.shadowlab = { run: (query) => go(new URLSearchParams(query)), loseDevice: () => lose_device() };
   const params = new URLSearchParams(location.search);
   showForm(requestFrom(params.has('scene') ? params : new URLSearchParams('scene=courtyard&t=sm&t=csm&t=lt')));
   try {

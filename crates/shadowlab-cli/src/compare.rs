@@ -42,7 +42,7 @@ pub fn render(args: &RunArgs, out: &Path) -> Result<()> {
 }
 
 pub fn compare(args: &RunArgs, out: &Path, export_raw: bool) -> Result<()> {
-    anyhow::ensure!(args.frames >= 1, "--frames must be at least 1");
+    shadowlab_gpu::lab::path::check_frames(args.frames)?;
     let cfg = resolve(args, &shadowlab_gpu::registry::default_compare())?;
     // before any work: never replace what shadowlab did not write
     crate::output::check_target(out)?;

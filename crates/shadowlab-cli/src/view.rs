@@ -51,14 +51,49 @@ pub struct ViewArgs {
     /// Set a parameter of technique A at a frame: FRAME:KEY=VALUE (repeatable; scripted runs)
     #[arg(long = "set-at")]
     pub set_at: Vec<String>,
+    /// Run this many seconds, then exit (scripted runs, long sessions)
+    #[arg(long)]
+    pub exit_after_s: Option<f64>,
+    /// Technique A becomes the next of these specs every --cycle-every frames (repeatable;
+    /// scripted runs)
+    #[arg(long = "cycle")]
+    pub cycle: Vec<String>,
+    /// Frames between --cycle steps
+    #[arg(long, default_value_t = 0)]
+    pub cycle_every: usize,
+    /// Turn the light about the vertical axis by this many degrees at each --cycle step
+    #[arg(long, default_value_t = 0.0)]
+    pub light_turn: f32,
+    /// Print the resident memory every this many seconds (scripted runs: `memory:` lines)
+    #[arg(long)]
+    pub memory_every: Option<f64>,
+    /// Destroy the GPU device before frame N, as a driver reset would (tests the viewer's
+    /// handling of a lost device: it saves the view and exits with a message)
+    #[arg(long, hide = true)]
+    pub lose_device_at: Option<usize>,
 }
 
 pub fn view(args: &ViewArgs) -> Result<()> {
-    if args.screenshot.is_some() && args.exit_after.is_none() {
+    if args.screenshot.is_some() && args.exit_after.is_none() && args.exit_after_s.is_none() {
         bail!("--screenshot writes the last frame of a scripted run: give --exit-after N too (or press F12 in the window)");
     }
     if args.exit_after == Some(0) {
         bail!("--exit-after must be at least 1");
+    }
+    if args.exit_after_s.is_some_and(|s| !(s.is_finite() && s > 0.0)) {
+        bail!("--exit-after-s must be a positive number of seconds");
+    }
+    if !args.cycle.is_empty() && args.cycle_every == 0 {
+        bail!("--cycle changes technique A every --cycle-every N frames: give N (at least 1)");
+    }
+    if args.cycle.is_empty() && (args.cycle_every > 0 || args.light_turn != 0.0) {
+        bail!("--cycle-every and --light-turn act at --cycle steps: give --cycle SPEC (repeatable)");
+    }
+    for spec in &args.cycle {
+        shadowlab_view::widgets::resolve_text(spec).map_err(|e| anyhow!("--cycle {spec}: {e}"))?;
+    }
+    if !args.light_turn.is_finite() || args.memory_every.is_some_and(|s| !(s.is_finite() && s > 0.0)) {
+        bail!("--light-turn must be a finite number of degrees and --memory-every a positive number of seconds");
     }
     if !args.orbit.is_finite() {
         bail!("--orbit {}: must be a finite number of degrees", args.orbit);
@@ -105,6 +140,12 @@ pub fn view(args: &ViewArgs) -> Result<()> {
             orbit_deg: args.orbit,
             orbit_frames: args.orbit_frames,
             set_at,
+            lose_device_at: args.lose_device_at,
+            exit_after_s: args.exit_after_s,
+            cycle: args.cycle.clone(),
+            cycle_every: args.cycle_every,
+            light_turn_deg: args.light_turn,
+            memory_every_s: args.memory_every,
         },
         setup,
         scene: cfg.scene,

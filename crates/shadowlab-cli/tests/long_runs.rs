@@ -92,3 +92,18 @@ fn coincident_triangles_run_through_every_default_technique() {
     assert!(m["reference"]["evaluated_pixels"].as_u64().unwrap() > 0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A frame count of 0 or above the path limit is refused before anything is made, naming the
+/// limit (each frame keeps its figures, so a run's memory and metrics.json are bounded).
+#[test]
+fn a_frame_count_over_the_limit_is_refused_first() {
+    for (cmd, n) in [("compare", "100001"), ("compare", "0"), ("sweep", "100001")] {
+        let out = tmp(&format!("frames-{cmd}-{n}"));
+        let t0 = std::time::Instant::now();
+        let o = run(&[cmd, "--scene", "planebox", "-t", "sm", "--frames", n, "--out", out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(&format!("--frames {n}")) && err.contains("100000"), "{cmd} --frames {n}: {err}");
+        assert!(!out.exists(), "{cmd} wrote {} before refusing", out.display());
+        assert!(t0.elapsed().as_secs_f64() < 10.0, "refused late");
+    }
+}

@@ -123,3 +123,95 @@ fn the_window_renders_under_xvfb() {
     assert!(hi - lo > 150, "dark and bright pixels: luma {lo}..{hi}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A lost device (forced: `--lose-device-at` destroys it, as a driver reset would) ends the
+/// viewer with one message naming the loss and how to reopen the view, saved as a setup; no
+/// panic, no frozen window.
+#[test]
+fn a_lost_device_saves_the_view_and_says_so() {
+    if skip_gpu() {
+        return;
+    }
+    let dir = tmp("lost");
+    let out = Command::new("timeout")
+        .args(["120", "xvfb-run", "-a", "-s", "-screen 0 1280x800x24"])
+        .arg(env!("CARGO_BIN_EXE_shadowlab"))
+        .args([
+            "view",
+            "--scene",
+            "planebox",
+            "-t",
+            "sm:pcf=3",
+            "--size",
+            "160x120",
+            "--exit-after",
+            "40",
+            "--orbit",
+            "2",
+            "--lose-device-at",
+            "4",
+        ])
+        .arg("--out")
+        .arg(&dir)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(1), "stdout: {stdout}\nstderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(stdout.contains("frame 4: destroying the GPU device"), "{stdout}");
+    assert!(stderr.contains("the GPU device was lost (destroyed)") && stderr.contains("shadowlab view --setup"), "{stderr}");
+    let saved: Vec<_> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
+    assert_eq!(saved.len(), 1, "{saved:?}");
+    assert!(stderr.contains(&saved[0].display().to_string()), "{stderr}");
+    let setup = shadowlab_core::setup::Setup::load(&saved[0]).unwrap();
+    setup.validate().unwrap();
+    let specs: Vec<_> = setup.techniques.iter().map(|t| t.spec.as_str()).collect();
+    assert_eq!(specs, ["sm:pcf=3"]);
+    // the camera orbited before the loss: the saved view is where the window was, not the start
+    let start = shadowlab_core::builtin::builtin("planebox").unwrap().camera;
+    assert_ne!(setup.camera.unwrap().position, start.position);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A scripted session that switches techniques and turns the light (every technique and the
+/// reference are made again for each light) keeps its resident memory: after two rounds of the
+/// cycle, the end is within 10 % (the 10-minute run: BENCHMARKS.md, scripts/long-session.sh).
+#[test]
+fn a_long_session_keeps_its_memory() {
+    if skip_gpu() {
+        return;
+    }
+    let dir = tmp("long");
+    let out = Command::new("timeout")
+        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 1280x800x24"])
+        .arg(env!("CARGO_BIN_EXE_shadowlab"))
+        .args(["view", "--scene", "planebox", "-t", "sm", "--size", "160x120", "--exit-after", "160", "--orbit", "1.5"])
+        .args(["--cycle", "sm", "--cycle", "vsm:res=512", "--cycle", "lt:res=512", "--cycle", "sm:pcf=3", "--cycle-every", "4"])
+        .args(["--light-turn", "9", "--memory-every", "0.25"])
+        .arg("--out")
+        .arg(&dir)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "stdout: {stdout}\nstderr: {stderr}");
+    // "memory: t=1.2 s, frame 40, resident 210.3 MiB, technique A ..."
+    let samples: Vec<(usize, f64)> = stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("memory: "))
+        .map(|l| {
+            let frame = l.split("frame ").nth(1).unwrap().split(',').next().unwrap().parse().unwrap();
+            let mib = l.split("resident ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+            (frame, mib)
+        })
+        .collect();
+    assert!(samples.len() >= 4, "{stdout}");
+    assert!(stdout.contains("technique A lt:res=512"), "the cycle ran: {stdout}");
+    let warm = samples.iter().find(|(f, _)| *f >= 32).expect("a sample after two rounds").1;
+    let end = samples.last().unwrap();
+    assert_eq!(end.0, 160, "{stdout}");
+    assert!(end.1 <= warm * 1.10, "resident {:.1} MiB at the end against {warm:.1} MiB after two rounds: {samples:?}", end.1);
+    let _ = std::fs::remove_dir_all(&dir);
+}

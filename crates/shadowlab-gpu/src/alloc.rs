@@ -20,8 +20,6 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-use wgpu::util::DeviceExt;
-
 use crate::Gpu;
 
 /// Idle buffers a pool keeps; more are dropped.
@@ -62,6 +60,25 @@ fn give(pool: &Mutex<Vec<wgpu::Buffer>>, buf: wgpu::Buffer) {
     }
 }
 
+/// Why a buffer of `size` bytes with `usage` cannot be made on a device with `limits`: over
+/// its largest buffer, or a storage buffer over its largest storage binding (shadowlab binds
+/// storage buffers whole). The message names the buffer, both sizes and the limit.
+pub fn over_limit(limits: &wgpu::Limits, label: &str, size: u64, usage: wgpu::BufferUsages) -> Option<String> {
+    let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+    let (limit, name) = if usage.contains(wgpu::BufferUsages::STORAGE) && size > limits.max_storage_buffer_binding_size {
+        (limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")
+    } else if size > limits.max_buffer_size {
+        (limits.max_buffer_size, "max_buffer_size")
+    } else {
+        return None;
+    };
+    Some(format!(
+        "'{label}' needs {:.2} MiB, over this device's {name} of {:.2} MiB: use a smaller output size or map resolution",
+        mib(size),
+        mib(limit)
+    ))
+}
+
 impl Gpu {
     /// Buffers created through this device wrapper so far.
     pub fn buffers_created(&self) -> u64 {
@@ -96,16 +113,41 @@ impl Gpu {
         self.device.create_bind_group(desc)
     }
 
-    /// A new buffer (counted).
+    /// A new buffer (counted). One over the device's limits is refused ([`Gpu::refuse`],
+    /// named with the limit); the device then makes no memory for it.
     pub fn buffer(&self, desc: &wgpu::BufferDescriptor) -> wgpu::Buffer {
         self.alloc.buffers.fetch_add(1, Ordering::Relaxed);
+        if let Some(msg) = over_limit(&self.limits, desc.label.unwrap_or("buffer"), desc.size, desc.usage) {
+            self.refuse(msg);
+            // an empty stand-in: what is recorded with it fails validation, reported after the refusal
+            return self.device.create_buffer(&wgpu::BufferDescriptor { size: 4, mapped_at_creation: false, ..*desc });
+        }
         self.device.create_buffer(desc)
     }
 
-    /// A new buffer with its contents (counted).
+    /// A new buffer with its contents (counted; refused as [`Gpu::buffer`] over the limits).
+    /// Written through its mapping at creation, as `wgpu::util::DeviceExt::create_buffer_init`
+    /// does, except that a buffer the device could not make (a lost device) is reported by
+    /// [`Gpu::take_error`] rather than a panic.
     pub fn buffer_desc_init(&self, desc: &wgpu::util::BufferInitDescriptor) -> wgpu::Buffer {
         self.alloc.buffers.fetch_add(1, Ordering::Relaxed);
-        self.device.create_buffer_init(desc)
+        let len = desc.contents.len() as u64;
+        let size = len.div_ceil(wgpu::COPY_BUFFER_ALIGNMENT).max(1) * wgpu::COPY_BUFFER_ALIGNMENT;
+        if let Some(msg) = over_limit(&self.limits, desc.label.unwrap_or("buffer"), size, desc.usage) {
+            self.refuse(msg);
+            let stand_in = wgpu::BufferDescriptor { label: desc.label, size: 4, usage: desc.usage, mapped_at_creation: false };
+            return self.device.create_buffer(&stand_in);
+        }
+        let buf =
+            self.device.create_buffer(&wgpu::BufferDescriptor { label: desc.label, size, usage: desc.usage, mapped_at_creation: true });
+        match buf.slice(..).get_mapped_range_mut() {
+            Ok(mut range) => range.slice(..desc.contents.len()).copy_from_slice(desc.contents),
+            Err(e) => {
+                self.errors_push(crate::GpuError::Validation(format!("'{}' could not be written: {e}", desc.label.unwrap_or("buffer"))))
+            }
+        }
+        buf.unmap();
+        buf
     }
 
     /// A mapped `COPY_SRC` buffer of at least `size` bytes (from the pool, or new). Give it

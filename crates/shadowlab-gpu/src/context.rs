@@ -10,6 +10,8 @@ pub enum GpuError {
     Invalid(String),
     #[error("GPU error: {0}")]
     Validation(String),
+    #[error("the GPU device was lost ({0})")]
+    DeviceLost(String),
 }
 
 /// Pipeline constants of a technique's analysis variant of its evaluation (`view.wgsl`).
@@ -22,7 +24,10 @@ pub struct Gpu {
     pub limits: wgpu::Limits,
     /// Stage times come from GPU timestamps (else wall clock with a device wait); see `timing`.
     pub gpu_timestamps: bool,
-    errors: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+    /// The device's errors and shadowlab's refusals ([`Gpu::refuse`]), oldest first.
+    errors: std::sync::Arc<std::sync::Mutex<Vec<GpuError>>>,
+    /// Why the device was lost (a driver reset, a backgrounded browser tab, `destroy`), once it is.
+    lost: std::sync::Arc<std::sync::Mutex<Option<String>>>,
     /// Queue submissions made through [`Gpu::submit`] (tests count a frame's submits).
     submits: std::sync::atomic::AtomicU64,
     /// The buffer counter and the upload / readback pools (alloc.rs).
@@ -97,8 +102,18 @@ impl Gpu {
         let gpu_timestamps = device.features().contains(ts) && crate::timing::want_timestamps(&info)?;
         let errors = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let sink = errors.clone();
-        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(e.to_string())));
-        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors, submits: Default::default(), alloc: Default::default() })
+        device
+            .on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| sink.lock().unwrap().push(GpuError::Validation(e.to_string()))));
+        let lost = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let why = lost.clone();
+        device.set_device_lost_callback(move |reason, msg| {
+            let reason = match reason {
+                wgpu::DeviceLostReason::Destroyed => "destroyed",
+                _ => "driver reset or unknown cause",
+            };
+            *why.lock().unwrap() = Some(if msg.is_empty() { reason.to_string() } else { format!("{reason}: {msg}") });
+        });
+        Ok(Gpu { device, queue, info, limits, gpu_timestamps, errors, lost, submits: Default::default(), alloc: Default::default() })
     }
 
     /// Submits one command buffer (every submit of shadowlab goes through here and is counted).
@@ -112,11 +127,31 @@ impl Gpu {
         self.submits.load(std::sync::atomic::Ordering::Relaxed)
     }
 
-    /// Returns the first GPU validation/out-of-memory error raised since the last call.
+    /// Records a refusal (a resource over the device's limits): [`Gpu::take_error`] returns it
+    /// before any error the device raises because of it.
+    pub fn refuse(&self, msg: String) {
+        self.errors_push(GpuError::Invalid(msg));
+    }
+
+    pub(crate) fn errors_push(&self, e: GpuError) {
+        self.errors.lock().unwrap().push(e);
+    }
+
+    /// Why the device was lost, once it is: nothing made on it works any more; a host makes a
+    /// new [`Gpu`] (and `Lab`) or says so and stops.
+    pub fn lost(&self) -> Option<String> {
+        self.lost.lock().unwrap().clone()
+    }
+
+    /// Returns the device's loss, else the first refusal or GPU validation/out-of-memory error
+    /// raised since the last call.
     pub fn take_error(&self) -> Result<(), GpuError> {
-        let first = self.errors.lock().unwrap().drain(..).next();
-        match first {
-            Some(msg) => Err(GpuError::Validation(msg)),
+        if let Some(why) = self.lost() {
+            self.errors.lock().unwrap().clear();
+            return Err(GpuError::DeviceLost(why));
+        }
+        match self.errors.lock().unwrap().drain(..).next() {
+            Some(e) => Err(e),
             None => Ok(()),
         }
     }
@@ -190,7 +225,7 @@ impl Gpu {
             let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
             let flag = done.clone();
             self.queue.on_submitted_work_done(move || flag.store(true, std::sync::atomic::Ordering::Release));
-            crate::web::block_until(&done);
+            crate::web::block_until(&done, || self.lost().is_some());
         }
     }
 
@@ -201,7 +236,7 @@ impl Gpu {
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
         self.submit(enc.finish());
-        let mut bytes = self.map_and_take(&staging);
+        let mut bytes = self.map_and_take(&staging, size as usize);
         self.give_readback(staging);
         bytes.truncate(size as usize);
         bytes
@@ -209,7 +244,7 @@ impl Gpu {
 
     /// Maps a `MAP_READ` buffer whose copy was already submitted, and reads `count` values.
     pub fn map_read_as<T: bytemuck::Pod>(&self, staging: &wgpu::Buffer, count: usize) -> Vec<T> {
-        let bytes = self.map_and_take(staging);
+        let bytes = self.map_and_take(staging, count * std::mem::size_of::<T>());
         bytemuck::pod_collect_to_vec(&bytes[..count * std::mem::size_of::<T>()])
     }
 
@@ -234,7 +269,7 @@ impl Gpu {
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         self.submit(enc.finish());
-        let data = self.map_and_take(&staging);
+        let data = self.map_and_take(&staging, (padded * h) as usize);
         self.give_readback(staging);
         let mut out = Vec::with_capacity((row * h) as usize);
         for y in 0..h as usize {
@@ -243,7 +278,10 @@ impl Gpu {
         out
     }
 
-    fn map_and_take(&self, staging: &wgpu::Buffer) -> Vec<u8> {
+    /// The bytes of a mapped readback (at least `len`). When the map fails (a buffer refused
+    /// over a limit, a lost device) `len` zero bytes, and the failure is reported by
+    /// [`Gpu::take_error`], which every caller asks before using what it read.
+    fn map_and_take(&self, staging: &wgpu::Buffer, len: usize) -> Vec<u8> {
         use std::sync::atomic::{AtomicBool, Ordering};
         use std::sync::{Arc, Mutex};
         let slice = staging.slice(..);
@@ -257,11 +295,22 @@ impl Gpu {
         #[cfg(not(target_arch = "wasm32"))]
         self.wait();
         #[cfg(target_arch = "wasm32")]
-        crate::web::block_until(&done);
-        assert!(done.load(Ordering::Acquire), "map callback");
-        result.lock().unwrap().take().expect("map callback").expect("buffer map failed");
+        crate::web::block_until(&done, || self.lost().is_some());
+        let mapped = match result.lock().unwrap().take() {
+            Some(r) => r.map_err(|e| e.to_string()),
+            None => Err("the device was lost before the map completed".to_string()),
+        };
+        if let Err(e) = mapped {
+            self.errors_push(GpuError::Validation(format!("reading back {len} bytes failed: {e}")));
+            return vec![0; len];
+        }
         let data = slice.get_mapped_range().expect("mapped range").to_vec();
         staging.unmap();
+        if data.len() < len {
+            // the stand-in of a readback refused over a limit (`Gpu::buffer`)
+            self.errors_push(GpuError::Validation(format!("reading back {len} bytes from a buffer of {}", data.len())));
+            return vec![0; len];
+        }
         data
     }
 

@@ -183,6 +183,11 @@ impl<'a> Recorder<'a> {
             return;
         }
         let size = (data.len() as u64).div_ceil(4) * 4;
+        if offset + size > buf.size() {
+            // a buffer refused over a limit is a 4-byte stand-in (`Gpu::buffer`)
+            self.gpu.refuse(format!("a write of {} bytes at offset {offset} does not fit its buffer of {} bytes", data.len(), buf.size()));
+            return;
+        }
         let staging = self.gpu.upload(size);
         {
             let mut view = staging.slice(..size).get_mapped_range_mut().expect("an upload buffer is mapped until its copy is recorded");

@@ -20,9 +20,10 @@ fn next_turn() -> js_sys::Promise {
     })
 }
 
-/// Yields to the event loop (suspending under JSPI) until `done` is set.
-pub fn block_until(done: &AtomicBool) {
-    while !done.load(Ordering::Acquire) {
+/// Yields to the event loop (suspending under JSPI) until `done` is set, or `give_up` says
+/// it never will be (a lost device).
+pub fn block_until(done: &AtomicBool, give_up: impl Fn() -> bool) {
+    while !done.load(Ordering::Acquire) && !give_up() {
         #[allow(deprecated)] // js-sys marks its JSPI support experimental
         js_sys::futures::jspi_block_on_promise(&next_turn()).expect("a zero timeout resolves");
     }

@@ -16,6 +16,7 @@ mod host;
 mod hygiene;
 mod iasm;
 mod iasm_fit;
+mod limits;
 mod lt;
 mod mdsm;
 mod min_sm;

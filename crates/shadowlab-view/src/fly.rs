@@ -4,6 +4,7 @@
 
 use glam::{Quat, Vec3};
 use shadowlab_core::camera::Camera;
+use shadowlab_core::light::Light;
 
 /// One frame's fly input: movement axes in -1..1 and mouse look in radians.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -59,6 +60,19 @@ pub fn orbit(cam: &Camera, deg: f32) -> Camera {
     let mut c = *cam;
     c.position = cam.target + Quat::from_rotation_y(deg.to_radians()) * (cam.position - cam.target);
     c
+}
+
+/// Turns the light about the vertical axis by `deg` degrees: a sun's direction, a point or spot
+/// light's position about the vertical through `about` (a spot's direction turns with it).
+pub fn turn_light(light: &Light, deg: f32, about: Vec3) -> Light {
+    let q = Quat::from_rotation_y(deg.to_radians());
+    match *light {
+        Light::Directional { direction } => Light::Directional { direction: q * direction },
+        Light::Point { position } => Light::Point { position: about + q * (position - about) },
+        Light::Spot { position, direction, cone_deg } => {
+            Light::Spot { position: about + q * (position - about), direction: q * direction, cone_deg }
+        }
+    }
 }
 
 /// Where a directional light travels, from the sun's azimuth (degrees from +X towards +Z) and

@@ -40,10 +40,11 @@ mod browser {
     }
 
     /// Opens the browser's WebGPU adapter and device; resolves to the adapter's description.
+    /// Once the device is lost (a GPU reset, a tab the browser froze), opens a new one.
     #[wasm_bindgen]
     pub async fn open() -> Result<String, JsValue> {
         report_panics();
-        if let Some(gpu) = GPU.with(|g| *g.borrow()) {
+        if let Some(gpu) = GPU.with(|g| *g.borrow()).filter(|g| g.lost().is_none()) {
             return Ok(gpu.adapter_summary());
         }
         let gpu: &'static Gpu = Box::leak(Box::new(Gpu::open().await.map_err(|e| JsValue::from_str(&e.to_string()))?));
@@ -52,17 +53,31 @@ mod browser {
     }
 
     /// Runs the request (JSON of `compare::Request`) and returns the outcome's JSON, or
-    /// `{"error": MESSAGE}`. Needs `open` first.
+    /// `{"error": MESSAGE}`; `"lost": true` beside it when the device was lost (the page then
+    /// calls `open` again, which makes a new one, and repeats the run). Needs `open` first.
     #[wasm_bindgen(jspi)]
     pub fn run(request: String) -> String {
+        let gpu = GPU.with(|g| *g.borrow());
         let result = (|| {
-            let gpu = GPU.with(|g| *g.borrow()).ok_or("the GPU is not open (call open first)")?;
+            let gpu = gpu.ok_or("the GPU is not open (call open first)")?;
+            if let Some(why) = gpu.lost() {
+                return Err(format!("the GPU device was lost ({why})"));
+            }
             let req: Request = serde_json::from_str(&request).map_err(|e| format!("bad request: {e}"))?;
             let (outcome, pictures) = compare::run(gpu, &req)?;
             PICTURES.with(|p| *p.borrow_mut() = pictures);
             serde_json::to_string(&outcome).map_err(|e| e.to_string())
         })();
-        result.unwrap_or_else(|e: String| serde_json::json!({ "error": e }).to_string())
+        let lost = gpu.is_some_and(|g| g.lost().is_some());
+        result.unwrap_or_else(|e: String| serde_json::json!({ "error": e, "lost": lost }).to_string())
+    }
+
+    /// Destroys the device, as a GPU reset would (tests the page's recovery).
+    #[wasm_bindgen]
+    pub fn lose_device() {
+        if let Some(gpu) = GPU.with(|g| *g.borrow()) {
+            gpu.device.destroy();
+        }
     }
 
     /// Technique `index`'s picture of the last run, RGBA8: `"shaded"` or `"error"` (empty if

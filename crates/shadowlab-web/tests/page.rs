@@ -49,6 +49,8 @@ fn the_page_gives_the_native_numbers_and_stays_usable_after_a_bad_spec() {
         .arg(format!("scene=courtyard{first}&size=256x256&run=1"))
         .arg("scene=courtyard&t=nosuch&size=256x256")
         .arg("scene=courtyard&t=sm&size=64x64")
+        .arg("eval:window.shadowlab.loseDevice()")
+        .arg("scene=courtyard&t=sm&size=64x64")
         .output()
         .expect("python3 scripts/web-drive.py");
     assert!(o.status.success(), "web-drive failed: {}", String::from_utf8_lossy(&o.stderr));
@@ -80,6 +82,12 @@ fn the_page_gives_the_native_numbers_and_stays_usable_after_a_bad_spec() {
     assert_eq!(again["title"], "shadowlab: done", "the page still runs after an error: {again}");
     assert_eq!(again["result"]["techniques"][0]["label"], "sm");
 
-    assert_eq!(runs[3]["blank"], false, "the screenshot ({}) shows the page's pictures", shot.display());
+    // a lost device: the page opens a new one and repeats the run, with the same figures
+    let recovered = &runs[4];
+    assert_eq!(recovered["title"], "shadowlab: done", "after a lost device: {recovered}");
+    assert_eq!(recovered["result"]["recovered"], true, "{recovered}");
+    assert_eq!(recovered["result"]["techniques"][0]["wrong_pct"], again["result"]["techniques"][0]["wrong_pct"]);
+
+    assert_eq!(runs[5]["blank"], false, "the screenshot ({}) shows the page's pictures", shot.display());
     let _ = std::fs::remove_file(&shot);
 }

@@ -53,9 +53,7 @@ fn progress(quiet: bool, len: u64) -> ProgressBar {
 /// Runs a sweep and writes its directory; returns what sweep.json holds.
 pub fn sweep(a: &SweepArgs) -> Result<Sweep> {
     let t0 = std::time::Instant::now();
-    if a.frames == 0 {
-        bail!("--frames must be at least 1");
-    }
+    shadowlab_gpu::lab::path::check_frames(a.frames)?;
     if a.repeat == 0 {
         bail!("--repeat must be at least 1");
     }

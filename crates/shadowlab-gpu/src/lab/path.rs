@@ -42,6 +42,21 @@ pub struct PathSpec<'a> {
     pub repeat: usize,
 }
 
+/// Frames one camera path may have: each keeps its figures (a record per technique, about a
+/// kilobyte with its stage times, and a line of metrics.json), so a run's memory and output
+/// are bounded; longer studies run as several paths.
+pub const MAX_FRAMES: usize = 100_000;
+
+/// Refuses a frame count of 0 or above [`MAX_FRAMES`], naming the limit.
+pub fn check_frames(frames: usize) -> Result<(), GpuError> {
+    if frames == 0 || frames > MAX_FRAMES {
+        return Err(GpuError::Invalid(format!(
+            "--frames {frames}: must be between 1 and {MAX_FRAMES} (each frame keeps its figures; run a longer study as several paths)"
+        )));
+    }
+    Ok(())
+}
+
 /// The cameras of `frames` frames: the camera itself for one, else along the keyframes `keys`
 /// ([`path_cameras`]; the camera holds still without keys).
 pub fn cameras(camera: &Camera, keys: &[CameraKey], frames: usize) -> Vec<Camera> {
@@ -157,9 +172,7 @@ impl Lab<'_> {
     /// Runs the reference and `p.specs` over the frames of `p.cameras` (see the module's docs).
     pub fn run_path(&self, p: &PathSpec, progress: &mut dyn FnMut(Progress)) -> Result<PathRun, PathError> {
         let frames = p.cameras.len();
-        if frames == 0 {
-            return Err(GpuError::Invalid("a camera path needs at least one camera".into()).into());
-        }
+        check_frames(frames)?;
         let (warm_up, timed) = if frames == 1 { (true, p.repeat) } else { (false, 1) };
         let light = &p.light;
         let mut rt_inst = self.instantiate(&registry::reference(), light)?;

@@ -51,6 +51,9 @@ pub(crate) fn run(opts: Options) -> anyhow::Result<()> {
 
 impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        if let Some(why) = self.gpu.lost() {
+            state::exit_on_loss(&why);
+        }
         if self.closing {
             return;
         }

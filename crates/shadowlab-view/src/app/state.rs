@@ -14,7 +14,7 @@ use shadowlab_core::setup::Setup;
 use shadowlab_gpu::lab::Lab;
 use shadowlab_gpu::Gpu;
 
-use crate::fly::{fly, orbit, FlyInput};
+use crate::fly::{fly, orbit, turn_light, FlyInput};
 use crate::render::{FrameInfo, Look, Pose, Renderer, Right};
 use crate::script::Script;
 use crate::{session, widgets, Options};
@@ -28,6 +28,47 @@ const LOOK_PER_POINT: f32 = 0.005;
 
 pub const CONTROLS_W: f32 = 300.0;
 pub const HUD_W: f32 = 300.0;
+
+/// What the window showed after its last frame, for [`exit_on_loss`].
+struct LastView {
+    setup: Setup,
+    camera: Camera,
+    light: Light,
+    time: f32,
+    size: (u32, u32),
+    specs: Vec<String>,
+    out_dir: std::path::PathBuf,
+    frames: usize,
+}
+
+static LAST_VIEW: Mutex<Option<LastView>> = Mutex::new(None);
+
+/// The device is lost (a driver reset, a GPU removed, `--lose-device-at`): nothing made on it
+/// works again, and egui's painter cannot continue on it. Saves the last view as a setup, says
+/// so in one message with the command that reopens it, and exits with status 1. Called at the
+/// start of each frame and, for a loss in the middle of one (egui's painter panics on a lost
+/// device), from the panic hook [`App::new`] installs.
+pub fn exit_on_loss(why: &str) -> ! {
+    let last = LAST_VIEW.lock().unwrap_or_else(|e| e.into_inner()).take();
+    let msg = match last {
+        Some(v) => {
+            let s = session::snapshot(&v.setup, &v.camera, &v.light, v.time, v.size.0, v.size.1, &v.specs);
+            let saved = session::to_toml(&s)
+                .and_then(|t| session::write_fresh(&v.out_dir, "view", "toml", t.as_bytes()).map_err(|e| e.to_string()));
+            match saved {
+                Ok(p) => format!(
+                    "the GPU device was lost ({why}) after {} frames; the view is saved: `shadowlab view --setup {}` reopens it",
+                    v.frames,
+                    p.display()
+                ),
+                Err(e) => format!("the GPU device was lost ({why}) after {} frames; the view could not be saved: {e}", v.frames),
+            }
+        }
+        None => format!("the GPU device was lost ({why}) before the first frame"),
+    };
+    eprintln!("error: {msg}");
+    std::process::exit(1);
+}
 
 /// The debug pictures of the current evaluation, as egui textures.
 #[derive(Default)]
@@ -74,7 +115,7 @@ pub(crate) struct App {
     script: Script,
     frames: usize,
     /// Every frame's time (ms), and the window's frame period (ms, frame to frame, egui and
-    /// presentation included), for the scripted run's summary.
+    /// presentation included), for the scripted run's summary (kept in scripted runs only).
     all_frame_ms: Vec<f64>,
     all_period_ms: Vec<f64>,
     last_moving: bool,
@@ -83,6 +124,8 @@ pub(crate) struct App {
     current_after: Option<(f64, usize)>,
     /// A scripted run has asked the window to close.
     pub closing: bool,
+    /// When (seconds after the start) the last `memory:` line was printed.
+    memory_printed: f64,
     dragging_divider: bool,
     pub debug: DebugPictures,
     /// A scripted run's failure, returned by [`run`] once the window is closed.
@@ -95,6 +138,13 @@ impl App {
         let gpu: &'static Gpu = Box::leak(Box::new(Gpu::from_device(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info())?));
         let scene = Box::leak(Box::new(opts.scene));
         let lab = Lab::new(gpu, scene)?;
+        let default_hook = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if let Some(why) = gpu.lost() {
+                exit_on_loss(&why);
+            }
+            default_hook(info)
+        }));
         let (w, h) = opts.size.unwrap_or((640, 480));
         let r = Renderer::new(lab, w, h, &opts.light, opts.a, opts.b.clone())?;
         let extent = scene.bounds().diagonal().max(1e-3);
@@ -137,6 +187,7 @@ impl App {
             still_since: None,
             current_after: None,
             closing: false,
+            memory_printed: 0.0,
             dragging_divider: false,
             debug: Default::default(),
             fatal,
@@ -249,6 +300,31 @@ impl App {
         if self.script.orbit_deg != 0.0 && self.script.orbit_frames.is_none_or(|n| self.frames < n) {
             self.camera = orbit(&self.camera, self.script.orbit_deg);
         }
+        if self.script.lose_device_at == Some(self.frames) {
+            println!("frame {}: destroying the GPU device (--lose-device-at)", self.frames);
+            self.gpu.device.destroy();
+        }
+        if let Some(spec) = self.script.cycle_step(self.frames).map(str::to_string) {
+            if self.script.light_turn_deg != 0.0 {
+                self.light = turn_light(&self.light, self.script.light_turn_deg, self.camera.target);
+            }
+            self.set_spec(false, Some(&spec));
+            if let Some(e) = self.error.take() {
+                self.fail(format!("--cycle {spec} at frame {}: {e}", self.frames));
+            }
+        }
+        if let Some(every) = self.script.memory_every_s {
+            let t = self.started.elapsed().as_secs_f64();
+            if self.frames == 0 || t >= self.memory_printed + every {
+                self.memory_printed = t;
+                let rss = crate::script::resident_mib().map_or("n/a".to_string(), |m| format!("{m:.1}"));
+                println!(
+                    "memory: t={t:.1} s, frame {}, resident {rss} MiB, technique A {}",
+                    self.frames,
+                    self.r.technique(false).expect("A").text
+                );
+            }
+        }
         let changes: Vec<(String, String)> = self.script.changes_at(self.frames).map(|(k, v)| (k.to_string(), v.to_string())).collect();
         for (k, v) in changes {
             match self.set_param(false, &k, &v) {
@@ -256,6 +332,23 @@ impl App {
                 Err(e) => self.fail(format!("--set-at {}:{k}={v}: {e}", self.frames)),
             }
         }
+    }
+
+    /// Keeps what [`exit_on_loss`] saves current (after every frame).
+    fn remember_view(&self) {
+        let (w, h) = self.r.size();
+        let view = LastView {
+            setup: self.setup.clone(),
+            camera: self.camera,
+            light: self.light,
+            time: self.time,
+            size: (w, h),
+            specs: self.specs(),
+            out_dir: self.out_dir.clone(),
+            // this frame is rendered; `scripted_end` counts it after
+            frames: self.frames + 1,
+        };
+        *LAST_VIEW.lock().unwrap_or_else(|e| e.into_inner()) = Some(view);
     }
 
     fn fail(&mut self, e: String) {
@@ -266,8 +359,12 @@ impl App {
     /// After the frame: count it, and end a scripted run once it has rendered its frames.
     fn scripted_end(&mut self, ui: &egui::Ui) {
         self.frames += 1;
-        let Some(n) = self.script.exit_after else { return };
-        if self.closing || (self.frames < n && self.fatal.lock().expect("not poisoned").is_none()) {
+        if !self.script.is_scripted() {
+            return;
+        }
+        let due = self.script.exit_after.is_some_and(|n| self.frames >= n)
+            || self.script.exit_after_s.is_some_and(|s| self.started.elapsed().as_secs_f64() >= s);
+        if self.closing || (!due && self.fatal.lock().expect("not poisoned").is_none()) {
             return;
         }
         self.closing = true;
@@ -286,6 +383,15 @@ impl App {
             v.sort_by(f64::total_cmp);
             v.get(v.len() / 2).copied().unwrap_or(0.0)
         };
+        if self.script.memory_every_s.is_some() {
+            let rss = crate::script::resident_mib().map_or("n/a".to_string(), |m| format!("{m:.1}"));
+            let t = self.started.elapsed().as_secs_f64();
+            println!(
+                "memory: t={t:.1} s, frame {}, resident {rss} MiB, technique A {} (end)",
+                self.frames,
+                self.r.technique(false).expect("A").text
+            );
+        }
         let (frame_ms, period_ms) = (median(&self.all_frame_ms), median(&self.all_period_ms));
         let current = match self.current_after {
             Some((t, n)) => format!("; reference current {t:.0} ms after the camera stopped ({n} frames)"),
@@ -315,7 +421,7 @@ impl App {
         let picture = egui::Rect::from_center_size(avail.center(), egui::vec2(w as f32 * scale, h as f32 * scale));
         let now = Instant::now();
         let period = now.duration_since(self.last_frame);
-        if self.frames > 0 && self.last_moving {
+        if self.frames > 0 && self.last_moving && self.script.is_scripted() {
             // frame to frame while the camera moves (still frames add reference bands)
             self.all_period_ms.push(period.as_secs_f64() * 1e3);
         }
@@ -352,15 +458,23 @@ impl App {
                 while self.frame_times.front().is_some_and(|f| f[0] < t - PLOT_S) {
                     self.frame_times.pop_front();
                 }
-                self.all_frame_ms.push(info.frame_ms);
+                if self.script.is_scripted() {
+                    self.all_frame_ms.push(info.frame_ms);
+                }
                 self.track_stillness(still, &info, changed);
                 if info.recreated {
                     self.status = "light moved: every technique and the reference were created again for it (maps, lt's history and iasm's pages are per light)".into();
                 }
                 self.info = Some(info);
             }
-            Err(e) => self.error = Some(e.to_string()),
+            Err(e) => {
+                if let Some(why) = self.gpu.lost() {
+                    exit_on_loss(&why);
+                }
+                self.error = Some(e.to_string())
+            }
         }
+        self.remember_view();
         self.last_pose = Some(pose);
         self.prev_camera = self.camera;
         self.prev_time = self.time;

@@ -53,7 +53,11 @@ pub(super) fn plan(gpu: &Gpu, scene: &GpuScene, p: &IasmSettings, light: &Light)
     };
     let texels = core::texels(&THESIS_RESOLUTIONS);
     if texels * 4 > gpu.limits.max_storage_buffer_binding_size {
-        return Err(GpuError::Invalid("iasm shadow buffer exceeds this device's storage binding limit".into()));
+        return Err(GpuError::Invalid(format!(
+            "iasm: its shadow buffer needs {:.1} MiB, over this device's max_storage_buffer_binding_size of {:.1} MiB",
+            (texels * 4) as f64 / (1u64 << 20) as f64,
+            gpu.limits.max_storage_buffer_binding_size as f64 / (1u64 << 20) as f64
+        )));
     }
     let chunk = p.chunk.max(1);
     let (right, up, dir) = core::light_basis(direction);

@@ -157,6 +157,15 @@ fn subdivision_capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64) -> R
     let on = k.subdiv > 0.0;
     let auto = (8 * tris as u64).max(1 << 21);
     let wanted = if k.subdiv_capacity > 0 { k.subdiv_capacity as u64 } else { auto };
+    // an asked-for capacity is given or refused; the automatic one takes what the device holds
+    let most = limit.saturating_sub(tris as u64);
+    if on && k.subdiv_capacity > 0 && wanted > most {
+        return Err(GpuError::Invalid(format!(
+            "{name}: subdiv_capacity={wanted} needs {:.1} MiB of pieces (16 bytes each), over this device's max_storage_buffer_binding_size of {:.1} MiB: at most {most} here",
+            (wanted * 16) as f64 / (1u64 << 20) as f64,
+            max_binding as f64 / (1u64 << 20) as f64
+        )));
+    }
     // at least one per triangle: the root finishes up to one extra piece per triangle (the
     // second half of a triangle cut by the near plane) before any level can check
     let extra = if on { wanted.max(tris as u64).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
