@@ -84,6 +84,21 @@ fn a_saved_view_reproduces_its_numbers_in_compare() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `shadowlab view ARGS --out DIR` under Xvfb, killed after `timeout_s` seconds.
+fn view_under_xvfb(args: &[&str], dir: &std::path::Path, timeout_s: u32) -> std::process::Output {
+    Command::new("timeout")
+        .arg(timeout_s.to_string())
+        .args(["xvfb-run", "-a", "-s", "-screen 0 1280x800x24"])
+        .arg(env!("CARGO_BIN_EXE_shadowlab"))
+        .arg("view")
+        .args(args)
+        .arg("--out")
+        .arg(dir)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn the_window_renders_under_xvfb() {
     if skip_gpu() {
@@ -93,17 +108,9 @@ fn the_window_renders_under_xvfb() {
     assert!(xvfb.is_ok(), "xvfb-run not found: `make setup` (scripts/setup.sh) installs xvfb for this test");
     let dir = tmp("smoke");
     let shot = dir.join("last.png");
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1280x800x24"])
-        .arg(env!("CARGO_BIN_EXE_shadowlab"))
-        .args(["view", "--scene", "planebox", "-t", "sm", "--size", "160x120", "--exit-after", "6", "--orbit", "4", "--set-at", "3:pcf=3"])
-        .arg("--screenshot")
-        .arg(&shot)
-        .arg("--out")
-        .arg(&dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
+    let shot_arg = shot.to_str().unwrap();
+    let args = ["--scene", "planebox", "-t", "sm", "--size", "160x120", "--exit-after", "6", "--orbit", "4", "--set-at", "3:pcf=3"];
+    let out = view_under_xvfb(&[&args[..], &["--screenshot", shot_arg]].concat(), &dir, 300);
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "stdout: {stdout}\nstderr: {stderr}");
     assert!(stdout.contains("frame 3: technique A is now sm:pcf=3"), "{stdout}");
@@ -133,29 +140,9 @@ fn a_lost_device_saves_the_view_and_says_so() {
         return;
     }
     let dir = tmp("lost");
-    let out = Command::new("timeout")
-        .args(["120", "xvfb-run", "-a", "-s", "-screen 0 1280x800x24"])
-        .arg(env!("CARGO_BIN_EXE_shadowlab"))
-        .args([
-            "view",
-            "--scene",
-            "planebox",
-            "-t",
-            "sm:pcf=3",
-            "--size",
-            "160x120",
-            "--exit-after",
-            "40",
-            "--orbit",
-            "2",
-            "--lose-device-at",
-            "4",
-        ])
-        .arg("--out")
-        .arg(&dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
+    let args =
+        ["--scene", "planebox", "-t", "sm:pcf=3", "--size", "160x120", "--exit-after", "40", "--orbit", "2", "--lose-device-at", "4"];
+    let out = view_under_xvfb(&args, &dir, 120);
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert_eq!(out.status.code(), Some(1), "stdout: {stdout}\nstderr: {stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
@@ -184,17 +171,13 @@ fn a_long_session_keeps_its_memory() {
         return;
     }
     let dir = tmp("long");
-    let out = Command::new("timeout")
-        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 1280x800x24"])
-        .arg(env!("CARGO_BIN_EXE_shadowlab"))
-        .args(["view", "--scene", "planebox", "-t", "sm", "--size", "160x120", "--exit-after", "160", "--orbit", "1.5"])
-        .args(["--cycle", "sm", "--cycle", "vsm:res=512", "--cycle", "lt:res=512", "--cycle", "sm:pcf=3", "--cycle-every", "4"])
-        .args(["--light-turn", "9", "--memory-every", "0.25"])
-        .arg("--out")
-        .arg(&dir)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
+    let args = [
+        ["--scene", "planebox", "-t", "sm", "--size", "160x120", "--exit-after", "160", "--orbit", "1.5"].as_slice(),
+        &["--cycle", "sm", "--cycle", "vsm:res=512", "--cycle", "lt:res=512", "--cycle", "sm:pcf=3", "--cycle-every", "4"],
+        &["--light-turn", "9", "--memory-every", "0.25"],
+    ]
+    .concat();
+    let out = view_under_xvfb(&args, &dir, 300);
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "stdout: {stdout}\nstderr: {stderr}");
     // "memory: t=1.2 s, frame 40, resident 210.3 MiB, technique A ..."

@@ -43,13 +43,14 @@ pub fn load(files: &dyn Files, path: &Path, m: Mat4) -> Result<Scene, LoadError>
     let slice = if data.starts_with(b"glTF") { check_glb_header(&data).map_err(fail)? } else { &data[..] };
     let gltf = gltf::Gltf::from_slice_without_validation(slice).map_err(|e| fail(format!("invalid glTF: {e}")))?;
     let blob = gltf.blob;
-    let json = gltf.document.into_json();
+    let mut json = gltf.document.into_json();
     precheck(&json).map_err(fail)?;
+    let repaired = repair_images(&mut json);
     let doc = gltf::Document::from_json(json).map_err(|e| fail(format!("{e}")))?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let buffers = load_buffers(files, &doc, &base, blob).map_err(fail)?;
 
-    let mut warnings = Vec::new();
+    let mut warnings = repaired;
     let mut loader = Loader { files, base: &base, buffers: &buffers, images: HashMap::new(), textures: Vec::new() };
 
     // Materials: index i is glTF material i; the spec's default material is appended on demand.
@@ -209,6 +210,24 @@ fn check_glb_header(data: &[u8]) -> Result<&[u8], String> {
 
 /// Checks the gltf crate's validation would index without bounds checks (it indexes
 /// `accessors[POSITION]` directly).
+/// Images the spec forbids but the `gltf` crate would panic on (`Image::source` unwraps): one
+/// with neither `uri` nor `bufferView` gets an empty URI (it then fails to load: a warning, the
+/// material untextured), one with a `bufferView` and no `mimeType` an unknown type (its format
+/// is guessed from its bytes). Found by the glTF fuzz target. Returns the warnings.
+fn repair_images(json: &mut gltf::json::Root) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for (i, image) in json.images.iter_mut().enumerate() {
+        if image.buffer_view.is_some() && image.mime_type.is_none() {
+            image.mime_type = Some(gltf::json::image::MimeType("application/octet-stream".into()));
+            warnings.push(format!("images[{i}]: a bufferView without mimeType; its format is guessed from its bytes"));
+        } else if image.buffer_view.is_none() && image.uri.is_none() {
+            image.uri = Some(String::new());
+            warnings.push(format!("images[{i}]: neither uri nor bufferView"));
+        }
+    }
+    warnings
+}
+
 fn precheck(json: &gltf::json::Root) -> Result<(), String> {
     for (mi, mesh) in json.meshes.iter().enumerate() {
         for (pi, prim) in mesh.primitives.iter().enumerate() {
