@@ -178,18 +178,21 @@ impl TriangleSink {
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let scale = (p[1] - p[0]).length_squared().max((p[2] - p[0]).length_squared());
         let area2 = n.length_squared();
-        let n = if area2.is_finite() && (scale * scale).is_finite() {
-            (area2 != 0.0 && area2 > scale * scale * 1e-14).then(|| n.normalize())
+        let n = if area2 == 0.0 {
+            None
+        } else if area2.is_finite() && (scale * scale).is_finite() && area2 >= f32::MIN_POSITIVE {
+            (area2 > scale * scale * 1e-14).then(|| n.normalize())
         } else {
-            // coordinates whose products leave f32's range (edges beyond about 1e9): the same
-            // test in f64 (every ordinary triangle takes the f32 path above, bit for bit)
+            // products that leave f32's normal range (edges beyond about 1e9, or below about
+            // 1e-10, where normalising a subnormal vector is inexact): the same test in f64
+            // (every ordinary triangle takes the f32 path above, bit for bit)
             let q = p.map(|v| v.as_dvec3());
             let n = (q[1] - q[0]).cross(q[2] - q[0]);
             let scale = (q[1] - q[0]).length_squared().max((q[2] - q[0]).length_squared());
             let area2 = n.length_squared();
-            (area2 != 0.0 && area2 > scale * scale * 1e-14).then(|| n.normalize().as_vec3())
+            (area2 > scale * scale * 1e-14).then(|| n.normalize().as_vec3())
         };
-        let Some(n) = n.filter(|n| n.is_finite()) else {
+        let Some(n) = n.filter(|n| n.is_finite() && (n.length() - 1.0).abs() < 1e-4) else {
             self.report.degenerate_triangles_skipped += 1;
             return false;
         };
@@ -230,6 +233,9 @@ mod tests {
         }
         assert!(!s.push([Vec3::ZERO, Vec3::X * 1e20, Vec3::X * 2e20], z, 0), "collinear");
         assert_eq!(s.report.degenerate_triangles_skipped, 1);
+        // tiny: the cross product's square is subnormal in f32 (normalising gave a length of 1.15)
+        assert!(s.push([Vec3::ZERO, Vec3::X * 1e-10, Vec3::new(3e-11, 3e-10, 0.0)], z, 0));
+        assert!((Vec3::from(s.vertices.last().unwrap().normal) - Vec3::Z).length() < 1e-6);
     }
 
     #[test]
