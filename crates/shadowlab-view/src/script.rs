@@ -39,7 +39,7 @@ impl Script {
 
     /// The spec technique A changes to before `frame` (the light turns then too).
     pub fn cycle_step(&self, frame: usize) -> Option<&str> {
-        if self.cycle.is_empty() || self.cycle_every == 0 || frame == 0 || frame % self.cycle_every != 0 {
+        if self.cycle.is_empty() || self.cycle_every == 0 || frame == 0 || !frame.is_multiple_of(self.cycle_every) {
             return None;
         }
         Some(&self.cycle[(frame / self.cycle_every) % self.cycle.len()])

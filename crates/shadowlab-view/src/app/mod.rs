@@ -1,6 +1,7 @@
 //! The window: eframe (winit + egui-wgpu) on shadowlab's device; [`state`] holds the viewer
 //! and renders the picture, [`panels`] draws the controls and the numbers.
 
+mod loss;
 mod panels;
 mod state;
 
@@ -52,7 +53,7 @@ pub(crate) fn run(opts: Options) -> anyhow::Result<()> {
 impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         if let Some(why) = self.gpu.lost() {
-            state::exit_on_loss(&why);
+            loss::exit_on_loss(&why);
         }
         if self.closing {
             return;

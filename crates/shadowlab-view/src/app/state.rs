@@ -19,6 +19,8 @@ use crate::render::{FrameInfo, Look, Pose, Renderer, Right};
 use crate::script::Script;
 use crate::{session, widgets, Options};
 
+use super::loss::{self, LastView};
+
 /// Seconds without camera, light or time change before the reference starts refining.
 const SETTLE_S: f64 = 0.15;
 /// Seconds of frame times in the HUD's plot.
@@ -28,47 +30,6 @@ const LOOK_PER_POINT: f32 = 0.005;
 
 pub const CONTROLS_W: f32 = 300.0;
 pub const HUD_W: f32 = 300.0;
-
-/// What the window showed after its last frame, for [`exit_on_loss`].
-struct LastView {
-    setup: Setup,
-    camera: Camera,
-    light: Light,
-    time: f32,
-    size: (u32, u32),
-    specs: Vec<String>,
-    out_dir: std::path::PathBuf,
-    frames: usize,
-}
-
-static LAST_VIEW: Mutex<Option<LastView>> = Mutex::new(None);
-
-/// The device is lost (a driver reset, a GPU removed, `--lose-device-at`): nothing made on it
-/// works again, and egui's painter cannot continue on it. Saves the last view as a setup, says
-/// so in one message with the command that reopens it, and exits with status 1. Called at the
-/// start of each frame and, for a loss in the middle of one (egui's painter panics on a lost
-/// device), from the panic hook [`App::new`] installs.
-pub fn exit_on_loss(why: &str) -> ! {
-    let last = LAST_VIEW.lock().unwrap_or_else(|e| e.into_inner()).take();
-    let msg = match last {
-        Some(v) => {
-            let s = session::snapshot(&v.setup, &v.camera, &v.light, v.time, v.size.0, v.size.1, &v.specs);
-            let saved = session::to_toml(&s)
-                .and_then(|t| session::write_fresh(&v.out_dir, "view", "toml", t.as_bytes()).map_err(|e| e.to_string()));
-            match saved {
-                Ok(p) => format!(
-                    "the GPU device was lost ({why}) after {} frames; the view is saved: `shadowlab view --setup {}` reopens it",
-                    v.frames,
-                    p.display()
-                ),
-                Err(e) => format!("the GPU device was lost ({why}) after {} frames; the view could not be saved: {e}", v.frames),
-            }
-        }
-        None => format!("the GPU device was lost ({why}) before the first frame"),
-    };
-    eprintln!("error: {msg}");
-    std::process::exit(1);
-}
 
 /// The debug pictures of the current evaluation, as egui textures.
 #[derive(Default)]
@@ -138,13 +99,7 @@ impl App {
         let gpu: &'static Gpu = Box::leak(Box::new(Gpu::from_device(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info())?));
         let scene = Box::leak(Box::new(opts.scene));
         let lab = Lab::new(gpu, scene)?;
-        let default_hook = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if let Some(why) = gpu.lost() {
-                exit_on_loss(&why);
-            }
-            default_hook(info)
-        }));
+        loss::exit_on_loss_in_panics(gpu);
         let (w, h) = opts.size.unwrap_or((640, 480));
         let r = Renderer::new(lab, w, h, &opts.light, opts.a, opts.b.clone())?;
         let extent = scene.bounds().diagonal().max(1e-3);
@@ -334,10 +289,10 @@ impl App {
         }
     }
 
-    /// Keeps what [`exit_on_loss`] saves current (after every frame).
+    /// Keeps what [`loss::exit_on_loss`] saves current (after every frame).
     fn remember_view(&self) {
         let (w, h) = self.r.size();
-        let view = LastView {
+        loss::remember(LastView {
             setup: self.setup.clone(),
             camera: self.camera,
             light: self.light,
@@ -347,8 +302,7 @@ impl App {
             out_dir: self.out_dir.clone(),
             // this frame is rendered; `scripted_end` counts it after
             frames: self.frames + 1,
-        };
-        *LAST_VIEW.lock().unwrap_or_else(|e| e.into_inner()) = Some(view);
+        });
     }
 
     fn fail(&mut self, e: String) {
@@ -469,7 +423,7 @@ impl App {
             }
             Err(e) => {
                 if let Some(why) = self.gpu.lost() {
-                    exit_on_loss(&why);
+                    loss::exit_on_loss(&why);
                 }
                 self.error = Some(e.to_string())
             }
