@@ -125,21 +125,17 @@ impl Gpu {
         self.device.create_buffer(desc)
     }
 
-    /// A new buffer with its contents (counted; refused as [`Gpu::buffer`] over the limits).
-    /// Written through its mapping at creation, as `wgpu::util::DeviceExt::create_buffer_init`
-    /// does, except that a buffer the device could not make (a lost device) is reported by
-    /// [`Gpu::take_error`] rather than a panic.
+    /// A new buffer with its contents, made by [`Gpu::buffer`] (counted, refused over the
+    /// limits) and written through its mapping at creation, as
+    /// `wgpu::util::DeviceExt::create_buffer_init` does, except that a buffer the device could
+    /// not map (a lost device) is reported by [`Gpu::take_error`] rather than a panic.
     pub fn buffer_desc_init(&self, desc: &wgpu::util::BufferInitDescriptor) -> wgpu::Buffer {
-        self.alloc.buffers.fetch_add(1, Ordering::Relaxed);
         let len = desc.contents.len() as u64;
         let size = len.div_ceil(wgpu::COPY_BUFFER_ALIGNMENT).max(1) * wgpu::COPY_BUFFER_ALIGNMENT;
-        if let Some(msg) = over_limit(&self.limits, desc.label.unwrap_or("buffer"), size, desc.usage) {
-            self.refuse(msg);
-            let stand_in = wgpu::BufferDescriptor { label: desc.label, size: 4, usage: desc.usage, mapped_at_creation: false };
-            return self.device.create_buffer(&stand_in);
+        let buf = self.buffer(&wgpu::BufferDescriptor { label: desc.label, size, usage: desc.usage, mapped_at_creation: true });
+        if buf.size() < size {
+            return buf; // refused over a limit: an unmapped stand-in, already reported
         }
-        let buf =
-            self.device.create_buffer(&wgpu::BufferDescriptor { label: desc.label, size, usage: desc.usage, mapped_at_creation: true });
         match buf.slice(..).get_mapped_range_mut() {
             Ok(mut range) => range.slice(..desc.contents.len()).copy_from_slice(desc.contents),
             Err(e) => {

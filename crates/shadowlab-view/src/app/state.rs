@@ -272,12 +272,7 @@ impl App {
             let t = self.started.elapsed().as_secs_f64();
             if self.frames == 0 || t >= self.memory_printed + every {
                 self.memory_printed = t;
-                let rss = crate::script::resident_mib().map_or("n/a".to_string(), |m| format!("{m:.1}"));
-                println!(
-                    "memory: t={t:.1} s, frame {}, resident {rss} MiB, technique A {}",
-                    self.frames,
-                    self.r.technique(false).expect("A").text
-                );
+                self.print_memory("");
             }
         }
         let changes: Vec<(String, String)> = self.script.changes_at(self.frames).map(|(k, v)| (k.to_string(), v.to_string())).collect();
@@ -287,6 +282,14 @@ impl App {
                 Err(e) => self.fail(format!("--set-at {}:{k}={v}: {e}", self.frames)),
             }
         }
+    }
+
+    /// A `memory:` line of a scripted run (`--memory-every`).
+    fn print_memory(&self, suffix: &str) {
+        let rss = crate::script::resident_mib().map_or("n/a".to_string(), |m| format!("{m:.1}"));
+        let t = self.started.elapsed().as_secs_f64();
+        let a = &self.r.technique(false).expect("A").text;
+        println!("memory: t={t:.1} s, frame {}, resident {rss} MiB, technique A {a}{suffix}", self.frames);
     }
 
     /// Keeps what [`loss::exit_on_loss`] saves current (after every frame).
@@ -338,13 +341,7 @@ impl App {
             v.get(v.len() / 2).copied().unwrap_or(0.0)
         };
         if self.script.memory_every_s.is_some() {
-            let rss = crate::script::resident_mib().map_or("n/a".to_string(), |m| format!("{m:.1}"));
-            let t = self.started.elapsed().as_secs_f64();
-            println!(
-                "memory: t={t:.1} s, frame {}, resident {rss} MiB, technique A {} (end)",
-                self.frames,
-                self.r.technique(false).expect("A").text
-            );
+            self.print_memory(" (end)");
         }
         let (frame_ms, period_ms) = (median(&self.all_frame_ms), median(&self.all_period_ms));
         let current = match self.current_after {

@@ -168,7 +168,7 @@ fn subdivision_capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64) -> R
     }
     // at least one per triangle: the root finishes up to one extra piece per triangle (the
     // second half of a triangle cut by the near plane) before any level can check
-    let extra = if on { wanted.max(tris as u64).min(limit.saturating_sub(tris as u64)) as u32 } else { 0 };
+    let extra = if on { wanted.max(tris as u64).min(most) as u32 } else { 0 };
     // the root queues up to two pieces per triangle (a triangle cut by the near plane); the
     // triangle index keeps 3 bits free for the split mask
     let queue = if on { (2 * tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
