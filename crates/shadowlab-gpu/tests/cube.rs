@@ -188,7 +188,7 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 }
 
 #[test]
-fn cube_notw_lists_notws_parameters_with_nine_defaults_of_its_own() {
+fn cube_notw_lists_notws_parameters_with_eleven_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
     // notw's whole list (the same keys in the same order, as the code reads them all)
     let (a, b) = (cube::CubeNotwSettings::defs(), warp::NotwSettings::defs());
@@ -205,6 +205,9 @@ fn cube_notw_lists_notws_parameters_with_nine_defaults_of_its_own() {
         ("edge_importance", cube::DEFAULT_NOTW_EDGE_IMPORTANCE),
         // notw's exact inversion was chosen on planar maps; the faces keep the Newton steps
         ("exact_inverse", warp::DEFAULT_EXACT_INVERSE),
+        // notw interpolates its depth since issue 48; the faces keep the exact depth and its bias
+        ("exact_depth", cube::DEFAULT_NOTW_EXACT_DEPTH),
+        ("bias", cube::DEFAULT_NOTW_BIAS),
     ];
     for (x, y) in a.iter().zip(b) {
         match own.iter().find(|(k, _)| *k == x.key) {

@@ -17,6 +17,8 @@ use crate::common::*;
 /// inversion (`exact_inverse`) must remove a clear part of the false shadows against rt, each
 /// on its own, without more false lit. Window 16 (notw's default until issue 31): the wider
 /// window of today's default smooths most kinks away, and with them most of what the fix fixes.
+/// Exact depth at subdiv 1 with bias 1.5 (notw's defaults until issue 48, which interpolates the
+/// depth over finer pieces): the inversion is what this test checks.
 #[test]
 fn the_kinks_fix_removes_false_shadow_specks_on_a_low_sun_city() {
     let Some(gpu) = gpu() else { return };
@@ -29,10 +31,10 @@ fn the_kinks_fix_removes_false_shadow_specks_on_a_low_sun_city() {
         let run = lab.run(&v, &TechniqueSpec::parse(spec).unwrap(), 1).unwrap();
         compare(&run.visibility, &rt.visibility, &v.mask)
     };
-    let before = errors("notw:window=16,bias_mode=2,exact_inverse=false");
-    let secant = errors("notw:window=16,bias_mode=4,exact_inverse=false");
-    let inverse = errors("notw:window=16,bias_mode=2,exact_inverse=true");
-    let both = errors("notw:window=16,bias_mode=4,exact_inverse=true");
+    let before = errors("notw:window=16,exact_depth=true,subdiv=1,bias=1.5,bias_mode=2,exact_inverse=false");
+    let secant = errors("notw:window=16,exact_depth=true,subdiv=1,bias=1.5,bias_mode=4,exact_inverse=false");
+    let inverse = errors("notw:window=16,exact_depth=true,subdiv=1,bias=1.5,bias_mode=2,exact_inverse=true");
+    let both = errors("notw:window=16,exact_depth=true,subdiv=1,bias=1.5,bias_mode=4,exact_inverse=true");
     for (name, e) in [("before", &before), ("secant", &secant), ("inverse", &inverse), ("both", &both)] {
         eprintln!(
             "city low sun 512, {name}: {:.3} % wrong ({:.3} false lit / {:.3} false shadow)",

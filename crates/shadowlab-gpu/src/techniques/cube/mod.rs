@@ -143,14 +143,26 @@ pub const DEFAULT_NOTW_WINDOW_TENT: f64 = 1.0;
 /// faces: flagged degraded, deterministic) (docs/bench/stress.md).
 pub const DEFAULT_NOTW_EDGE_IMPORTANCE: f64 = 8.0;
 
+/// cube-notw's depth: exact per fragment (the warp inverted by Newton steps), not `notw`'s
+/// interpolated depth (issue 48, step 1), with notw's former constant bias of 1.5 warped texels.
+/// `shadowlab tune -t 'cube-notw:exact_depth=false,subdiv=0.25|0.5,bias=1.5|2|2.5'` at 512x512
+/// chose `subdiv=0.25` with bias 1.5 on room light 1 and bias 2.5 on point-courtyard, and
+/// neither carried over to the view not used to choose it: conference light 1 0.182 against
+/// 0.181 % wrong, sponza-peer 0.509 against 0.498 (docs/bench/warp.md). The interpolated depth
+/// took 0.3-0.6x the frame there; a default only where validation agrees.
+pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 1.0;
+pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
+
+const CUBE_DEPTH_TUNE: &str =
+    "shadowlab tune on room light 1 and point-courtyard, checked on conference light 1 and sponza-peer (docs/bench/warp.md, issue 48)";
 const THREE_SETUPS: &str =
     "shadowlab measurement on the room, courtyard lantern and conference point lights (docs/bench/point.md, point_quality.md)";
 
 shadowlab_core::param_set! {
     /// `cube-notw`'s parameters: notw's (same keys, order, ranges and docs: each face is a `notw`
-    /// map), with the window, blur, mix, subdivision, normal offset, bias footprint, smoothing
-    /// tent and edge importance defaults measured for cube faces (tests/cube.rs checks the rows
-    /// against notw's).
+    /// map), with the window, blur, mix, subdivision, normal offset, bias footprint, exact depth,
+    /// bias, smoothing tent and edge importance defaults measured for cube faces (tests/cube.rs
+    /// checks the rows against notw's).
     pub struct CubeNotwSettings {
         pub notw: w::NotwSettings = Block::as_declared()
             .with(w::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"))
@@ -161,6 +173,8 @@ shadowlab_core::param_set! {
             .with(w::NOTW_SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, THREE_SETUPS))
             .with(w::NORMAL_OFFSET.with_default(DEFAULT_NOTW_NORMAL_OFFSET, THREE_SETUPS))
             .with(w::BIAS_MODE.with_default(DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS))
+            .with(w::NOTW_EXACT.with_default(DEFAULT_NOTW_EXACT_DEPTH, CUBE_DEPTH_TUNE))
+            .with(w::NOTW_BIAS.with_default(DEFAULT_NOTW_BIAS, CUBE_DEPTH_TUNE))
             .with(w::WINDOW_TENT.with_default(
                 DEFAULT_NOTW_WINDOW_TENT,
                 "shadowlab: chosen on sibenik, checked on room, courtyard lantern, conference and eaves point lights (docs/bench/stress.md)",

@@ -146,9 +146,12 @@ impl Warped {
     /// Fragments the last frame's exact-depth pass shaded and kept (each one inversion of the
     /// warp; discarded ones, behind a paraboloid's split plane or cut out, not counted): its
     /// draw again, with the depth test off, under an occlusion query (the map is kept).
-    /// None without `exact_depth` or before a frame.
+    /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame.
     pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
-        let (scene_group, triangles) = self.scene.last.as_ref().filter(|_| self.params.exact_depth != 0)?;
+        let (scene_group, triangles) = self.scene.last.as_ref()?;
+        if self.params.exact_depth == 0 {
+            return Some(0);
+        }
         let (pipeline, set, resolve) = self.scene.counting.get_or_init(|| {
             let pipeline = counting_pipeline(gpu, self.name(), &self.lookup_layout, &self.scene, &self.params);
             let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {

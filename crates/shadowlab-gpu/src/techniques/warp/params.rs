@@ -26,8 +26,12 @@ pub const DEFAULT_MIX: f64 = 2.0;
 /// 0.5, 0.63 at 2). With `exact_depth=false` the interpolated depth is off by up to the
 /// subdivision threshold and 2 is better (courtyard sun 1 -> 1.78 %, 2 -> 1.25, 512 view).
 /// Re-measured with `bias_mode=2` (docs/bench/warp_bias.md): 0.5 / 1 / 1.25 / 1.5 sum to
-/// 6.453 / 5.558 / 5.393 / 5.303 % (subdiv 1): 1.5 kept (also `cube-notw`'s inherited default).
-pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
+/// 6.453 / 5.558 / 5.393 / 5.303 % (subdiv 1). Since the depth is interpolated again (issue 48,
+/// `DEFAULT_NOTW_EXACT_DEPTH`) the bias also covers the interpolation's error inside a piece:
+/// `shadowlab tune` (`NOTW_DEPTH_TUNED`'s setups): at subdiv 0.35, bias 1.5 / 2 / 2.5 give a
+/// train mean of 0.414 / 0.412 / 0.412 % wrong, at subdiv 0.5 0.438 / 0.430 / 0.429; suns alone
+/// prefer 2.5-3 (acne on grazing receivers), spot lights 1.5 (leaks). docs/bench/warp.md.
+pub const DEFAULT_NOTW_BIAS: f64 = 2.0;
 /// Subdivision threshold (largest bend of a warped edge from its rasterised line, warped
 /// texels); 0 = off. Courtyard 512 view: off -> 70 % wrong (rtw and notw: the floor is two
 /// triangles); rtw 1 -> 0.58 % with 24 k pieces (crack-free subdivision); notw 2 -> 1.25 %
@@ -39,8 +43,14 @@ pub const DEFAULT_SUBDIV: f64 = 1.0;
 /// acne where the light grazes a receiver (a thin sliver in the map). 1024x1024, 512 map
 /// (docs/bench/warp.md): 2 -> 1 cuts `notw`'s false shadows on all six setups (courtyard sun
 /// 0.59 -> 0.37 %, courtyard spot 0.28 -> 0.13, sponza sun 0.31 -> 0.11) for ~2x the pieces
-/// (0.1-1.3 M). 0.5 overflows the piece capacity on sponza (0.49 M pieces dropped).
-pub const DEFAULT_NOTW_SUBDIV: f64 = 1.0;
+/// (0.1-1.3 M). With the interpolated depth (issue 48) the threshold also bounds the depth's
+/// error inside a piece, so it is finer: `shadowlab tune` over the suns of courtyard,
+/// kinks-city and city_corner gives 0.339 / 0.349 / 0.377 % wrong at 0.25 / 0.5 / 0.75 (each at
+/// its best bias), but 0.25 makes 7.9 pieces a texel on kinks-city-b and fills the piece
+/// capacity there (drawn degraded). With two spot lights added to the train setups
+/// (`NOTW_DEPTH_TUNED`) 0.35 beats 0.5 (0.412 against 0.429 %) and fits everywhere (at most
+/// 6.6 pieces a texel, kinks-city-b). docs/bench/warp.md.
+pub const DEFAULT_NOTW_SUBDIV: f64 = 0.35;
 /// Subdivision levels (edge halvings) per triangle: 2^10 = 1024 pieces per edge, enough for a
 /// triangle spanning the map at a 1-texel threshold. The authors' OpenGL code used a
 /// tessellation factor of 16 (4 levels); measured too few for the big floor triangles here.
@@ -93,9 +103,10 @@ pub const W_DV: ParamDef = ParamDef::number(
 );
 pub const W_EYE: ParamDef =
     ParamDef::number("w_eye", 1.0, 0.0, 100.0, "RTW distance-to-eye importance weight, (max d - d) / max d", "GUIDE / Rosen 2012");
-pub const NOTW_SUBDIV: ParamDef = SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, SUBDIV.source);
-pub const NOTW_BIAS: ParamDef =
-    BIAS.with_default(DEFAULT_NOTW_BIAS, "shadowlab sweep 0.5/1/1.5/2 with exact depth on six setups (docs/bench/warp.md)");
+pub const NOTW_SUBDIV: ParamDef = SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, NOTW_DEPTH_TUNED);
+/// Where `notw`'s depth, subdivision and bias defaults come from (issue 48, step 1).
+const NOTW_DEPTH_TUNED: &str = "shadowlab tune: trained on courtyard, kinks-city, city_corner (suns), lt-multi light 1 and sponza-peer light 1 (spots); validated on sponza, kinks-city-b lights 0 and 1, lt-multi lights 0 and 2, sibenik (docs/bench/warp.md, issue 48)";
+pub const NOTW_BIAS: ParamDef = BIAS.with_default(DEFAULT_NOTW_BIAS, NOTW_DEPTH_TUNED);
 pub const SUBDIV: ParamDef = ParamDef::number("subdiv", DEFAULT_SUBDIV, 0.0, 1024.0, "split triangles until the warp bends no edge (or centroid) by more than this many warped texels from the rasterised line; 0 = off; low: many pieces, high: bent edges", "shadowlab measurement (docs/bench/warp.md)");
 pub const INTERP: ParamDef = ParamDef::flag("interp", DEFAULT_INTERP != 0.0, "interpolate offsets between neighbouring row/column functions (a continuous warp); false = eq. 6 as printed (one function per texel row: a sub-triangle crossing rows is rasterised across an offset jump)", "shadowlab measurement (docs/bench/warp.md): eq. 6 as printed leaves 40-65 % wrong on courtyard");
 pub const SUBDIV_LEVELS: ParamDef = ParamDef::integer(
@@ -147,13 +158,17 @@ pub const CLOSE_CRACKS: ParamDef = ParamDef::flag("close_cracks", DEFAULT_CLOSE_
 /// its smooth warp bends little at subdiv 1, so exact depth changes wrong pixels by <= 0.01
 /// points on five of six setups (sponza sun 1.18 -> 1.06 %) for 1.1-1.7x the total time.
 pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
-/// NoTW: on. Fewer wrong pixels on all six setups (with bias 1.5: e.g. sponza spot 3.47 ->
-/// 3.22 %, conference sun 0.64 -> 0.46) for 2.8-4.8x the depth-pass time, 1.1-1.8x the total
-/// (no early depth test, 9 warp evaluations per fragment). Too slow? `exact_depth=false,bias=2`.
-pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 1.0;
+/// NoTW: off, as the seeds draw it (seed 000 Algorithm 1 warps x and y only; issue 48). Exact
+/// depth was the default at subdiv 1 (fewer wrong pixels there than the interpolated depth), but
+/// it costs a warp inversion per fragment and the early depth test (3.6-6 fragments a texel,
+/// the depth pass 165-175 ms against `rtw`'s 9-10 on courtyard). Interpolated on pieces of
+/// 0.35 warped texels with bias 2 it is better and cheaper: `shadowlab tune` (`NOTW_DEPTH_TUNED`:
+/// train mean 0.492 -> 0.412 % wrong), validated on six views not used to choose (0.652 ->
+/// 0.607 %, no worse on 6 of 6); docs/bench/warp.md.
+pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 0.0;
 pub const EXACT_DEPTH: ParamDef = ParamDef::flag("exact_depth", DEFAULT_EXACT_DEPTH != 0.0, "write the exact depth per fragment: invert the warp at the fragment (3 Newton steps, 9 warp lookups) and evaluate the triangle's depth plane there; false = depth interpolated between warped vertices (off by up to the subdivision bend); disables early depth test", "shadowlab experiment (docs/bench/warp.md)");
 
-pub const NOTW_EXACT: ParamDef = EXACT_DEPTH.with_default(DEFAULT_NOTW_EXACT_DEPTH, EXACT_DEPTH.source);
+pub const NOTW_EXACT: ParamDef = EXACT_DEPTH.with_default(DEFAULT_NOTW_EXACT_DEPTH, NOTW_DEPTH_TUNED);
 
 /// Warp strength alpha: warp(u) = u + alpha * offsets (lookup.wgsl). 1 = the seeds' warp;
 /// 0 = the identity (the DV crop only, `notw-dv` through the warped pipeline). A diagnostic

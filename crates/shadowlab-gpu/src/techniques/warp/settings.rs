@@ -236,7 +236,7 @@ pub(crate) mod tests {
         for ok in [
             "notw:subdiv=0",
             "notw:cull_hidden=true,subdiv_levels=3,min_piece=1",
-            "notw:exact_inverse=true,depth_clamp=1,footprint_cap=4",
+            "notw:exact_depth=true,exact_inverse=true,depth_clamp=1,footprint_cap=4",
             "rtw:exact_depth=true,depth_clamp=1,bias_mode=2,footprint_cap=4",
             "notw-dv:dv_margin=4,pcf=3",
         ] {
