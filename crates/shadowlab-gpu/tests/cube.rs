@@ -188,7 +188,7 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
 }
 
 #[test]
-fn cube_notw_lists_notws_parameters_with_eleven_defaults_of_its_own() {
+fn cube_notw_lists_notws_parameters_with_twelve_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};
     // notw's whole list (the same keys in the same order, as the code reads them all)
     let (a, b) = (cube::CubeNotwSettings::defs(), warp::NotwSettings::defs());
@@ -208,6 +208,8 @@ fn cube_notw_lists_notws_parameters_with_eleven_defaults_of_its_own() {
         // notw interpolates its depth since issue 48; the faces keep the exact depth and its bias
         ("exact_depth", cube::DEFAULT_NOTW_EXACT_DEPTH),
         ("bias", cube::DEFAULT_NOTW_BIAS),
+        // and the full warp (notw's strength 0.8 was chosen on planar maps)
+        ("strength", warp::DEFAULT_STRENGTH),
     ];
     for (x, y) in a.iter().zip(b) {
         match own.iter().find(|(k, _)| *k == x.key) {

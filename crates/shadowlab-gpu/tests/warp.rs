@@ -328,3 +328,30 @@ fn finer_subdivision_removes_grazing_acne_on_courtyard() {
     assert!(fine.false_shadow_pct < 0.8 * coarse.false_shadow_pct, "subdiv 0.35 {fine:?} vs subdiv 2 {coarse:?}");
     assert!(fine.wrong_pct < 0.9 * coarse.wrong_pct, "subdiv 0.35 {fine:?} vs subdiv 2 {coarse:?}");
 }
+
+/// `depth_split`: an edge's bend judged across it against `subdiv` and along it against
+/// `depth_split`. Each sampled displacement's two components are at most its length, so with
+/// `depth_split` equal to `subdiv` no edge splits that the whole displacement (the default)
+/// leaves whole, and the pieces can only be fewer; a larger `depth_split` leaves more edges
+/// whole. The shadows must stay close to the default's against rt.
+#[test]
+fn depth_split_judges_the_bend_along_the_edge_apart() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    let rt = lab.reference(&v, 1).unwrap();
+    let run = |s: &str| lab.run(&v, &TechniqueSpec::parse(s).unwrap(), 1).unwrap();
+    let pieces = |r: &shadowlab_gpu::lab::Run| r.report.counters["subdiv_triangles_drawn"];
+    let wrong = |r: &shadowlab_gpu::lab::Run| compare(&r.visibility, &rt.visibility, &v.mask).wrong_pct;
+    let whole = run("notw:res=256");
+    let equal = run(&format!("notw:res=256,depth_split={}", shadowlab_gpu::techniques::warp::DEFAULT_NOTW_SUBDIV));
+    let loose = run(&format!("notw:res=256,depth_split={}", 2.0 * shadowlab_gpu::techniques::warp::DEFAULT_NOTW_SUBDIV));
+    for (name, r) in [("whole displacement", &whole), ("depth_split = subdiv", &equal), ("depth_split = 2 subdiv", &loose)] {
+        eprintln!("courtyard 256, notw res 256, {name}: {} pieces, {:.3} % wrong", pieces(r), wrong(r));
+        assert!(r.report.degraded.is_empty(), "{name}: {:?}", r.report.degraded);
+    }
+    assert!(pieces(&equal) <= pieces(&whole), "{} vs {}", pieces(&equal), pieces(&whole));
+    assert!(pieces(&loose) < pieces(&equal), "{} vs {}", pieces(&loose), pieces(&equal));
+    assert!(wrong(&equal) <= wrong(&whole) + 0.1 && wrong(&loose) <= wrong(&whole) + 0.25);
+}

@@ -22,7 +22,7 @@ fn strength_zero_is_the_desired_view_crop() {
         let run = |spec: &str| lab.run(&v, &TechniqueSpec::parse(spec).unwrap(), 1).unwrap();
         let dv = run("notw-dv");
         let flat = run("notw:strength=0,bias=0.5,exact_depth=false");
-        let warped = run("notw:bias=0.5,exact_depth=false");
+        let warped = run("notw:strength=1,bias=0.5,exact_depth=false");
         let same = agreement(&flat.visibility, &dv.visibility, &v.mask);
         let exact = flat.visibility.iter().zip(&dv.visibility).filter(|(a, b)| a != b).count();
         eprintln!("{name} light {light}: strength 0 vs notw-dv: {same:.4} % agree, {exact} samples differ");

@@ -161,7 +161,7 @@ const THREE_SETUPS: &str =
 shadowlab_core::param_set! {
     /// `cube-notw`'s parameters: notw's (same keys, order, ranges and docs: each face is a `notw`
     /// map), with the window, blur, mix, subdivision, normal offset, bias footprint, exact depth,
-    /// bias, smoothing tent and edge importance defaults measured for cube faces (tests/cube.rs
+    /// bias, strength, smoothing tent and edge importance defaults measured for cube faces (tests/cube.rs
     /// checks the rows against notw's).
     pub struct CubeNotwSettings {
         pub notw: w::NotwSettings = Block::as_declared()
@@ -175,6 +175,8 @@ shadowlab_core::param_set! {
             .with(w::BIAS_MODE.with_default(DEFAULT_NOTW_BIAS_MODE, THREE_SETUPS))
             .with(w::NOTW_EXACT.with_default(DEFAULT_NOTW_EXACT_DEPTH, CUBE_DEPTH_TUNE))
             .with(w::NOTW_BIAS.with_default(DEFAULT_NOTW_BIAS, CUBE_DEPTH_TUNE))
+            // notw's strength of 0.8 was chosen on planar maps; the faces keep the full warp
+            .with(w::STRENGTH)
             .with(w::WINDOW_TENT.with_default(
                 DEFAULT_NOTW_WINDOW_TENT,
                 "shadowlab: chosen on sibenik, checked on room, courtyard lantern, conference and eaves point lights (docs/bench/stress.md)",
@@ -320,9 +322,9 @@ mod tests {
     #[test]
     fn the_tables_keep_their_keys_in_order_and_the_rules_apply() {
         assert_eq!(keys::<CubeSettings>(), ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "depth"]);
-        // each face is a notw map: notw's rows, eight of them with other defaults (tests/cube.rs)
+        // each face is a notw map: notw's rows, twelve of them with other defaults (tests/cube.rs)
         assert_eq!(keys::<CubeNotwSettings>(), keys::<w::NotwSettings>());
-        assert_eq!(keys::<CubeNotwSettings>().len(), 25);
+        assert_eq!(keys::<CubeNotwSettings>().len(), 26);
         assert_eq!(CubeSettings::defaults().depth, FaceDepth::Hardware);
         assert_eq!(error("cube-notw:res=64"), "technique 'cube-notw': window 128 must be below res 64");
         assert!(error("cube-notw:subdiv=0,cull_hidden=true").contains("cull_hidden has no effect: subdiv=0"));

@@ -126,7 +126,9 @@ shadowlab_core::param_set! {
     }
     rules {
         fn ineffective(&self) -> Vec<(&'static str, String)> {
-            self.subdivision.dead()
+            let mut v = self.subdivision.dead();
+            v.extend(self.subdivision.planar_only());
+            v
         }
     }
 }
@@ -320,11 +322,11 @@ mod tests {
     #[test]
     fn the_tables_keep_their_keys_in_order() {
         #[rustfmt::skip]
-        let dpsm = ["res", "split", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece", "exact_depth", "pcf", "bias",
+        let dpsm = ["res", "split", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece", "depth_split", "exact_depth", "pcf", "bias",
             "slope_bias", "max_slope", "normal_offset"];
         #[rustfmt::skip]
         let notw = ["res", "split", "window", "blur", "mix", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
-            "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
+            "depth_split", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
             "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "window_tent"];
         assert_eq!(keys::<DpsmSettings>(), dpsm);
         assert_eq!(keys::<DpsmNotwSettings>(), notw);
@@ -341,6 +343,10 @@ mod tests {
         // dpsm-notw's exact depth is off by default
         assert!(error("dpsm-notw:exact_inverse=true").contains("exact_inverse has no effect: exact_depth=false"));
         assert!(error("dpsm-notw:footprint_cap=2").contains("footprint_cap has no effect: bias_mode=0"));
+        for spec in ["dpsm:depth_split=1", "dpsm-notw:depth_split=1"] {
+            assert!(error(spec).contains("depth_split has no effect: a paraboloid map's subdivision"), "{spec}");
+        }
+        assert!(error("dpsm:subdiv=0,depth_split=1").contains("depth_split has no effect: subdiv=0"));
         for ok in ["dpsm:split=x,subdiv=0,exact_depth=true", "dpsm-notw:exact_depth=true,exact_inverse=true", "dpsm-notw:res=256"] {
             assert_eq!(error(ok), "", "{ok}");
         }

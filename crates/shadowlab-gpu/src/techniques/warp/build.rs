@@ -222,7 +222,7 @@ fn uniform(k: &Knobs, base: &BaseProjection, tris: u32, extra: u32) -> WarpParam
         cull_hidden: if k.cull_hidden { 1.0 } else { 0.0 },
         tent: if k.tent { 1.0 } else { 0.0 },
         edge_importance: k.edge_importance,
-        pad0: 0,
+        depth_split: k.depth_split,
         pad1: 0,
         pad2: 0,
     }

@@ -35,6 +35,8 @@ pub struct Knobs {
     pub(crate) subdiv_capacity: u32,
     /// Smallest warped extent (texels) of an edge that is split; 0 = no bound.
     pub(crate) min_piece: f32,
+    /// Planar subdivision's along-edge threshold (`depth_split`; 0 = the whole displacement).
+    pub(crate) depth_split: f32,
     pub(crate) exact_depth: bool,
     pub(crate) close_cracks: bool,
     pub(crate) dv_margin: f32,
@@ -85,6 +87,7 @@ impl Knobs {
             subdiv_levels: 1,
             subdiv_capacity: 0,
             min_piece: 0.0,
+            depth_split: 0.0,
             exact_depth: false,
             close_cracks: false,
             dv_margin: 0.0,
@@ -106,6 +109,7 @@ impl Knobs {
             subdiv_levels: s.subdiv_levels,
             subdiv_capacity: s.subdiv_capacity,
             min_piece: s.min_piece,
+            depth_split: s.depth_split,
             exact_depth,
             ..self
         }

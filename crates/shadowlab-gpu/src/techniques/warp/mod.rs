@@ -190,7 +190,9 @@ pub struct WarpParams {
     pub tent: f32,
     /// Extra count of a view sample on a shadow edge of the occluder map (`edge_importance`)
     pub edge_importance: u32,
-    pub pad0: u32,
+    /// Planar subdivision: split on the perpendicular bend (`subdiv`) and the along-edge
+    /// displacement (this); 0 = on the whole displacement against `subdiv` (`depth_split`)
+    pub depth_split: f32,
     pub pad1: u32,
     pub pad2: u32,
 }

@@ -149,6 +149,23 @@ pub const MIN_PIECE: ParamDef = ParamDef::number(
     "shadowlab (bounded subdivision, issue 18)",
 );
 
+/// Planar subdivision: how a warped edge's bend is judged. The rasteriser draws a piece's edge as
+/// the chord of its curved warped image: a point of the curve strays from the chord across it
+/// (its coverage: shadow edges move) and along it (the depth interpolated there belongs to
+/// another point of the edge). 0: the whole displacement against `subdiv` (before issue 48).
+/// > 0: the perpendicular bend against `subdiv` and the displacement along the edge against
+/// this many warped texels (the interpolated depth's error, in texels of the edge's own depth
+/// slope), so the two can be bounded apart.
+pub const DEFAULT_DEPTH_SPLIT: f64 = 0.0;
+pub const DEPTH_SPLIT: ParamDef = ParamDef::number(
+    "depth_split",
+    DEFAULT_DEPTH_SPLIT,
+    0.0,
+    1024.0,
+    "planar maps: split an edge whose warped image strays along itself (which moves the interpolated depth) by more than this many warped texels, and on its perpendicular bend against subdiv; 0 = the whole displacement against subdiv",
+    "shadowlab (issue 48, step 2)",
+);
+
 /// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.
 pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
 pub const CLOSE_CRACKS: ParamDef = ParamDef::flag("close_cracks", DEFAULT_CLOSE_CRACKS != 0.0, "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap", "shadowlab measurement (docs/bench/warp.md)");
@@ -182,6 +199,15 @@ pub const STRENGTH: ParamDef = ParamDef::number(
     "warp strength: offsets scaled by this (1 = the computed warp, 0 = identity, i.e. the DV crop only); low: less even sampling",
     "shadowlab diagnostic (docs/bench/warp_bias.md)",
 );
+/// `notw`'s warp strength (issue 48, step 5: the authors' OpenGL code scales its warp by a warp
+/// factor). A weaker warp bends edges less, so fewer pieces pass the subdivision threshold:
+/// `shadowlab tune -t 'notw:strength=0.7|0.8|0.9'` (`NOTW_DEPTH_TUNED`'s setups), train mean
+/// 0.415 / 0.406 / 0.410 % wrong against 0.412 at 1 with 0.60 / 0.67 / 0.75 pieces a texel
+/// against 0.83; validated: 0.606 against 0.607 %, no worse on 3 of 6, 1.86 pieces a texel
+/// against 2.37 (docs/bench/warp.md). Too low: the sampling evens out less (0.4: 0.434 %).
+pub const DEFAULT_NOTW_STRENGTH: f64 = 0.8;
+pub const NOTW_STRENGTH: ParamDef = STRENGTH.with_default(DEFAULT_NOTW_STRENGTH, NOTW_DEPTH_TUNED);
+
 /// Bias footprint: how one warped texel's world size, which scales the constant bias and the
 /// normal offset, is taken from the warp's Jacobian J at the sample (eval.wgsl). 0: cropped
 /// texel / smallest singular value of J (isotropic, the largest footprint); 1: cropped texel,

@@ -68,7 +68,9 @@ struct WarpParams {
     tent: f32,
     // extra count of a view sample on a shadow edge of the occluder map (analyze.wgsl count)
     edge_importance: u32,
-    pad0: u32,
+    // subdivision (planar): > 0 splits an edge on its perpendicular bend (> subdiv) and its
+    // displacement along itself (> depth_split, warped texels); 0: on the whole displacement
+    depth_split: f32,
     pad1: u32,
     pad2: u32,
 }

@@ -41,6 +41,7 @@ shadowlab_core::param_set! {
         pub subdiv_levels: u32 = SUBDIV_LEVELS,
         pub subdiv_capacity: u32 = SUBDIV_CAPACITY,
         pub min_piece: f32 = MIN_PIECE,
+        pub depth_split: f32 = DEPTH_SPLIT,
     }
 }
 
@@ -49,12 +50,20 @@ impl Subdivision {
     pub fn on(&self) -> bool {
         self.subdiv > 0.0
     }
+    /// On a paraboloid map (`dpsm`, `dpsm-notw`) the bend is judged across the edge only.
+    pub(crate) fn planar_only(&self) -> Vec<(&'static str, String)> {
+        if self.on() {
+            dead_keys(&["depth_split"], "a paraboloid map's subdivision judges the bend across the edge only")
+        } else {
+            vec![]
+        }
+    }
     /// Without subdivision its bounds do nothing.
     pub(crate) fn dead(&self) -> Vec<(&'static str, String)> {
         if self.on() {
             vec![]
         } else {
-            dead_keys(&["subdiv_levels", "subdiv_capacity", "min_piece"], "subdiv=0 turns subdivision off")
+            dead_keys(&["subdiv_levels", "subdiv_capacity", "min_piece", "depth_split"], "subdiv=0 turns subdivision off")
         }
     }
 }
@@ -121,6 +130,7 @@ impl NotwCore {
         let mut v = self.subdivision.dead();
         v.extend(self.footprint.dead());
         if paraboloid {
+            v.extend(self.subdivision.planar_only());
             v.extend(dead_keys(&["depth_clamp"], PARABOLOID_CLAMP));
         } else if !self.exact_depth {
             v.extend(dead_keys(&["depth_clamp"], "exact_depth=false"));
@@ -167,7 +177,7 @@ shadowlab_core::param_set! {
     /// the shadow-edge importance (planar maps only).
     pub struct NotwSettings {
         pub res: u32 = RES,
-        pub core: NotwCore = Block::as_declared().with(NOTW_WINDOW).with(NOTW_EXACT_INVERSE),
+        pub core: NotwCore = Block::as_declared().with(NOTW_WINDOW).with(NOTW_EXACT_INVERSE).with(NOTW_STRENGTH),
         pub cull_hidden: bool = CULL_HIDDEN,
         pub window_tent: bool = WINDOW_TENT,
         pub edge_importance: u32 = EDGE_IMPORTANCE,
@@ -206,12 +216,12 @@ pub(crate) mod tests {
     fn the_tables_keep_their_keys_in_order() {
         #[rustfmt::skip]
         let rtw = ["res", "w_dv", "w_eye", "blur", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
-            "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
-            "bias_mode", "footprint_cap", "depth_clamp"];
+            "depth_split", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin",
+            "strength", "bias_mode", "footprint_cap", "depth_clamp"];
         #[rustfmt::skip]
         let notw = ["res", "window", "blur", "mix", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
-            "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
-            "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "cull_hidden", "window_tent", "edge_importance"];
+            "depth_split", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin",
+            "strength", "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "cull_hidden", "window_tent", "edge_importance"];
         #[rustfmt::skip]
         let dv = ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin"];
         assert_eq!(keys::<RtwSettings>(), rtw);
@@ -237,6 +247,8 @@ pub(crate) mod tests {
             "notw:subdiv=0",
             "notw:cull_hidden=true,subdiv_levels=3,min_piece=1",
             "notw:exact_depth=true,exact_inverse=true,depth_clamp=1,footprint_cap=4",
+            "notw:depth_split=0.7",
+            "rtw:depth_split=2",
             "rtw:exact_depth=true,depth_clamp=1,bias_mode=2,footprint_cap=4",
             "notw-dv:dv_margin=4,pcf=3",
         ] {

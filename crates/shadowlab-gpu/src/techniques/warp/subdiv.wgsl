@@ -62,17 +62,30 @@ fn below_min_piece(lo: vec2<f32>, hi: vec2<f32>) -> bool {
 }
 
 // How far the warped edge strays from the straight line the rasteriser draws between its
-// warped ends (warped texels), sampled at 1/4, 1/2 and 3/4; 0 below `min_piece`.
+// warped ends (warped texels), sampled at 1/4, 1/2 and 3/4; 0 below `min_piece`. With
+// `depth_split` > 0 the displacement along the edge counts scaled by subdiv / depth_split, so
+// that the result exceeds `subdiv` when the perpendicular bend exceeds it or the along-edge
+// displacement exceeds `depth_split`.
 fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32 {
     var e = 0.0;
     var lo = min(wa, wb);
     var hi = max(wa, wb);
+    let dir = wb - wa;
+    let len2 = dot(dir, dir);
+    let split = wp.depth_split > 0.0 && len2 > 1e-24;
     for (var s = 1u; s <= 3u; s++) {
         let t = f32(s) / 4.0;
         let w = warp(mix(ma, mb, t));
         lo = min(lo, w);
         hi = max(hi, w);
-        e = max(e, distance(w, mix(wa, wb, t)));
+        let d = w - mix(wa, wb, t);
+        if split {
+            let along = abs(dot(d, dir)) * inverseSqrt(len2);
+            let across = abs(d.x * dir.y - d.y * dir.x) * inverseSqrt(len2);
+            e = max(e, max(across, along * wp.subdiv / wp.depth_split));
+        } else {
+            e = max(e, length(d));
+        }
     }
     if below_min_piece(lo, hi) {
         return 0.0;
