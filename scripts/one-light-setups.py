@@ -7,7 +7,8 @@ import os
 import re
 import sys
 
-SECTION = re.compile(r"(?m)^(?=\[)")
+# a table header line: [name] or [[name]]
+SECTION = re.compile(r"(?m)^(?=\[\[?[A-Za-z_][\w.]*\]\]?\s*$)")
 
 
 def one_light(setup, index, outdir):

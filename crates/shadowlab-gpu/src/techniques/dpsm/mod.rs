@@ -127,7 +127,7 @@ shadowlab_core::param_set! {
     rules {
         fn ineffective(&self) -> Vec<(&'static str, String)> {
             let mut v = self.subdivision.dead();
-            v.extend(self.subdivision.planar_only());
+            v.extend(self.subdivision.paraboloid_dead());
             v
         }
     }

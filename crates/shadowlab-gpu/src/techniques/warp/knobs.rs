@@ -190,7 +190,7 @@ mod tests {
         let mut s = NotwSettings::defaults();
         s.cull_hidden = true;
         assert!(Knobs::notw(&s).cull_hidden);
-        assert_eq!(Knobs::notw(&s).bias, [super::super::params::DEFAULT_NOTW_BIAS as f32, 0.0, 0.5, 4.0]);
+        assert_eq!(Knobs::notw(&s).bias, [crate::techniques::warp::DEFAULT_NOTW_BIAS as f32, 0.0, 0.5, 4.0]);
         s.core.subdivision.subdiv = 0.0;
         assert!(!Knobs::notw(&s).cull_hidden);
         // "off" is judged in the uniform's precision, by the rules as by the knobs

@@ -155,7 +155,10 @@ pub const MIN_PIECE: ParamDef = ParamDef::number(
 /// another point of the edge). 0: the whole displacement against `subdiv` (before issue 48).
 /// > 0: the perpendicular bend against `subdiv` and the displacement along the edge against
 /// this many warped texels (the interpolated depth's error, in texels of the edge's own depth
-/// slope), so the two can be bounded apart.
+/// slope), so the two can be bounded apart. `notw`, five train views (docs/bench/warp.md): the
+/// across part cannot go above 0.35 (0.5: sponza-peer's spot 0.645 -> 0.746 % wrong); at subdiv
+/// 0.35, depth_split 0.7 makes 26 % fewer pieces for +0.005 points, 1.4 brings acne (courtyard
+/// 0.521 -> 0.874 %). Left at 0: no point was as good as the default on the train mean.
 pub const DEFAULT_DEPTH_SPLIT: f64 = 0.0;
 pub const DEPTH_SPLIT: ParamDef = ParamDef::number(
     "depth_split",
@@ -163,7 +166,7 @@ pub const DEPTH_SPLIT: ParamDef = ParamDef::number(
     0.0,
     1024.0,
     "planar maps: split an edge whose warped image strays along itself (which moves the interpolated depth) by more than this many warped texels, and on its perpendicular bend against subdiv; 0 = the whole displacement against subdiv",
-    "shadowlab (issue 48, step 2)",
+    "shadowlab measurement (docs/bench/warp.md, issue 48)",
 );
 
 /// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.

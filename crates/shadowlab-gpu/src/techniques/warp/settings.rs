@@ -51,7 +51,7 @@ impl Subdivision {
         self.subdiv > 0.0
     }
     /// On a paraboloid map (`dpsm`, `dpsm-notw`) the bend is judged across the edge only.
-    pub(crate) fn planar_only(&self) -> Vec<(&'static str, String)> {
+    pub(crate) fn paraboloid_dead(&self) -> Vec<(&'static str, String)> {
         if self.on() {
             dead_keys(&["depth_split"], "a paraboloid map's subdivision judges the bend across the edge only")
         } else {
@@ -130,7 +130,7 @@ impl NotwCore {
         let mut v = self.subdivision.dead();
         v.extend(self.footprint.dead());
         if paraboloid {
-            v.extend(self.subdivision.planar_only());
+            v.extend(self.subdivision.paraboloid_dead());
             v.extend(dead_keys(&["depth_clamp"], PARABOLOID_CLAMP));
         } else if !self.exact_depth {
             v.extend(dead_keys(&["depth_clamp"], "exact_depth=false"));

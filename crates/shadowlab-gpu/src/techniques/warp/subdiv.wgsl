@@ -73,6 +73,7 @@ fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32
     let dir = wb - wa;
     let len2 = dot(dir, dir);
     let split = wp.depth_split > 0.0 && len2 > 1e-24;
+    let inv_len = select(0.0, inverseSqrt(len2), split);
     for (var s = 1u; s <= 3u; s++) {
         let t = f32(s) / 4.0;
         let w = warp(mix(ma, mb, t));
@@ -80,8 +81,8 @@ fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32
         hi = max(hi, w);
         let d = w - mix(wa, wb, t);
         if split {
-            let along = abs(dot(d, dir)) * inverseSqrt(len2);
-            let across = abs(d.x * dir.y - d.y * dir.x) * inverseSqrt(len2);
+            let along = abs(dot(d, dir)) * inv_len;
+            let across = abs(d.x * dir.y - d.y * dir.x) * inv_len;
             e = max(e, max(across, along * wp.subdiv / wp.depth_split));
         } else {
             e = max(e, length(d));
