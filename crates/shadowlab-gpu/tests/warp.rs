@@ -149,8 +149,10 @@ fn gpu_warps_equal_the_cpu_warps_on_the_same_samples() {
     let agree = |a: &[u32], b: &[u32]| a.iter().zip(b).filter(|(x, y)| x == y).count() as f64 / a.len() as f64;
     let counts = t.read_counts_before(&gpu);
     assert!(agree(&counts, &cpu.counts) > 0.995, "count maps agree on {:.4}", agree(&counts, &cpu.counts));
+    // the rebuilt maps: apart by what the count maps' few differing samples move
     let rows = t.read_counts_rows(&gpu);
-    assert!(agree(&rows, &cpu.counts_rows) > 0.98, "rebuilt count maps agree on {:.4}", agree(&rows, &cpu.counts_rows));
+    let apart = rows.iter().zip(&cpu.counts_rows).map(|(a, b)| (a - b).abs()).sum::<f32>() / cpu.counts_rows.iter().sum::<f32>();
+    assert!(apart < 0.01, "rebuilt count maps differ by {apart} of their sum");
     let g = t.read_warp(&gpu);
     assert_eq!((g.rows_x, g.cols_y), (res, res));
     assert!(max_diff(&g.ox, &cpu.warp.ox) < 2e-3, "row warps differ by {}", max_diff(&g.ox, &cpu.warp.ox));

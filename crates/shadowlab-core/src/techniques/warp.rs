@@ -217,12 +217,45 @@ pub fn count_map(points: &[[f32; 2]], res: usize, warp: Option<(&Warp2D, bool)>)
 /// Every stage of the NoTW construction (seed 000 section 3, steps 2-7), kept for the report.
 pub struct Notw {
     pub counts: Vec<u32>,
-    pub counts_rows: Vec<u32>,
+    /// The counts rebuilt through the row warps ([`rebuild_rows`]).
+    pub counts_rows: Vec<f32>,
     pub warp: Warp2D,
 }
 
+/// The count map rebuilt through row warps (step 6) from the counts alone: each texel's count is
+/// spread evenly over its image [x'(k / res), x'((k + 1) / res)] under its own row's function
+/// (`ox`, row-major offsets at the right edges), each texel it covers taking its overlap's
+/// share. It takes a texel's samples as spread evenly over it, which is what the
+/// piecewise-linear warp assumes; a second pass over the samples (`count_map` through the rows)
+/// would cost as much as the first. The GPU `rebuild` in analyze.wgsl, in the same order.
+pub fn rebuild_rows(counts: &[u32], ox: &[f32], res: usize) -> Vec<f32> {
+    let mut out = vec![0.0f32; res * res];
+    let fw = res as f32;
+    for i in 0..res {
+        let row = &mut out[i * res..(i + 1) * res];
+        let mut x0 = 0.0f32;
+        for k in 0..res {
+            let x1 = if k + 1 == res { 1.0 } else { (k + 1) as f32 / fw + ox[i * res + k] };
+            let c = counts[i * res + k] as f32;
+            if c > 0.0 {
+                let (ja, jb) = (texel(x0, res), texel(x1, res));
+                if ja == jb || x1 <= x0 {
+                    row[ja] += c;
+                } else {
+                    for (j, r) in row.iter_mut().enumerate().take(jb + 1).skip(ja) {
+                        let part = x1.min((j + 1) as f32 / fw) - x0.max(j as f32 / fw);
+                        *r += c * part.max(0.0) / (x1 - x0);
+                    }
+                }
+            }
+            x0 = x1;
+        }
+    }
+    out
+}
+
 /// NoTW on points in map coordinates: count map, row warps (smoothed over `window` rows
-/// weighted by their totals), the count map rebuilt through them, column warps (smoothed over
+/// weighted by their totals), the count map rebuilt through them ([`rebuild_rows`]), column warps (smoothed over
 /// `window` columns), the final warp of eq. 6 (`interp`: offsets interpolated between
 /// neighbouring functions). `blur` > 0 box-blurs the counts along each row (column) first;
 /// `mix` adds a uniform floor of `mix` x the mean count per texel (points / res^2) to each.
@@ -237,13 +270,12 @@ pub fn notw_shaped(points: &[[f32; 2]], res: usize, window: usize, tent: bool, i
     let counts = count_map(points, res, None);
     let cf = blur_rows(counts.iter().map(|&c| c as f32).collect());
     let ox = row_warps(&cf, res, window, tent);
-    let rows_only = Warp2D { res, rows_x: res, cols_y: 1, ox, oy: vec![0.0; res], interp };
-    let counts_rows = count_map(points, res, Some((&rows_only, false)));
+    let counts_rows = rebuild_rows(&counts, &ox, res);
     // columns: transpose, warp as rows, transpose back into the image layout
-    let t = blur_rows((0..res * res).map(|idx| counts_rows[(idx % res) * res + idx / res] as f32).collect());
+    let t = blur_rows((0..res * res).map(|idx| counts_rows[(idx % res) * res + idx / res]).collect());
     let oy_t = row_warps(&t, res, window, tent);
     let oy: Vec<f32> = (0..res * res).map(|idx| oy_t[(idx % res) * res + idx / res]).collect();
-    Notw { counts, counts_rows, warp: Warp2D { res, rows_x: res, cols_y: res, ox: rows_only.ox, oy, interp } }
+    Notw { counts, counts_rows, warp: Warp2D { res, rows_x: res, cols_y: res, ox, oy, interp } }
 }
 
 /// Box blur of half-width `radius` (clamped at the ends, normalised by the taps inside).

@@ -18,9 +18,7 @@ pub(super) fn source() -> String {
 /// The entry points a variant dispatches.
 fn entries(variant: Variant) -> &'static [&'static str] {
     match variant {
-        Variant::Notw => {
-            &["dv_reduce", "count", "blur_rows", "offsets_rows", "smooth_rows", "rebuild", "blur_cols", "offsets_cols", "smooth_cols"]
-        }
+        Variant::Notw => &["dv_reduce", "count", "functions_rows", "smooth_rows", "rebuild", "functions_cols", "smooth_cols"],
         Variant::Rtw => &["dv_reduce", "count", "rtw_collapse", "rtw_blur", "rtw_offsets"],
         Variant::Dv => &["dv_reduce"],
     }
@@ -92,28 +90,29 @@ impl Warped {
             enc.clear_buffer(&self.work, 0, None);
             gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
             match self.variant {
-                Variant::Notw => self.notw_warps(gpu, enc, &group, w, h),
+                Variant::Notw => self.notw_warps(gpu, enc, &group),
                 _ => self.rtw_warps(gpu, enc, &group),
             }
         });
     }
 
-    /// NoTW after the count map: per direction blur, prefix sums, offsets and smoothing, the count
-    /// map rebuilt through the row warps in between (`w x h`: the view).
-    fn notw_warps(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, group: &wgpu::BindGroup, w: u32, h: u32) {
+    /// NoTW after the count map, per direction: the functions (blur, prefix sum and offsets, one
+    /// invocation each) and their smoothing; the count map rebuilt through the row warps between.
+    fn notw_warps(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, group: &wgpu::BindGroup) {
         let res = self.res;
-        let n = res * res;
-        gpu.dispatch_2d(enc, "notw.blur_rows", self.pipeline("blur_rows"), &[group], res, res);
-        let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::rows(res, res) };
-        self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
-        gpu.dispatch_2d(enc, "notw.offsets_rows", self.pipeline("offsets_rows"), &[group], res, res);
+        self.dispatch_1d(gpu, enc, group, "functions_rows", res);
         gpu.dispatch_2d(enc, "notw.smooth_rows", self.pipeline("smooth_rows"), &[group], res, res.div_ceil(SMOOTH_BLOCK));
-        gpu.dispatch_2d(enc, "notw.rebuild", self.pipeline("rebuild"), &[group], w, h);
-        gpu.dispatch_2d(enc, "notw.blur_cols", self.pipeline("blur_cols"), &[group], res, res);
-        let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::columns(res, res) };
-        self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
-        gpu.dispatch_2d(enc, "notw.offsets_cols", self.pipeline("offsets_cols"), &[group], res, res);
+        self.dispatch_1d(gpu, enc, group, "rebuild", res);
+        self.dispatch_1d(gpu, enc, group, "functions_cols", res);
         gpu.dispatch_2d(enc, "notw.smooth_cols", self.pipeline("smooth_cols"), &[group], res, res.div_ceil(SMOOTH_BLOCK));
+    }
+
+    /// Entry point `e` over `n` invocations (workgroups of 64).
+    fn dispatch_1d(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, group: &wgpu::BindGroup, e: &str, n: u32) {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(e), timestamp_writes: None });
+        pass.set_pipeline(self.pipeline(e));
+        pass.set_bind_group(0, group, &[]);
+        gpu.dispatch(&mut pass, [n.div_ceil(64), 1, 1]);
     }
 
     /// RTW after the importance map: the max-collapse to two 1D functions, their blur, one
@@ -121,16 +120,10 @@ impl Warped {
     fn rtw_warps(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, group: &wgpu::BindGroup) {
         let res = self.res;
         let n = res * res;
-        let one_d = |enc: &mut wgpu::CommandEncoder, e: &str| {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(e), timestamp_writes: None });
-            pass.set_pipeline(self.pipeline(e));
-            pass.set_bind_group(0, group, &[]);
-            gpu.dispatch(&mut pass, [(2 * res).div_ceil(64), 1, 1]);
-        };
-        one_d(enc, "rtw_collapse");
-        one_d(enc, "rtw_blur");
+        self.dispatch_1d(gpu, enc, group, "rtw_collapse", 2 * res);
+        self.dispatch_1d(gpu, enc, group, "rtw_blur", 2 * res);
         let scan = ScanParams { in_base: 3 * n, input_f32: 1, ..ScanParams::rows(res, 2) };
         self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
-        one_d(enc, "rtw_offsets");
+        self.dispatch_1d(gpu, enc, group, "rtw_offsets", 2 * res);
     }
 }

@@ -1,13 +1,13 @@
 // Building the warp from the view samples (seed 000 section 3, steps 2-7; RTW: seed 002
-// Algorithm 1). Entry points run in this order: dv_reduce, count, then for NoTW blur_rows,
-// (prefix sums of the rows) offsets_rows, smooth_rows, rebuild, blur_cols, (column prefix
-// sums) offsets_cols, smooth_cols; for RTW rtw_collapse, rtw_blur, (prefix sums) rtw_offsets.
-// A paraboloid map analyses only the view samples of its hemisphere (`owns_sample`).
+// Algorithm 1). Entry points run in this order: dv_reduce, count, then for NoTW
+// functions_rows, smooth_rows, rebuild, functions_cols, smooth_cols; for RTW rtw_collapse,
+// rtw_blur, (prefix sums) rtw_offsets. A paraboloid map analyses only the view samples of its
+// hemisphere (`owns_sample`).
 //
-// work (u32): counts [0,n) | counts rebuilt through the row warps [n,2n) | RTW importance or
-// NoTW blurred counts as f32 bits [2n,3n) | blurred 1D importance as f32 bits [3n,3n+2w).  fwork (f32): prefix sums [0,n) |
-// unsmoothed offsets [n,2n) | smoothed row offsets [2n,3n) | totals [3n,3n+w) | collapsed
-// importance [3n+w,3n+3w).  n = w*w.
+// NoTW: work (u32): counts [0,n).  fwork (f32): counts rebuilt through the row warps [0,n) |
+// prefix sums, then unsmoothed offsets [n,2n) | smoothed row offsets [2n,3n) | totals [3n,3n+w).
+// RTW: work (u32): importance as f32 bits [2n,3n) | blurred 1D importance as f32 bits
+// [3n,3n+2w).  fwork (f32): prefix sums [0,2w) | collapsed importance [3n+w,3n+3w).  n = w*w.
 
 @group(0) @binding(6) var<uniform> wp: WarpParams;
 @group(0) @binding(7) var<storage, read_write> dv: array<atomic<u32>, 8>;
@@ -139,68 +139,62 @@ fn at(axis: u32, r: u32, k: u32) -> u32 {
     return select(k * w + r, r * w + k, axis == 0u);
 }
 
-// Box blur of the counts along each function (half-width imp.z; 0 copies) plus a uniform
-// floor (`mix`, a fraction of the mean count per texel), from work[src..] into work[2n..] as
-// f32 bits. The floor bounds the magnification where a function has few samples; without it the per-texel count noise puts a kink into the warp
-// at every texel, which linear rasterisation cannot follow (docs/bench/warp.md).
-fn blur_along(axis: u32, src: u32, id: vec3<u32>) {
-    let w = res_u();
-    let k = id.x;
-    let r = id.y;
-    if k >= w || r >= w {
-        return;
+// Texel k's count along function r: the sample counts (rows) or the counts rebuilt through the
+// row warps (columns).
+fn count_at(axis: u32, r: u32, k: u32) -> f32 {
+    if axis == 0u {
+        return f32(atomicLoad(&work[at(0u, r, k)]));
     }
-    let rad = u32(wp.blur);
-    let a = u32(max(i32(k) - i32(rad), 0));
-    let b = min(k + rad, w - 1u);
-    var sum = 0.0;
-    for (var j = a; j <= b; j++) {
-        sum += f32(atomicLoad(&work[src + at(axis, r, j)]));
-    }
-    // plus the uniform floor: `mix` x the mean count per texel of the whole map
-    let floor_density = wp.mix * f32(atomicLoad(&dv[5])) / f32(w * w);
-    atomicStore(&work[2u * w * w + at(axis, r, k)], bitcast<u32>(sum / f32(b - a + 1u) + floor_density));
+    return fwork[at(1u, r, k)];
 }
 
-@compute @workgroup_size(8, 8)
-fn blur_rows(@builtin(global_invocation_id) id: vec3<u32>) {
-    blur_along(0u, 0u, id);
-}
-
-@compute @workgroup_size(8, 8)
-fn blur_cols(@builtin(global_invocation_id) id: vec3<u32>) {
+// One warping function per invocation (eq. 4), in two sweeps along it: the counts box-blurred
+// (half-width `blur`, normalised by the taps inside; a sliding sum, exact for whole counts)
+// plus a uniform floor (`mix` x the mean count per texel of the whole map) and their prefix
+// sums, then the offsets o = g / N - x (identity for an empty function) and the total N. The
+// floor bounds the magnification where a function has few samples; without the blur the
+// per-texel count noise puts a kink into the warp at every texel, which linear rasterisation
+// cannot follow (docs/bench/warp.md). The same sums in the same order as core warp::notw.
+fn build_function(axis: u32, r: u32) {
     let w = res_u();
-    blur_along(1u, w * w, id);
-}
-
-// Eq. 4 at the right texel edges: o = g / N - x; identity for empty functions.
-fn offsets(axis: u32, id: vec3<u32>) {
-    let w = res_u();
-    let k = id.x;
-    let r = id.y;
-    if k >= w || r >= w {
+    if r >= w {
         return;
     }
     let n = w * w;
-    let total = fwork[at(axis, r, w - 1u)];
-    var o = 0.0;
-    if total > 0.0 {
-        o = fwork[at(axis, r, k)] / total - f32(k + 1u) / f32(w);
+    let rad = u32(wp.blur);
+    let floor_density = wp.mix * f32(atomicLoad(&dv[5])) / f32(n);
+    var win = 0.0;
+    for (var j = 0u; j <= min(rad, w - 1u); j++) {
+        win += count_at(axis, r, j);
     }
-    fwork[n + at(axis, r, k)] = o;
-    if k == 0u {
-        fwork[3u * n + r] = total;
+    var g = 0.0;
+    for (var k = 0u; k < w; k++) {
+        let a = u32(max(i32(k) - i32(rad), 0));
+        let b = min(k + rad, w - 1u);
+        g += win / f32(b - a + 1u) + floor_density;
+        fwork[n + at(axis, r, k)] = g;
+        if k + rad + 1u < w {
+            win += count_at(axis, r, k + rad + 1u);
+        }
+        if k >= rad {
+            win -= count_at(axis, r, k - rad);
+        }
     }
+    for (var k = 0u; k < w; k++) {
+        let i = n + at(axis, r, k);
+        fwork[i] = select(0.0, fwork[i] / g - f32(k + 1u) / f32(w), g > 0.0);
+    }
+    fwork[3u * n + r] = g;
 }
 
-@compute @workgroup_size(8, 8)
-fn offsets_rows(@builtin(global_invocation_id) id: vec3<u32>) {
-    offsets(0u, id);
+@compute @workgroup_size(64)
+fn functions_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    build_function(0u, id.x);
 }
 
-@compute @workgroup_size(8, 8)
-fn offsets_cols(@builtin(global_invocation_id) id: vec3<u32>) {
-    offsets(1u, id);
+@compute @workgroup_size(64)
+fn functions_cols(@builtin(global_invocation_id) id: vec3<u32>) {
+    build_function(1u, id.x);
 }
 
 // Smoothing across neighbouring functions: the average over [r - window/2, r + window/2]
@@ -292,39 +286,40 @@ fn smooth_cols(@builtin(global_invocation_id) id: vec3<u32>) {
     smooth_block(1u, id.x, id.y);
 }
 
-// o_x^(i)(x) from the smoothed row offsets in fwork.
-fn row_offset(i: u32, x: f32) -> f32 {
-    let w = res_u();
-    if x < 0.0 || x >= 1.0 {
-        return 0.0;
-    }
-    let sx = x * f32(w);
-    let k = min(u32(sx), w - 1u);
-    let row = 2u * w * w + i * w;
-    var left = 0.0;
-    if k > 0u {
-        left = fwork[row + k - 1u];
-    }
-    return edge_lerp(left, fwork[row + k], sx, k);
-}
-
-// The count map rebuilt through the smoothed row warps (step 6), each sample with its count.
-@compute @workgroup_size(8, 8)
+// The count map rebuilt through the smoothed row warps (step 6), one row per invocation: each
+// texel's count spread evenly over its image [x'(k / w), x'((k + 1) / w)] under the row's own
+// warp (the function at the texel's centre), the texels it covers taking their overlap's share.
+// A sweep along the row (the warp is monotonic), without atomics: the same sums on every run.
+// The samples are taken as spread evenly over their texel, which is what the piecewise-linear
+// warp assumes; core warp::rebuild_rows is the reference.
+@compute @workgroup_size(64)
 fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
-    var s: Sample;
-    if !load_sample(id, &s) || !owns_sample(wp, s.p) {
-        return;
-    }
-    let u = sample_dv(s.p);
-    if !inside(u) {
-        return;
-    }
     let w = res_u();
-    let i = texel_of(u.y, w);
-    let a = neighbours(u.y, w, wp.interp != 0u);
-    let xw = u.x + mix(row_offset(u32(a.x), u.x), row_offset(u32(a.y), u.x), a.z);
-    if xw >= 0.0 && xw < 1.0 {
-        atomicAdd(&work[w * w + i * w + texel_of(xw, w)], sample_weight(s.p, u));
+    let i = id.x;
+    if i >= w {
+        return;
+    }
+    for (var j = 0u; j < w; j++) {
+        fwork[i * w + j] = 0.0;
+    }
+    let fw = f32(w);
+    var x0 = 0.0;
+    for (var k = 0u; k < w; k++) {
+        let x1 = select(f32(k + 1u) / fw + fwork[2u * w * w + i * w + k], 1.0, k + 1u == w);
+        let c = f32(atomicLoad(&work[i * w + k]));
+        if c > 0.0 {
+            let ja = texel_of(x0, w);
+            let jb = texel_of(x1, w);
+            if ja == jb || x1 <= x0 {
+                fwork[i * w + ja] += c;
+            } else {
+                for (var j = ja; j <= jb; j++) {
+                    let part = min(x1, f32(j + 1u) / fw) - max(x0, f32(j) / fw);
+                    fwork[i * w + j] += c * max(part, 0.0) / (x1 - x0);
+                }
+            }
+        }
+        x0 = x1;
     }
 }
 

@@ -250,16 +250,14 @@ impl Resources {
         let (name, res, queue) = (plan.name, plan.res, plan.queue);
         let n = res as u64 * res as u64;
         let [wx, wy] = plan.warp_sizes();
-        // the DV crop alone has no count map, warps or smoothing to keep
-        let scratch = plan.variant != Variant::Dv;
         let tris = plan.params.triangles as u64;
         let levels = plan.params.subdiv_levels;
         Resources {
             warp_x: r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1),
             warp_y: r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1),
             map: raster::depth_target(gpu, &format!("{name}.map"), res, res, 1, wgpu::TextureUsages::empty()),
-            work: gpu.storage(&format!("{name}.work"), if scratch { (3 * n + 2 * res as u64) * 4 } else { 4 }),
-            fwork: gpu.storage(&format!("{name}.fwork"), if scratch { (3 * n + 3 * res as u64) * 4 } else { 4 }),
+            work: gpu.storage(&format!("{name}.work"), work_words(plan.variant, res)[0] * 4),
+            fwork: gpu.storage(&format!("{name}.fwork"), work_words(plan.variant, res)[1] * 4),
             pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
             queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16)),
             counters: gpu.buffer(&wgpu::BufferDescriptor {
@@ -284,6 +282,17 @@ impl Resources {
                 mapped_at_creation: false,
             }),
         }
+    }
+}
+
+/// Words of the analysis's two work buffers (analyze.wgsl's layouts): NoTW's counts, then its
+/// rebuilt counts, offsets and totals; RTW's importance and 1D functions; the DV alone: none.
+fn work_words(variant: Variant, res: u32) -> [u64; 2] {
+    let (n, w) = (res as u64 * res as u64, res as u64);
+    match variant {
+        Variant::Notw => [n, 3 * n + w],
+        Variant::Rtw => [3 * n + 2 * w, 3 * n + 3 * w],
+        Variant::Dv => [1, 1],
     }
 }
 

@@ -1,10 +1,11 @@
 //! Warped shadow maps (seed 000 sections 2.2-3.3, seed 002 chapter 4), one folder, three
 //! registry entries sharing every pass:
 //! - `notw`: Non-orthogonal Texture Warping. Desired view (DV) by a parallel min/max reduction,
-//!   count map at shadow-map resolution by atomic adds, per-row prefix sums, row warps
-//!   o(x) = g(x)/N - x smoothed across neighbouring rows weighted by their counts, the count map
-//!   rebuilt through them, the same for columns, the final warp of eq. 6; the warps live in two
-//!   R32Float textures (8 w^2 bytes per light).
+//!   count map at shadow-map resolution by atomic adds, per-row prefix sums (one invocation a
+//!   row), row warps o(x) = g(x)/N - x smoothed across neighbouring rows weighted by their
+//!   counts, the count map rebuilt through them (each texel's count spread over its image), the
+//!   same for columns, the final warp of eq. 6; the warps live in two R32Float textures (8 w^2
+//!   bytes per light).
 //! - `rtw`: Rectilinear Texture Warping (Rosen 2012), backward analysis: importance map
 //!   (desired-view + distance-to-eye), max-collapsed per column and row, blurred, two 1D warps
 //!   (w x 1 and 1 x w textures, 8 w bytes).
@@ -71,7 +72,7 @@ const LIGHTS: &[&str] = &["directional", "spot"];
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "notw",
     summary: "non-orthogonal texture warping: per-row and per-column warps from the view-sample count map, smoothed, DV crop",
-    cost: "DV reduction + count map + 2 prefix-sum passes + 2 rebuilds over the samples; one warped depth pass; 8 w^2 bytes of warps",
+    cost: "DV reduction + count map over the samples, then per direction one pass a row (column) and the smoothing over the map, the count map rebuilt through the row warps between; one warped depth pass; 8 w^2 bytes of warps",
     quality: "samples spread evenly over the map; long triangles bend unless subdivided",
     source: "seed 000 section 3, seed 002 chapter 4 (Navratil et al.)",
     lights: LIGHTS,

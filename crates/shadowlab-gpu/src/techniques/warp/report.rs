@@ -61,7 +61,9 @@ pub(super) fn report(t: &Warped, gpu: &Gpu) -> TechniqueReport {
         r.counters.insert("samples_per_used_texel_cv_before_warp".into(), s.samples_per_used_texel_cv);
         r.images.push(count_image("count map before warping (after DV)", res, &before));
         if t.variant == Variant::Notw {
-            r.images.push(count_image("count map after row warps", res, &t.read_counts_rows(gpu)));
+            // whole counts for the picture: a fractional share above 0 stays visible
+            let rows: Vec<u32> = t.read_counts_rows(gpu).iter().map(|&c| c.ceil() as u32).collect();
+            r.images.push(count_image("count map after row warps", res, &rows));
         }
     }
     r.images.push(count_image("count map after warping", res, &after));
@@ -146,7 +148,7 @@ impl Warped {
     /// The count map of the last frame before warping (`notw`, `rtw`).
     pub fn read_counts_before(&self, gpu: &Gpu) -> Vec<u32> {
         let n = (self.res * self.res) as usize;
-        gpu.read_buffer_as(&self.work, 2 * n)[..n].to_vec()
+        gpu.read_buffer_as(&self.work, n)
     }
 
     /// `cull_hidden`: the last frame's occluder map (res x res) and its pyramid of maxima (all
@@ -161,10 +163,10 @@ impl Warped {
         gpu.read_buffer_as(&self.counts, (self.res * self.res) as usize)
     }
 
-    /// The count map rebuilt through the row warps (`notw`).
-    pub fn read_counts_rows(&self, gpu: &Gpu) -> Vec<u32> {
-        let n = (self.res * self.res) as usize;
-        gpu.read_buffer_as(&self.work, 2 * n)[n..].to_vec()
+    /// The count map rebuilt through the row warps (`notw`; fractional: each texel's count is
+    /// spread over the texels of its image).
+    pub fn read_counts_rows(&self, gpu: &Gpu) -> Vec<f32> {
+        gpu.read_buffer_as(&self.fwork, (self.res * self.res) as usize)
     }
 
     /// The warp textures of the last frame.
