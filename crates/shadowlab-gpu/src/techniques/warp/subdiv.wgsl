@@ -54,6 +54,27 @@ fn corner_pos(tri: u32, c: u32) -> vec3<f32> {
     return v0 + (vertices[3u * tri + 1u].pos - v0) * b.x + (vertices[3u * tri + 2u].pos - v0) * b.y;
 }
 
+// What the edge tests need of a piece's corner, computed once per piece (each corner lies on two
+// of its edges): the world point, its base clip position, its DV-cropped map coordinates and
+// their warped image (both 0 behind the light, where no edge through it is tested).
+struct Corner {
+    p: vec3<f32>,
+    clip: vec4<f32>,
+    u: vec2<f32>,
+    w: vec2<f32>,
+}
+
+fn piece_corner(tri: u32, c: u32, r: vec4<f32>) -> Corner {
+    var k: Corner;
+    k.p = corner_pos(tri, c);
+    k.clip = base_clip(wp, k.p);
+    if k.clip.w > 1e-7 {
+        k.u = to_dv(clip_to_map(k.clip).xy, r);
+        k.w = warp(k.u);
+    }
+    return k;
+}
+
 // Whether the warped points of an edge (its ends and the points its bend is measured at) span
 // less than `min_piece` warped texels along both map axes: the rasteriser cannot resolve a bend
 // inside it, so splitting it further only multiplies pieces (a function of the edge alone).
@@ -97,29 +118,24 @@ fn edge_error(ma: vec2<f32>, mb: vec2<f32>, wa: vec2<f32>, wb: vec2<f32>) -> f32
 // Whether an edge must be split: both ends in front of the light, the edge overlaps the
 // cropped map, and the warp bends it by more than the threshold. A function of the edge alone,
 // so the two pieces sharing an edge decide alike and no T-junction (crack) appears.
-fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
-    let r = dv_rect();
-    let pa = corner_pos(tri, ca);
-    let pb = corner_pos(tri, cb);
-    let a = base_clip(wp, pa);
-    let b = base_clip(wp, pb);
-    if min(a.w, b.w) <= 1e-7 {
+fn edge_needs_split(a: Corner, b: Corner, r: vec4<f32>) -> bool {
+    if min(a.clip.w, b.clip.w) <= 1e-7 {
         return false;
     }
     // paraboloid: an edge wholly behind the drawn part of the hemisphere is never drawn
-    if PARABOLOID && max(hemisphere_side(wp, pa), hemisphere_side(wp, pb)) < -SPLIT_OVERLAP {
+    if PARABOLOID && max(hemisphere_side(wp, a.p), hemisphere_side(wp, b.p)) < -SPLIT_OVERLAP {
         return false;
     }
-    let ua = to_dv(clip_to_map(a).xy, r);
-    let ub = to_dv(clip_to_map(b).xy, r);
+    let ua = a.u;
+    let ub = b.u;
     if any(max(ua, ub) < vec2<f32>(0.0)) || any(min(ua, ub) > vec2<f32>(1.0)) {
         return false;
     }
     if PARABOLOID {
-        return paraboloid_edge_error(pa, pb, warp(ua), warp(ub), r) > wp.subdiv;
+        return paraboloid_edge_error(a.p, b.p, a.w, b.w, r) > wp.subdiv;
     }
-    let wa = warp(ua);
-    let wb = warp(ub);
+    let wa = a.w;
+    let wb = b.w;
     let e = edge_error(ua, ub, wa, wb);
     if e <= wp.subdiv {
         return false;
@@ -128,7 +144,7 @@ fn edge_needs_split(tri: u32, ca: u32, cb: u32) -> bool {
     // about e * (base length / warped length) cropped texels; twice that plus HIDDEN_MARGIN
     let rho = length(ub - ua) / max(length(wb - wa), 1e-12);
     let m = (HIDDEN_MARGIN + 2.0 * e * rho) / wp.res;
-    if hidden(min(ua, ub) - m, max(ua, ub) + m, min(clip_to_map(a).z, clip_to_map(b).z)) {
+    if hidden(min(ua, ub) - m, max(ua, ub) + m, min(clip_to_map(a.clip).z, clip_to_map(b.clip).z)) {
         atomicAdd(&counters[21], 1u);
         return false;
     }
@@ -201,38 +217,31 @@ fn paraboloid_edge_error(pa: vec3<f32>, pb: vec3<f32>, wa: vec2<f32>, wb: vec2<f
 // they are straight (the courtyard floor: two triangles whose edges lie outside the map). Its
 // neighbours may not split the shared edge: a possible crack, on such big pieces only.
 // (Testing interior points as well brought the cracks back: conference sun 0.37 -> 1.36 %.)
-fn interior_needs_split(p: vec4<u32>) -> bool {
-    let r = dv_rect();
-    let a = base_clip(wp, corner_pos(p.x, p.y));
-    let b = base_clip(wp, corner_pos(p.x, p.z));
-    let c = base_clip(wp, corner_pos(p.x, p.w));
-    if min(min(a.w, b.w), c.w) <= 1e-7 {
+fn interior_needs_split(k: array<Corner, 3>) -> bool {
+    if min(min(k[0].clip.w, k[1].clip.w), k[2].clip.w) <= 1e-7 {
         return false;
     }
     if PARABOLOID {
-        let side = max(max(hemisphere_side(wp, corner_pos(p.x, p.y)), hemisphere_side(wp, corner_pos(p.x, p.z))),
-            hemisphere_side(wp, corner_pos(p.x, p.w)));
+        let side = max(max(hemisphere_side(wp, k[0].p), hemisphere_side(wp, k[1].p)), hemisphere_side(wp, k[2].p));
         if side < -SPLIT_OVERLAP {
             return false;
         }
     }
-    let u = array<vec2<f32>, 3>(to_dv(clip_to_map(a).xy, r), to_dv(clip_to_map(b).xy, r), to_dv(clip_to_map(c).xy, r));
-    let lo = min(min(u[0], u[1]), u[2]);
-    let hi = max(max(u[0], u[1]), u[2]);
+    let lo = min(min(k[0].u, k[1].u), k[2].u);
+    let hi = max(max(k[0].u, k[1].u), k[2].u);
     if any(hi < vec2<f32>(0.0)) || any(lo > vec2<f32>(1.0)) {
         return false;
     }
-    if max(hi.x - lo.x, hi.y - lo.y) > BIG_PIECE {
-        return true;
-    }
-    return false;
+    return max(hi.x - lo.x, hi.y - lo.y) > BIG_PIECE;
 }
 
 // Bit 0: edge a-b, bit 1: b-c, bit 2: c-a.
 fn split_mask(p: vec4<u32>) -> u32 {
-    let m = select(0u, 1u, edge_needs_split(p.x, p.y, p.z)) | select(0u, 2u, edge_needs_split(p.x, p.z, p.w))
-        | select(0u, 4u, edge_needs_split(p.x, p.w, p.y));
-    if m != 7u && interior_needs_split(p) {
+    let r = dv_rect();
+    let k = array<Corner, 3>(piece_corner(p.x, p.y, r), piece_corner(p.x, p.z, r), piece_corner(p.x, p.w, r));
+    let m = select(0u, 1u, edge_needs_split(k[0], k[1], r)) | select(0u, 2u, edge_needs_split(k[1], k[2], r))
+        | select(0u, 4u, edge_needs_split(k[2], k[0], r));
+    if m != 7u && interior_needs_split(k) {
         return 7u;
     }
     return m;
