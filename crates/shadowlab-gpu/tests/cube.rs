@@ -203,8 +203,8 @@ fn cube_notw_lists_notws_parameters_with_twelve_defaults_of_its_own() {
         ("bias_mode", cube::DEFAULT_NOTW_BIAS_MODE),
         ("window_tent", cube::DEFAULT_NOTW_WINDOW_TENT),
         ("edge_importance", cube::DEFAULT_NOTW_EDGE_IMPORTANCE),
-        // notw's exact inversion was chosen on planar maps; the faces keep the Newton steps
-        ("exact_inverse", warp::DEFAULT_EXACT_INVERSE),
+        // the exact inversion, chosen for the faces on their own views (issue 48)
+        ("exact_inverse", cube::DEFAULT_NOTW_EXACT_INVERSE),
         // notw interpolates its depth since issue 48; the faces keep the exact depth and its bias
         ("exact_depth", cube::DEFAULT_NOTW_EXACT_DEPTH),
         ("bias", cube::DEFAULT_NOTW_BIAS),

@@ -143,15 +143,26 @@ pub const DEFAULT_NOTW_WINDOW_TENT: f64 = 1.0;
 /// faces: flagged degraded, deterministic) (docs/bench/stress.md).
 pub const DEFAULT_NOTW_EDGE_IMPORTANCE: f64 = 8.0;
 
-/// cube-notw's depth: exact per fragment (the warp inverted by Newton steps), not `notw`'s
-/// interpolated depth (issue 48, step 1), with notw's former constant bias of 1.5 warped texels.
+/// cube-notw's depth: exact per fragment (the warp inverted, `DEFAULT_NOTW_EXACT_INVERSE`), not
+/// `notw`'s interpolated depth (issue 48, step 1), with notw's former constant bias of 1.5 warped
+/// texels.
 /// `shadowlab tune -t 'cube-notw:exact_depth=false,subdiv=0.25|0.5,bias=1.5|2|2.5'` at 512x512
 /// chose `subdiv=0.25` with bias 1.5 on room light 1 and bias 2.5 on point-courtyard, and
 /// neither carried over to the view not used to choose it: conference light 1 0.182 against
 /// 0.181 % wrong, sponza-peer 0.509 against 0.498 (docs/bench/warp.md). The interpolated depth
-/// took 0.3-0.6x the frame there; a default only where validation agrees.
+/// took 0.3-0.6x the frame there; a default only where validation agrees. Rerun after the leaner
+/// analysis (step 3): 0.179 against 0.177, 0.521 against 0.512; still not.
 pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 1.0;
 pub const DEFAULT_NOTW_BIAS: f64 = 1.5;
+
+/// cube-notw inverts the warp exactly per fragment (`exact_inverse`: the two 1D inversions,
+/// searched from the fragment's screen-linear unwarped point), not by notw's former three
+/// Newton steps. Since that search starts at the guess it costs a few texture reads instead of
+/// the Newton steps' twelve warps. Chosen by the tune rule on room light 1 and point-courtyard
+/// (512x512: 0.1649 / 0.1378 -> 0.1653 / 0.1373 % wrong, mean 0.1514 -> 0.1513) and checked on
+/// conference light 1 and sponza-peer, not used to choose (0.1775 -> 0.1775, 0.5124 -> 0.5118:
+/// no worse on 2 of 2); the frame takes 0.67-0.86x (docs/bench/warp.md, issue 48).
+pub const DEFAULT_NOTW_EXACT_INVERSE: f64 = 1.0;
 
 const CUBE_DEPTH_TUNE: &str =
     "shadowlab tune on room light 1 and point-courtyard, checked on conference light 1 and sponza-peer (docs/bench/warp.md, issue 48)";
@@ -166,8 +177,10 @@ shadowlab_core::param_set! {
     pub struct CubeNotwSettings {
         pub notw: w::NotwSettings = Block::as_declared()
             .with(w::WINDOW.with_default(DEFAULT_NOTW_WINDOW, "shadowlab measurement on room's point light (docs/bench/point.md)"))
-            // notw's exact inversion was chosen on planar maps; the faces keep the Newton steps
-            .with(w::EXACT_INVERSE)
+            .with(w::EXACT_INVERSE.with_default(
+                DEFAULT_NOTW_EXACT_INVERSE,
+                "shadowlab: chosen on room light 1 and point-courtyard, checked on conference light 1 and sponza-peer (docs/bench/warp.md, issue 48)",
+            ))
             .with(w::NOTW_BLUR.with_default(DEFAULT_NOTW_BLUR, THREE_SETUPS))
             .with(w::MIX.with_default(DEFAULT_NOTW_MIX, THREE_SETUPS))
             .with(w::NOTW_SUBDIV.with_default(DEFAULT_NOTW_SUBDIV, THREE_SETUPS))

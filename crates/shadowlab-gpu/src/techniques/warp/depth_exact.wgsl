@@ -17,7 +17,8 @@ fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
     let res = wp.res;
     var inv = vec3<f32>(0.0);
     if EXACT_INVERSE {
-        inv = vec3<f32>(unwarp_exact(in.clip.xy / res), 0.0);
+        // searched from the screen-linear unwarped coordinate (within about `subdiv` texels)
+        inv = vec3<f32>(unwarp_exact(in.clip.xy / res, clamp(in.u, vec2<f32>(0.0), vec2<f32>(1.0))), 0.0);
     } else {
         inv = unwarp(in.clip.xy / res, in.u);
     }

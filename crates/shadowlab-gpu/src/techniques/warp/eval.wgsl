@@ -101,9 +101,9 @@ fn texel_jacobian(c: vec2<f32>) -> mat2x2<f32> {
         return mat2x2<f32>(vec2<f32>(0.0), vec2<f32>(0.0));
     }
     let t = floor(c * res);
-    let a = unwarp_exact(t / res);
-    let m0 = unwarp_exact((t + vec2<f32>(1.0, 0.0)) / res) - a;
-    let m1 = unwarp_exact((t + vec2<f32>(0.0, 1.0)) / res) - a;
+    let a = unwarp_exact(t / res, vec2<f32>(-1.0));
+    let m0 = unwarp_exact((t + vec2<f32>(1.0, 0.0)) / res, vec2<f32>(-1.0)) - a;
+    let m1 = unwarp_exact((t + vec2<f32>(0.0, 1.0)) / res, vec2<f32>(-1.0)) - a;
     let det = (m0.x * m1.y - m1.x * m0.y) * res;
     if abs(det) < 1e-20 {
         return mat2x2<f32>(vec2<f32>(0.0), vec2<f32>(0.0));

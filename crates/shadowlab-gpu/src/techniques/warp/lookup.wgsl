@@ -85,9 +85,12 @@ fn edge_warp(rows: bool, a: u32, b: u32, t: f32, k: u32, n: u32) -> f32 {
 }
 
 // The x with edge_warp's function(x) = goal, exactly (warp.rs `invert_pl`): the function is
-// monotonic and piecewise linear with kinks at the texel edges only, so bisection over the edges
-// finds the segment and its line gives x. Outside [0,1) the warp is the identity.
-fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32) -> f32 {
+// monotonic and piecewise linear with kinks at the texel edges only, so a search over the edges
+// finds the segment (the last edge lo with f(lo) <= goal) and its line gives x. With a guess in
+// [0,1] the search gallops out from the guess's edge (steps 1, 2, 4, ...) before it bisects:
+// the same segment, in two or three evaluations where the guess is within a texel, instead of
+// log2(n); a negative guess bisects the whole range. Outside [0,1) the warp is the identity.
+fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32, guess: f32) -> f32 {
     if goal < 0.0 || goal >= 1.0 {
         return goal;
     }
@@ -95,10 +98,45 @@ fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32) -> f32 {
     if rows {
         n = textureDimensions(warp_x).x;
     }
+    // invariant: f(lo) <= goal < f(hi), f(0) = 0 and f(n) = 1
     var lo = 0u;
     var hi = n;
     var flo = 0.0;
     var fhi = 1.0;
+    if guess >= 0.0 {
+        let g = min(u32(min(guess, 1.0) * f32(n)), n - 1u);
+        let fg = edge_warp(rows, a, b, t, g, n);
+        var step = 1u;
+        if fg <= goal {
+            lo = g;
+            flo = fg;
+            while lo + step < n {
+                let f = edge_warp(rows, a, b, t, lo + step, n);
+                if f > goal {
+                    hi = lo + step;
+                    fhi = f;
+                    break;
+                }
+                lo += step;
+                flo = f;
+                step *= 2u;
+            }
+        } else {
+            hi = g;
+            fhi = fg;
+            while hi >= step {
+                let f = edge_warp(rows, a, b, t, hi - step, n);
+                if f <= goal {
+                    lo = hi - step;
+                    flo = f;
+                    break;
+                }
+                hi -= step;
+                fhi = f;
+                step *= 2u;
+            }
+        }
+    }
     while hi - lo > 1u {
         let mid = (lo + hi) / 2u;
         let f = edge_warp(rows, a, b, t, mid, n);
@@ -116,17 +154,17 @@ fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32) -> f32 {
 
 // The exact inverse of `warp` (warp.rs `Warp2D::unapply`): the column pass reads its functions
 // at x', which the goal gives, so y is one 1D inversion; the row pass reads its functions at
-// y, so x is another.
-fn unwarp_exact(t: vec2<f32>) -> vec2<f32> {
+// y, so x is another. `guess`: a point near the answer to search from (negative: none).
+fn unwarp_exact(t: vec2<f32>, guess: vec2<f32>) -> vec2<f32> {
     if !WARPED {
         return t;
     }
     let res = u32(wp.res);
     let interp = wp.interp != 0u;
     let b = neighbours(t.x, res, interp);
-    let y = invert_1d(false, u32(b.x), u32(b.y), b.z, t.y);
+    let y = invert_1d(false, u32(b.x), u32(b.y), b.z, t.y, guess.y);
     let a = neighbours(y, res, interp);
-    return vec2<f32>(invert_1d(true, u32(a.x), u32(a.y), a.z, t.x), y);
+    return vec2<f32>(invert_1d(true, u32(a.x), u32(a.y), a.z, t.x, guess.x), y);
 }
 
 // Clip position of a world point in the warped map (Algorithm 1 of seed 000): crop to the DV,
