@@ -14,7 +14,7 @@
 //! The shadow map is rendered with the warp applied per vertex (optionally after subdividing
 //! triangles whose warped edges are long, `subdiv`), and evaluated through the same warp. The
 //! CPU reference of the math is `shadowlab_core::techniques::warp`. Stored depth: post-projective, 0 = near
-//! the light (orthographic: linear), as in `sm`; with `exact_depth` (notw default) each fragment
+//! the light (orthographic: linear), as in `sm`; with `exact_depth` (`cube-notw`'s default) each fragment
 //! writes its triangle's depth at the warp's preimage of the fragment (depth_exact.wgsl) instead
 //! of the depth interpolated between warped vertices.
 //!

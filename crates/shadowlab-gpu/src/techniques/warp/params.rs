@@ -173,7 +173,7 @@ pub const DEPTH_SPLIT: ParamDef = ParamDef::number(
 pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
 pub const CLOSE_CRACKS: ParamDef = ParamDef::flag("close_cracks", DEFAULT_CLOSE_CRACKS != 0.0, "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap", "shadowlab measurement (docs/bench/warp.md)");
 
-/// Exact depth per fragment (warp inverted by Newton steps, the triangle's plane evaluated);
+/// Exact depth per fragment (the warp inverted, `exact_inverse`, the triangle's plane evaluated);
 /// 0 = the rasterised depth interpolated between warped vertices. See `EXACT_DEPTH`. RTW: off;
 /// its smooth warp bends little at subdiv 1, so exact depth changes wrong pixels by <= 0.01
 /// points on five of six setups (sponza sun 1.18 -> 1.06 %) for 1.1-1.7x the total time.
@@ -186,7 +186,7 @@ pub const DEFAULT_EXACT_DEPTH: f64 = 0.0;
 /// train mean 0.492 -> 0.412 % wrong), validated on six views not used to choose (0.652 ->
 /// 0.607 %, no worse on 6 of 6); docs/bench/warp.md.
 pub const DEFAULT_NOTW_EXACT_DEPTH: f64 = 0.0;
-pub const EXACT_DEPTH: ParamDef = ParamDef::flag("exact_depth", DEFAULT_EXACT_DEPTH != 0.0, "write the exact depth per fragment: invert the warp at the fragment (3 Newton steps, 9 warp lookups) and evaluate the triangle's depth plane there; false = depth interpolated between warped vertices (off by up to the subdivision bend); disables early depth test", "shadowlab experiment (docs/bench/warp.md)");
+pub const EXACT_DEPTH: ParamDef = ParamDef::flag("exact_depth", DEFAULT_EXACT_DEPTH != 0.0, "write the exact depth per fragment: invert the warp at the fragment (exactly with `exact_inverse`, else 3 Newton steps) and evaluate the triangle's depth plane there; false = depth interpolated between warped vertices (off by up to the subdivision bend); disables early depth test", "shadowlab experiment (docs/bench/warp.md)");
 
 pub const NOTW_EXACT: ParamDef = EXACT_DEPTH.with_default(DEFAULT_NOTW_EXACT_DEPTH, NOTW_DEPTH_TUNED);
 
