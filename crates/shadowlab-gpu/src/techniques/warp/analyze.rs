@@ -122,7 +122,7 @@ impl Warped {
         let n = res * res;
         self.dispatch_1d(gpu, enc, group, "rtw_collapse", 2 * res);
         self.dispatch_1d(gpu, enc, group, "rtw_blur", 2 * res);
-        let scan = ScanParams { in_base: 3 * n, input_f32: 1, ..ScanParams::rows(res, 2) };
+        let scan = ScanParams { in_base: 2 * n, input_f32: 1, ..ScanParams::rows(res, 2) };
         self.prefix.encode(gpu, enc, &self.work, &self.fwork, scan);
         self.dispatch_1d(gpu, enc, group, "rtw_offsets", 2 * res);
     }

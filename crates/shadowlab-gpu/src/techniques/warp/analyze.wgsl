@@ -6,8 +6,8 @@
 //
 // NoTW: work (u32): counts [0,n).  fwork (f32): counts rebuilt through the row warps [0,n) |
 // prefix sums, then unsmoothed offsets [n,2n) | smoothed row offsets [2n,3n) | totals [3n,3n+w).
-// RTW: work (u32): importance as f32 bits [2n,3n) | blurred 1D importance as f32 bits
-// [3n,3n+2w).  fwork (f32): prefix sums [0,2w) | collapsed importance [3n+w,3n+3w).  n = w*w.
+// RTW: work (u32): counts [0,n) | importance as f32 bits [n,2n) | blurred 1D importance as f32
+// bits [2n,2n+2w).  fwork (f32): prefix sums [0,2w) | collapsed importance [2w,4w).  n = w*w.
 
 @group(0) @binding(6) var<uniform> wp: WarpParams;
 @group(0) @binding(7) var<storage, read_write> dv: array<atomic<u32>, 8>;
@@ -129,7 +129,7 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
         let maxd = bitcast<f32>(atomicLoad(&dv[4]));
         let d = distance(s.p, frame.camera_pos.xyz);
         let imp = wp.w_dv + wp.w_eye * clamp((maxd - d) / max(maxd, 1e-20), 0.0, 1.0);
-        atomicMax(&work[2u * w * w + t], bitcast<u32>(imp));
+        atomicMax(&work[w * w + t], bitcast<u32>(imp));
     }
 }
 
@@ -332,13 +332,13 @@ fn rtw_collapse(@builtin(global_invocation_id) id: vec3<u32>) {
     if t >= 2u * w {
         return;
     }
-    let base = 2u * w * w;
+    let base = w * w;
     var m = 0.0;
     for (var j = 0u; j < w; j++) {
         let idx = select(base + j * w + t, base + (t - w) * w + j, t >= w);
         m = max(m, bitcast<f32>(atomicLoad(&work[idx])));
     }
-    fwork[3u * w * w + w + t] = m;
+    fwork[2u * w + t] = m;
 }
 
 // Box blur of half-width imp.z (normalised by the taps inside), into work as f32 bits.
@@ -356,9 +356,9 @@ fn rtw_blur(@builtin(global_invocation_id) id: vec3<u32>) {
     let b = min(k + rad, w - 1u);
     var sum = 0.0;
     for (var j = u32(a); j <= b; j++) {
-        sum += fwork[3u * w * w + w + first + j];
+        sum += fwork[2u * w + first + j];
     }
-    atomicStore(&work[3u * w * w + t], bitcast<u32>(sum / f32(b - u32(a) + 1u)));
+    atomicStore(&work[2u * w * w + t], bitcast<u32>(sum / f32(b - u32(a) + 1u)));
 }
 
 // RTW's two 1D warps from the prefix sums of the blurred importance (runs 0: x, 1: y).

@@ -291,7 +291,7 @@ fn work_words(variant: Variant, res: u32) -> [u64; 2] {
     let (n, w) = (res as u64 * res as u64, res as u64);
     match variant {
         Variant::Notw => [n, 3 * n + w],
-        Variant::Rtw => [3 * n + 2 * w, 3 * n + 3 * w],
+        Variant::Rtw => [2 * n + 2 * w, 4 * w],
         Variant::Dv => [1, 1],
     }
 }

@@ -86,10 +86,13 @@ fn edge_warp(rows: bool, a: u32, b: u32, t: f32, k: u32, n: u32) -> f32 {
 
 // The x with edge_warp's function(x) = goal, exactly (warp.rs `invert_pl`): the function is
 // monotonic and piecewise linear with kinks at the texel edges only, so a search over the edges
-// finds the segment (the last edge lo with f(lo) <= goal) and its line gives x. With a guess in
-// [0,1] the search gallops out from the guess's edge (steps 1, 2, 4, ...) before it bisects:
-// the same segment, in two or three evaluations where the guess is within a texel, instead of
-// log2(n); a negative guess bisects the whole range. Outside [0,1) the warp is the identity.
+// finds the segment (f(lo) <= goal < f(lo + 1)) and its line gives x. With a guess in [0,1] the
+// search gallops out from the guess's edge (steps 1, 2, 4, ...) before it bisects: two or three
+// evaluations where the guess is within a texel, instead of log2(n); a negative guess bisects
+// the whole range. Where f increases from edge to edge in f32 that segment is unique, so both
+// searches find it; where rounding makes f flat or dip by an ulp they may stop at neighbouring
+// edges of equal value, whose lines give the same x to rounding. Outside [0,1) the warp is the
+// identity.
 fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32, guess: f32) -> f32 {
     if goal < 0.0 || goal >= 1.0 {
         return goal;
