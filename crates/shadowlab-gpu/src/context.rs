@@ -231,15 +231,24 @@ impl Gpu {
 
     /// Copies a buffer back to the CPU (blocking).
     pub fn read_buffer(&self, src: &wgpu::Buffer) -> Vec<u8> {
-        let size = src.size();
+        self.read_buffer_range(src, 0, src.size())
+    }
+
+    /// Copies `size` bytes of a buffer from `offset` (both multiples of 4) back to the CPU.
+    pub fn read_buffer_range(&self, src: &wgpu::Buffer, offset: u64, size: u64) -> Vec<u8> {
         let staging = self.readback(size);
         let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        enc.copy_buffer_to_buffer(src, offset, &staging, 0, size);
         self.submit(enc.finish());
         let mut bytes = self.map_and_take(&staging, size as usize);
         self.give_readback(staging);
         bytes.truncate(size as usize);
         bytes
+    }
+
+    /// `count` values from byte `offset` of a buffer.
+    pub fn read_buffer_at<T: bytemuck::Pod>(&self, src: &wgpu::Buffer, offset: u64, count: usize) -> Vec<T> {
+        bytemuck::pod_collect_to_vec(&self.read_buffer_range(src, offset, (count * std::mem::size_of::<T>()) as u64))
     }
 
     /// Maps a `MAP_READ` buffer whose copy was already submitted, and reads `count` values.
@@ -255,13 +264,18 @@ impl Gpu {
 
     /// Copies a 2D texture (mip 0) back to the CPU as tightly packed rows.
     pub fn read_texture(&self, tex: &wgpu::Texture, bytes_per_pixel: u32) -> Vec<u8> {
+        self.read_texture_layer(tex, bytes_per_pixel, 0)
+    }
+
+    /// [`Gpu::read_texture`] of one layer of a 2D array texture.
+    pub fn read_texture_layer(&self, tex: &wgpu::Texture, bytes_per_pixel: u32, layer: u32) -> Vec<u8> {
         let (w, h) = (tex.width(), tex.height());
         let row = w * bytes_per_pixel;
         let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let staging = self.readback((padded * h) as u64);
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
-            tex.as_image_copy(),
+            wgpu::TexelCopyTextureInfo { origin: wgpu::Origin3d { x: 0, y: 0, z: layer }, ..tex.as_image_copy() },
             wgpu::TexelCopyBufferInfo {
                 buffer: &staging,
                 layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },

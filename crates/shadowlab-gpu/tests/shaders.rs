@@ -327,7 +327,7 @@ fn warp_struct_layouts_match_rust() {
     use shadowlab_gpu::techniques::warp::WarpParams;
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
-    for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl"] {
+    for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl", "cube/eval_notw.wgsl"] {
         check_all(
             &get(w),
             "WarpParams",

@@ -8,7 +8,8 @@
 //!   The face math is `shadowlab_core::techniques::cube` (CPU, tested) and `faces.wgsl`.
 //! - `cube-notw` (notw.rs): NoTW per face: each face is a 90 degree square perspective frustum
 //!   (a spot light along the face axis) handled by `warp::Warped` with the face's view samples
-//!   only (its own desired view, count map and warps: 8 w^2 bytes per face).
+//!   only (its own desired view, count map and warps: 8 w^2 bytes per face), drawn into its
+//!   layer of shared array textures (`warp::Layers`) so that one evaluation reads every face.
 //!
 //! `cube`'s map is made and reported in map.rs, its faces drawn in depth.rs, evaluated in
 //! eval.rs; `cube-notw`'s per-face scenes are clip.rs.
@@ -35,7 +36,12 @@ use crate::{Gpu, GpuError};
 pub(crate) const FACES_WGSL: &str = include_str!("faces.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    vec![("cube/depth.wgsl", depth::source()), ("cube/eval.wgsl", eval::source()), ("cube/split.wgsl", notw::split_source())]
+    vec![
+        ("cube/depth.wgsl", depth::source()),
+        ("cube/eval.wgsl", eval::source()),
+        ("cube/split.wgsl", notw::split_source()),
+        ("cube/eval_notw.wgsl", notw::eval_source()),
+    ]
 }
 
 shadowlab_core::param_choice! {
@@ -212,7 +218,7 @@ shadowlab_core::param_set! {
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "cube-notw",
     summary: "NoTW per cube face: each face's view samples get their own desired view, count map and row/column warps",
-    cost: "notw's analysis + warped depth pass for every face that has view samples; 8 w^2 bytes of warps per face",
+    cost: "notw's analysis + warped depth pass for every face that has view samples, one evaluation over all faces; 8 w^2 bytes of warps per face",
     quality: "spreads the view samples over each face; faces with few samples gain little",
     source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
     lights: &["point"],
@@ -298,8 +304,8 @@ impl Technique for CubeMap {
 }
 
 /// A frame of `cube-notw`: the view samples split by face (one readback of their counts), then
-/// each face with samples runs `notw`'s passes on its own samples, and the faces' visibility is
-/// merged.
+/// each face with samples runs `notw`'s passes on its own samples, and one evaluation reads
+/// every face.
 impl Technique for CubeNotw {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.split_samples(gpu, f, rec);
@@ -310,17 +316,7 @@ impl Technique for CubeNotw {
         self.each_face(gpu, f, rec, |w, gpu, fi, t| w.render(gpu, fi, t))
     }
 
-    fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.evaluate(gpu, fi, t))?;
-        self.merge_faces(gpu, f, rec);
-        Ok(())
-    }
-
-    /// Each face's analysis pass (its per-face visibility is rewritten with the same values, so
-    /// the merged visibility stands).
-    fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.analyze(gpu, fi, t))
-    }
+    counted_evaluation!();
 
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
         self.face_report(gpu)

@@ -1,10 +1,11 @@
 //! `cube-notw`: NoTW per cube face (seed 002 chapter 5.3, "CubeSM w/ warping"). Each face is
 //! a 90 degree square perspective frustum, i.e. a spot light along the face axis, and is handled
-//! by one `warp::Warped` (notw's passes, unchanged): a `split` pass gives each face a mask of
-//! the view samples that fall on it (the same face rule as `cube`), the face's desired view,
-//! count map, row and column warps and warped depth map are built from those samples only, its
-//! evaluation writes a per-face visibility buffer, and `merge` copies each pixel's visibility
-//! from its face. Faces without view samples are skipped (no analysis, no depth pass).
+//! by one `warp::Warped` (notw's passes, unchanged) drawing into its layer of shared array
+//! textures (`warp::Layers`): a `split` pass gives each face a mask of the view samples that
+//! fall on it (the same face rule as `cube`), the face's desired view, count map, row and column
+//! warps and warped depth map are built from those samples only, and one evaluation over the
+//! view (eval_notw.wgsl) reads each sample's face. Faces without view samples are skipped (no
+//! analysis, no depth pass).
 //! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
 //! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
 
@@ -18,14 +19,22 @@ use crate::gbuffer::GBuffer;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueReport};
-use crate::techniques::warp::{Knobs, Warped};
+use crate::technique::EvalPipelines;
+use crate::techniques::warp::{self, Knobs, Layers, Warped, WarpParams};
 use crate::{binding, Gpu, GpuError};
 
 const SPLIT_WGSL: &str = include_str!("split.wgsl");
+const EVAL_NOTW_WGSL: &str = include_str!("eval_notw.wgsl");
 
-/// The `split` and `merge` passes (split.wgsl).
+/// The `split` pass (split.wgsl, with the warped maps' DV reduction).
 pub(super) fn split_source() -> String {
-    compose_view(&format!("{FACES_WGSL}{SPLIT_WGSL}"), false)
+    compose_view(&format!("{FACES_WGSL}{}{}{SPLIT_WGSL}", warp::PARAMS_WGSL, warp::DV_WGSL), false)
+}
+
+/// The evaluation of every face (eval_notw.wgsl over the warped map's evaluation).
+pub(super) fn eval_source() -> String {
+    let (params, lookup, eval) = (warp::PARAMS_WGSL, warp::LOOKUP_FNS_WGSL, warp::EVAL_FNS_WGSL);
+    compose_view(&format!("{FACES_WGSL}{params}{lookup}{eval}{EVAL_NOTW_WGSL}"), false)
 }
 
 /// The names of the images of a face's `Warped` report that `cube-notw` passes on.
@@ -41,7 +50,6 @@ struct Face {
     sel: wgpu::Buffer,
     /// u32 per pixel: 1 where the view sample falls on this face.
     mask: Option<wgpu::Buffer>,
-    vis: Option<wgpu::Buffer>,
     /// View samples on the face in the current frame.
     samples: u32,
 }
@@ -49,11 +57,18 @@ struct Face {
 pub struct CubeNotw {
     res: u32,
     faces: Vec<Face>,
-    face_samples: wgpu::Buffer,
+    /// The faces' warps, maps, DV bounds and counts, a layer each.
+    layers: Layers,
     layout: wgpu::BindGroupLayout,
     split: wgpu::ComputePipeline,
-    merge: wgpu::ComputePipeline,
     pixels: u64,
+    /// The evaluation: the six faces' uniforms, the layers' array views, and its pipelines.
+    params: wgpu::Buffer,
+    views: [wgpu::TextureView; 3],
+    sampler: wgpu::Sampler,
+    eval_layout: wgpu::BindGroupLayout,
+    eval: EvalPipelines,
+    eval_groups: crate::binding::GroupCache,
 }
 
 impl CubeNotw {
@@ -77,11 +92,12 @@ impl CubeNotw {
         let mut scenes: Vec<Option<GpuScene>> = scenes.into_iter().map(Some).collect();
         let mut built: Vec<Option<Face>> = (0..6).map(|_| None).collect();
         let mut shared = None;
+        let layers = Layers::notw(gpu, "cube-notw", res, 6);
         for f in order {
             let face_scene = scenes[f].take().expect("each face once");
             // one face = a spot light along the axis whose fitted frustum is the face's square
             let light = Light::Spot { position, direction: FACES[f].n, cone_deg: 45.0 };
-            let warped = Warped::new_sharing(gpu, &face_scene, &knobs, &light, shared.as_ref())?;
+            let mut warped = Warped::new_layer(gpu, &face_scene, &knobs, &light, shared.as_ref(), &layers, f as u32)?;
             shared.get_or_insert_with(|| warped.subdiv_scratch());
             built[f] = Some(Face {
                 groups: Default::default(),
@@ -91,22 +107,29 @@ impl CubeNotw {
                 light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
                 sel: gpu.uniform(&format!("cube-notw.face{f}"), &[f as u32, 0, 0, 0]),
                 mask: None,
-                vis: None,
                 samples: 0,
             });
         }
         let faces: Vec<Face> = built.into_iter().map(|f| f.expect("all six built")).collect();
         let rw = binding::storage(false);
-        let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw, rw, rw]);
-        let src = split_source();
+        let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw, rw, binding::uniform()]);
+        let params: [WarpParams; 6] = std::array::from_fn(|f| *faces[f].warped.params());
+        let (eval_layout, eval) = eval_pipelines(gpu, &params[0], layers.dv_stride());
+        let mut constants = warp::base_constants(&params[0]);
+        constants.push(("DV_STRIDE", (layers.dv_stride() / 4) as f64));
         Ok(CubeNotw {
             res,
             faces,
-            face_samples: gpu.storage("cube-notw.face_samples", 6 * 4),
-            split: gpu.compute_pipeline("cube-notw.split", &src, "split", &[&layout]),
-            merge: gpu.compute_pipeline("cube-notw.merge", &src, "merge", &[&layout]),
+            split: gpu.compute_pipeline_with("cube-notw.split", &split_source(), "split", &[&layout], &constants),
             layout,
             pixels: 0,
+            params: gpu.uniform("cube-notw.faces", &params),
+            views: layers.array_views(),
+            layers,
+            sampler: warp::eval_sampler(gpu),
+            eval_layout,
+            eval,
+            eval_groups: Default::default(),
         })
     }
 
@@ -121,18 +144,19 @@ impl CubeNotw {
     }
 
     fn group(&self, gpu: &Gpu, f: &FrameInputs, face: &Face) -> wgpu::BindGroup {
-        let (mask, vis) = (face.mask.as_ref().expect("sized in prepare"), face.vis.as_ref().expect("sized in prepare"));
+        let mask = face.mask.as_ref().expect("sized in prepare");
         f.view_group(
             gpu,
             &face.groups,
             "cube-notw.split",
             &self.layout,
-            &[face.sel.as_entire_binding(), mask.as_entire_binding(), vis.as_entire_binding(), self.face_samples.as_entire_binding()],
+            &[face.sel.as_entire_binding(), mask.as_entire_binding(), self.layers.dv().as_entire_binding(), self.params.as_entire_binding()],
         )
     }
 
-    /// Runs `step` on every face with view samples, with that face's inputs (its light, mask
-    /// and visibility buffer), and records the stages summed over the faces as `cube-notw.*`.
+    /// Runs `step` on every face with view samples, with that face's inputs (its light and
+    /// mask; the analysis passes zero the visibility of the other samples, which the
+    /// evaluation then writes), and records the stages summed over the faces as `cube-notw.*`.
     pub(super) fn each_face(
         &mut self,
         gpu: &Gpu,
@@ -145,7 +169,6 @@ impl CubeNotw {
         for face in self.faces.iter_mut().filter(|face| face.samples > 0) {
             let g = f.gbuffer;
             let gbuffer = GBuffer { mask: face.mask.clone().expect("sized in prepare"), ..g.clone() };
-            let vis = face.vis.clone().expect("sized in prepare");
             let fi = FrameInputs {
                 scene: &face.scene,
                 gbuffer: &gbuffer,
@@ -154,7 +177,7 @@ impl CubeNotw {
                 prev_camera: f.prev_camera,
                 light_buf: &face.light_buf,
                 frame: f.frame,
-                visibility: &vis,
+                visibility: f.visibility,
             };
             result = step(&mut face.warped, gpu, &fi, rec);
             if result.is_err() {
@@ -165,39 +188,53 @@ impl CubeNotw {
         result
     }
 
-    /// The `split` stage: each face's mask of the view samples on it (sized to the view), and
-    /// the samples per face read back (`cube-notw.face_samples`) so empty faces are skipped.
+    /// The `split` stage: each face's mask of the view samples on it (sized to the view) and its
+    /// desired view, and the samples per face read back (`cube-notw.face_samples`) so empty
+    /// faces are skipped.
     pub(super) fn split_samples(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         let pixels = w as u64 * h as u64;
         if pixels != self.pixels {
             for (i, face) in self.faces.iter_mut().enumerate() {
                 face.mask = Some(gpu.storage(&format!("cube-notw.mask{i}"), pixels * 4));
-                face.vis = Some(gpu.storage(&format!("cube-notw.vis{i}"), pixels * 4));
             }
             self.pixels = pixels;
         }
         let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
+        // every face's DV bounds empty (min at the top, max and count 0)
+        let stride = (self.layers.dv_stride() / 4) as usize;
+        let mut empty = vec![0u32; 6 * stride];
+        for f in 0..6 {
+            empty[f * stride..f * stride + 2].fill(u32::MAX);
+        }
+        rec.write_buffer(self.layers.dv(), 0, bytemuck::cast_slice(&empty));
         rec.stage("cube-notw.split", |enc| {
-            enc.clear_buffer(&self.face_samples, 0, None);
             for g in &groups {
                 gpu.dispatch_2d(enc, "cube-notw.split", &self.split, &[g], w, h);
             }
         });
-        let samples: Vec<u32> = rec.read_buffer_as(&self.face_samples, 6, "cube-notw.face_samples");
-        for (face, s) in self.faces.iter_mut().zip(samples) {
-            face.samples = s;
+        let bounds: Vec<u32> = rec.read_buffer_as(self.layers.dv(), 6 * stride, "cube-notw.face_samples");
+        for (f, face) in self.faces.iter_mut().enumerate() {
+            face.samples = bounds[f * stride + 5];
         }
     }
 
-    /// The `merge` stage: each pixel's visibility copied from its face's.
-    pub(super) fn merge_faces(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
-        let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
-        rec.stage("cube-notw.merge", |enc| {
-            for g in &groups {
-                gpu.dispatch_2d(enc, "cube-notw.merge", &self.merge, &[g], f.gbuffer.width, f.gbuffer.height);
-            }
-        });
+    /// The evaluation of every face in one pass (`final_pass`); with `counting` the lab's
+    /// analysis variant (each face's samples per warped texel, in its slice of the counts).
+    pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        let extra = [
+            self.params.as_entire_binding(),
+            self.layers.dv().as_entire_binding(),
+            wgpu::BindingResource::TextureView(&self.views[0]),
+            wgpu::BindingResource::TextureView(&self.views[1]),
+            wgpu::BindingResource::TextureView(&self.views[2]),
+            wgpu::BindingResource::Sampler(&self.sampler),
+            self.layers.counts().as_entire_binding(),
+        ];
+        let group = f.view_group(gpu, &self.eval_groups, "cube-notw.final_pass", &self.eval_layout, &extra);
+        let (w, h) = (f.gbuffer.width, f.gbuffer.height);
+        self.eval.record(gpu, rec, "cube-notw.final_pass", self.layers.counts(), &group, w, h, counting);
+        Ok(())
     }
 
     /// The faces' reports summed (memory, subdivision counters) or named per face (samples,
@@ -249,4 +286,28 @@ impl CubeNotw {
         r.sampling = Some(sampling_stats(&after));
         r
     }
+}
+
+/// The evaluation's layout (the view; the faces' uniforms, DV bounds, warps, maps, comparison
+/// sampler and counts) and pipelines, specialised as a face's own evaluation would be.
+fn eval_pipelines(gpu: &Gpu, p: &WarpParams, dv_stride: u64) -> (wgpu::BindGroupLayout, EvalPipelines) {
+    let array = |sample_type| wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false };
+    let float = array(wgpu::TextureSampleType::Float { filterable: false });
+    let layout = view_layout(
+        gpu,
+        "cube-notw.final_pass",
+        &[
+            binding::uniform(),
+            binding::storage(true),
+            float,
+            float,
+            array(wgpu::TextureSampleType::Depth),
+            binding::comparison_sampler(),
+            binding::storage(false),
+        ],
+    );
+    let mut constants = warp::eval_constants(p);
+    constants.push(("DV_STRIDE", (dv_stride / 4) as f64));
+    let eval = EvalPipelines::new(gpu, "cube-notw.final_pass", &eval_source(), &layout, &constants);
+    (layout, eval)
 }

@@ -230,7 +230,7 @@ impl Dpsm {
             Warped::with_projection(gpu, scene, k, Projection::Paraboloid { view: dp.view(h), hemisphere: h }, labels[i])
         };
         // the hemispheres render one after another: one set of subdivision buffers for both
-        let front = make(0)?;
+        let mut front = make(0)?;
         let mut back = make(1)?;
         back.borrow_subdiv(&front.subdiv_scratch());
         Ok(Dpsm { maps: [front, back], warped, res, pcf })

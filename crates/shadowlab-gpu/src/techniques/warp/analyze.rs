@@ -3,7 +3,7 @@
 //! cropped map and the warps built from it: NoTW's row warps, the count map rebuilt through
 //! them and the column warps; RTW's 1D collapse, blur and offsets.
 
-use super::{base_constants, Variant, WarpParams, Warped, PARAMS_WGSL, SMOOTH_BLOCK};
+use super::{base_constants, Variant, WarpParams, Warped, DV_WGSL, PARAMS_WGSL, SMOOTH_BLOCK};
 use crate::prefix_sum::ScanParams;
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, FrameInputs};
@@ -12,7 +12,7 @@ use crate::{binding, Gpu};
 const ANALYZE_WGSL: &str = include_str!("analyze.wgsl");
 
 pub(super) fn source() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{ANALYZE_WGSL}"), false)
+    compose_view(&format!("{PARAMS_WGSL}{DV_WGSL}{ANALYZE_WGSL}"), false)
 }
 
 /// The entry points a variant dispatches.
@@ -53,7 +53,8 @@ impl Warped {
     }
 
     /// This frame's desired view and warps (stages `desired_view`, with `edge_importance` the
-    /// `occluders` of the crop, and `importance_map`).
+    /// `occluders` of the crop, and `importance_map`). A layer of [`super::Layers`] has its
+    /// desired view reduced by its owner (cube-notw's `split`) before this.
     pub(super) fn fit_warps(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let name = self.name();
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
@@ -64,7 +65,7 @@ impl Warped {
             &self.analyze_layout,
             &[
                 self.uniform.as_entire_binding(),
-                self.dv.as_entire_binding(),
+                self.dv_binding(),
                 self.work.as_entire_binding(),
                 self.fwork.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&self.views[0]),
@@ -73,10 +74,12 @@ impl Warped {
                 self.occluders.as_ref().map_or(&self.counts, |o| &o.hzb).as_entire_binding(),
             ],
         );
-        rec.write_buffer(&self.dv, 0, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
-        rec.stage(&format!("{name}.desired_view"), |enc| {
-            gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
-        });
+        if !self.layered {
+            rec.write_buffer(&self.dv, 0, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
+            rec.stage(&format!("{name}.desired_view"), |enc| {
+                gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
+            });
+        }
         if self.variant == Variant::Dv {
             return;
         }

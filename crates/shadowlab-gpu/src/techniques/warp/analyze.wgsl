@@ -18,8 +18,6 @@
 // the occluder map's pyramid (level 0 first: the unwarped DV-cropped depth), `edge_importance`
 @group(0) @binding(12) var<storage, read> occ: array<f32>;
 
-var<workgroup> wg_bounds: array<atomic<u32>, 6>;
-
 fn res_u() -> u32 {
     return u32(wp.res);
 }
@@ -29,37 +27,20 @@ fn dv_now() -> vec4<f32> {
 }
 
 // DV: parallel min/max of the samples' map coordinates (fixed point), per workgroup in shared
-// memory, then one global atomic per workgroup; also the largest eye distance (RTW).
+// memory (dv.wgsl), then one global atomic per workgroup; also the largest eye distance (RTW)
+// and the sample count.
 @compute @workgroup_size(8, 8)
 fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) t: u32) {
-    if t == 0u {
-        atomicStore(&wg_bounds[0], 0xffffffffu);
-        atomicStore(&wg_bounds[1], 0xffffffffu);
-        atomicStore(&wg_bounds[2], 0u);
-        atomicStore(&wg_bounds[3], 0u);
-        atomicStore(&wg_bounds[4], 0u);
-        atomicStore(&wg_bounds[5], 0u);
-    }
-    workgroupBarrier();
     var s: Sample;
-    if load_sample(id, &s) && owns_sample(wp, s.p) {
-        let m = clamp(clip_to_map(base_clip(wp, s.p)).xy, vec2<f32>(0.0), vec2<f32>(1.0));
-        let f = vec2<u32>(min(m * DV_SCALE, vec2<f32>(DV_SCALE)));
-        atomicMin(&wg_bounds[0], f.x);
-        atomicMin(&wg_bounds[1], f.y);
-        atomicMax(&wg_bounds[2], f.x);
-        atomicMax(&wg_bounds[3], f.y);
-        atomicMax(&wg_bounds[4], bitcast<u32>(distance(s.p, frame.camera_pos.xyz)));
-        atomicAdd(&wg_bounds[5], 1u);
-    }
-    workgroupBarrier();
+    let counted = load_sample(id, &s) && owns_sample(wp, s.p);
+    let b = dv_workgroup(t, counted, wp, s.p);
     if t == 0u {
-        atomicMin(&dv[0], atomicLoad(&wg_bounds[0]));
-        atomicMin(&dv[1], atomicLoad(&wg_bounds[1]));
-        atomicMax(&dv[2], atomicLoad(&wg_bounds[2]));
-        atomicMax(&dv[3], atomicLoad(&wg_bounds[3]));
-        atomicMax(&dv[4], atomicLoad(&wg_bounds[4]));
-        atomicAdd(&dv[5], atomicLoad(&wg_bounds[5]));
+        atomicMin(&dv[0], b[0]);
+        atomicMin(&dv[1], b[1]);
+        atomicMax(&dv[2], b[2]);
+        atomicMax(&dv[3], b[3]);
+        atomicMax(&dv[4], b[4]);
+        atomicAdd(&dv[5], b[5]);
     }
 }
 

@@ -8,7 +8,7 @@ use shadowlab_core::lightspace;
 use shadowlab_core::techniques::dpsm::Hemisphere;
 
 use super::{analyze, depth, eval, occluders, subdiv};
-use super::{Groups, Knobs, Projection, SubdivScratch, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
+use super::{Groups, Knobs, Layers, Projection, SubdivScratch, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
 use crate::prefix_sum::PrefixSum;
 use crate::scene_gpu::GpuScene;
 use crate::technique::EvalPipelines;
@@ -23,13 +23,39 @@ impl Warped {
 
     /// `new`, borrowing `shared`'s subdivision buffers when they are large enough.
     pub fn new_sharing(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light, shared: Option<&SubdivScratch>) -> Result<Warped, GpuError> {
+        Warped::planar(gpu, scene, k, light, shared, None)
+    }
+
+    /// `new_sharing`, drawing into layer `layer` of `layers` (warps, map, DV bounds and
+    /// counts): a NoTW map of `layers`' resolution, evaluated with the others by the caller.
+    pub fn new_layer(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        k: &Knobs,
+        light: &Light,
+        shared: Option<&SubdivScratch>,
+        layers: &Layers,
+        layer: u32,
+    ) -> Result<Warped, GpuError> {
+        assert!(k.variant == Variant::Notw && k.res == layers.res && layer < layers.count(), "a layer fits a NoTW map of its resolution");
+        Warped::planar(gpu, scene, k, light, shared, Some((layers, layer)))
+    }
+
+    fn planar(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        k: &Knobs,
+        light: &Light,
+        shared: Option<&SubdivScratch>,
+        target: Option<(&Layers, u32)>,
+    ) -> Result<Warped, GpuError> {
         let name = k.variant.name();
         let res = k.res;
         gpu.check_size(res, res, "shadow map")?;
         let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
             GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
         })?;
-        let mut w = Warped::with_projection(gpu, scene, k, Projection::Planar(lp), name)?;
+        let mut w = Warped::with_projection_in(gpu, scene, k, Projection::Planar(lp), name, target)?;
         if let Some(s) = shared {
             w.borrow_subdiv(s);
         }
@@ -42,8 +68,19 @@ impl Warped {
     /// `dpsm`'s is not (the plain, unwarped paraboloid map, rendered with subdivision). The
     /// caller has checked `res`.
     pub fn with_projection(gpu: &Gpu, scene: &GpuScene, k: &Knobs, proj: Projection, name: &'static str) -> Result<Warped, GpuError> {
+        Warped::with_projection_in(gpu, scene, k, proj, name, None)
+    }
+
+    fn with_projection_in(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        k: &Knobs,
+        proj: Projection,
+        name: &'static str,
+        target: Option<(&Layers, u32)>,
+    ) -> Result<Warped, GpuError> {
         let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size)?;
-        let resources = Resources::new(gpu, &plan);
+        let resources = Resources::new(gpu, &plan, target);
         let pipelines = Pipelines::new(gpu, scene, &plan);
         let scene =
             depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None, counting: Default::default() };
@@ -51,10 +88,21 @@ impl Warped {
     }
 
     fn assemble(plan: Plan, r: Resources, p: Pipelines, scene: depth::SceneBinding) -> Warped {
+        // this map's layer of each texture (the whole texture when it has its own)
+        let layer_view = wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: r.layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        };
         Warped {
             scene,
             groups: Groups { levels: (0..=r.level_uniforms.len()).map(|_| Default::default()).collect(), ..Default::default() },
-            views: [&r.warp_x, &r.warp_y, &r.map].map(|t| t.create_view(&Default::default())),
+            views: [&r.warp_x, &r.warp_y, &r.map].map(|t| t.create_view(&layer_view)),
+            layer: r.layer,
+            layered: r.layered,
+            dv_offset: r.dv_offset,
+            counts_offset: r.counts_offset,
             variant: plan.variant,
             label: plan.name,
             res: plan.res,
@@ -72,6 +120,7 @@ impl Warped {
             counters: r.counters,
             queues: r.queues,
             owns_subdiv: true,
+            shares_subdiv: false,
             dispatch: r.dispatch,
             level_uniforms: r.level_uniforms,
             prefix: p.prefix,
@@ -243,19 +292,44 @@ struct Resources {
     dv: wgpu::Buffer,
     counts: wgpu::Buffer,
     dispatch: wgpu::Buffer,
+    /// The map's layer of the three textures, and its byte offsets in `dv` and `counts` (0
+    /// for a map with its own).
+    layer: u32,
+    layered: bool,
+    dv_offset: u64,
+    counts_offset: u64,
 }
 
 impl Resources {
-    fn new(gpu: &Gpu, plan: &Plan) -> Resources {
+    /// The plan's resources; with `target` its warps, map, DV bounds and counts are that
+    /// layer of shared ones ([`Layers`]).
+    fn new(gpu: &Gpu, plan: &Plan, target: Option<(&Layers, u32)>) -> Resources {
         let (name, res, queue) = (plan.name, plan.res, plan.queue);
         let n = res as u64 * res as u64;
         let [wx, wy] = plan.warp_sizes();
         let tris = plan.params.triangles as u64;
         let levels = plan.params.subdiv_levels;
+        let (warp_x, warp_y, map, dv, counts, layer, dv_offset, counts_offset) = match target {
+            Some((l, i)) => (l.warp_x.clone(), l.warp_y.clone(), l.map.clone(), l.dv.clone(), l.counts.clone(), i, i as u64 * l.dv_stride, i as u64 * n * 4),
+            None => (
+                r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1),
+                r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1),
+                raster::depth_target(gpu, &format!("{name}.map"), res, res, 1, wgpu::TextureUsages::empty()),
+                gpu.storage(&format!("{name}.dv"), 32),
+                gpu.storage(&format!("{name}.counts"), n * 4),
+                0,
+                0,
+                0,
+            ),
+        };
         Resources {
-            warp_x: r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1),
-            warp_y: r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1),
-            map: raster::depth_target(gpu, &format!("{name}.map"), res, res, 1, wgpu::TextureUsages::empty()),
+            warp_x,
+            warp_y,
+            map,
+            layer,
+            layered: target.is_some(),
+            dv_offset,
+            counts_offset,
             work: gpu.storage(&format!("{name}.work"), work_words(plan.variant, res)[0] * 4),
             fwork: gpu.storage(&format!("{name}.fwork"), work_words(plan.variant, res)[1] * 4),
             pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
@@ -273,8 +347,8 @@ impl Resources {
                 .map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue]))
                 .collect(),
             uniform: gpu.uniform(&format!("{name}.params"), &plan.params),
-            dv: gpu.storage(&format!("{name}.dv"), 32),
-            counts: gpu.storage(&format!("{name}.counts"), n * 4),
+            dv,
+            counts,
             dispatch: gpu.buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{name}.dispatch")),
                 size: 12,

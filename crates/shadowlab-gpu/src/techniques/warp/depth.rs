@@ -100,7 +100,7 @@ impl Warped {
     pub(super) fn lookup_resources(&self) -> [wgpu::BindingResource<'_>; 4] {
         [
             self.uniform.as_entire_binding(),
-            self.dv.as_entire_binding(),
+            self.dv_binding(),
             wgpu::BindingResource::TextureView(&self.views[0]),
             wgpu::BindingResource::TextureView(&self.views[1]),
         ]
@@ -146,11 +146,16 @@ impl Warped {
     /// Fragments the last frame's exact-depth pass shaded and kept (each one inversion of the
     /// warp; discarded ones, behind a paraboloid's split plane or cut out, not counted): its
     /// draw again, with the depth test off, under an occlusion query (the map is kept).
-    /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame.
+    /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame, and for a
+    /// map whose subdivision buffers are shared (cube-notw's faces, dpsm's hemispheres: after
+    /// the frame they hold another map's pieces, so the redraw would count those).
     pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
         let (scene_group, triangles) = self.scene.last.as_ref()?;
         if self.params.exact_depth == 0 {
             return Some(0);
+        }
+        if self.shares_subdiv && self.params.subdiv > 0.0 {
+            return None;
         }
         let (pipeline, set, resolve) = self.scene.counting.get_or_init(|| {
             let pipeline = counting_pipeline(gpu, self.name(), &self.lookup_layout, &self.scene, &self.params);

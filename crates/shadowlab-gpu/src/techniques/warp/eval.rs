@@ -10,15 +10,18 @@ use crate::shaders::flag;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, Gpu, GpuError};
 
-const EVAL_WGSL: &str = include_str!("eval.wgsl");
+/// The evaluation of one sample (`eval_sample`), for any bindings of the map.
+pub(crate) const EVAL_FNS_WGSL: &str = include_str!("eval.wgsl");
+/// One map's bindings and entry point.
+const EVAL_MAIN_WGSL: &str = include_str!("eval_main.wgsl");
 
 pub(super) fn source() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{EVAL_WGSL}"), false)
+    compose_view(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{EVAL_FNS_WGSL}{EVAL_MAIN_WGSL}"), false)
 }
 
 /// The evaluation's pipeline constants (eval.wgsl and params.wgsl): the knobs of `p` that choose
 /// code paths, so that the pipeline holds only the path this map takes.
-pub(super) fn constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
+pub(crate) fn constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
     let mut c = base_constants(p);
     c.extend([
         ("BIAS_MODE", p.bias_mode.round() as f64),
@@ -42,7 +45,7 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, p: &WarpParams) -> (wgpu::BindGro
 }
 
 /// The evaluation's depth comparison, nearest texel (the PCF taps are explicit).
-pub(super) fn sampler(gpu: &Gpu) -> wgpu::Sampler {
+pub(crate) fn sampler(gpu: &Gpu) -> wgpu::Sampler {
     gpu.device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("warp.cmp"),
         compare: Some(wgpu::CompareFunction::LessEqual),
@@ -57,12 +60,15 @@ pub(super) fn sampler(gpu: &Gpu) -> wgpu::Sampler {
 impl Warped {
     /// The evaluation; with `counting` the lab's analysis variant (view samples per texel).
     pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
+        // a layer of [`Layers`] is evaluated with the others by its owner (and the counting
+        // variant below clears the whole counts buffer)
+        assert!(!self.layered, "{}: a layered map is evaluated by its owner", self.name());
         let name = self.name();
         let mut extra: Vec<wgpu::BindingResource> = self.lookup_resources().to_vec();
         extra.extend([
             wgpu::BindingResource::TextureView(&self.views[2]),
             wgpu::BindingResource::Sampler(&self.sampler),
-            self.counts.as_entire_binding(),
+            self.counts_binding(),
         ]);
         let group = f.view_group(gpu, &self.groups.eval, &format!("{name}.final_pass"), &self.eval_layout, &extra);
         self.eval.record(gpu, rec, &format!("{name}.final_pass"), &self.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);

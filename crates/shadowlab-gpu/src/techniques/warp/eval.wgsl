@@ -11,16 +11,15 @@
 // (`texel_jacobian`: exact across the warp's kinks, docs/bench/warp_kinks.md). Also counts the samples per warped texel
 // (sampling statistics after warping).
 
+// The map, its samples' counts and the light's axis come from the entry point's file
+// (eval_main.wgsl for one map: `map_texel`, `map_compare`, `count_texel`, `light_axis`).
+
 // The knobs that choose code paths, fixed per map at pipeline creation (eval.rs `constants`,
 // equal to the uniform's `bias_mode`, `dv_mode` and `perspective`; PARABOLOID and WARPED in
 // params.wgsl).
 override BIAS_MODE: u32;
 override CLOSE_CRACKS: bool;
 override PERSPECTIVE: bool;
-
-@group(0) @binding(10) var shadow_map: texture_depth_2d;
-@group(0) @binding(11) var cmp: sampler_comparison;
-@group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
 
 // The nearest depth of the 3x3 texels around uv: closes the sub-texel cracks that adaptive
 // subdivision leaves at T-junctions (the finer side's midpoints are warped, the coarser side's
@@ -31,7 +30,7 @@ fn min_depth_3x3(uv: vec2<f32>, res: u32) -> f32 {
     for (var y = -1; y <= 1; y++) {
         for (var x = -1; x <= 1; x++) {
             let t = clamp(c + vec2<i32>(x, y), vec2<i32>(0), vec2<i32>(i32(res) - 1));
-            d = min(d, textureLoad(shadow_map, t, 0));
+            d = min(d, map_texel(t));
         }
     }
     return d;
@@ -118,13 +117,8 @@ fn jacobian(u: vec2<f32>, h: f32) -> mat2x2<f32> {
     return mat2x2<f32>(jx, jy);
 }
 
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    var s: Sample;
-    // a paraboloid map writes only its hemisphere's samples; the other map writes the rest
-    if !load_sample(id, &s) || !owns_sample(wp, s.p) {
-        return;
-    }
+// The visibility of one view sample through the map (and, counting, its warped texel counted).
+fn eval_sample(s: Sample) {
     let p = s.p;
     let n = s.n;
     let l = to_light(light, p);
@@ -136,13 +130,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let c0 = warp(u0);
     if COUNT_SAMPLES && all(c0 >= vec2<f32>(0.0)) && all(c0 < vec2<f32>(1.0)) {
         let t = vec2<u32>(c0 * res);
-        atomicAdd(&counts[t.y * u32(res) + t.x], 1u);
+        count_texel(t.y * u32(res) + t.x);
     }
 
     // world size of one cropped texel at p, then of one warped texel
     var texel = wp.texel_world * max(r.z - r.x, r.w - r.y);
     if PERSPECTIVE {
-        texel *= max(dot(p - light.position.xyz, light.direction.xyz), 0.0);
+        texel *= max(dot(p - light.position.xyz, light_axis()), 0.0);
     }
     if PARABOLOID {
         // texel.x = 2 / res radians per texel at the rim; (1 + n.z) x that in general
@@ -202,7 +196,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             if CLOSE_CRACKS {
                 lit += select(0.0, 1.0, z <= min_depth_3x3(uv, u32(res)));
             } else {
-                lit += textureSampleCompareLevel(shadow_map, cmp, uv, z);
+                lit += map_compare(uv, z);
             }
         }
     }

@@ -1,15 +1,9 @@
-// Applying a finished warp (depth, subdivision and evaluation passes): the DV rectangle and the
-// two R32Float warp textures at fixed bindings 6-9 of group 0. warp_x holds one row function
-// per texture row (one row for RTW), warp_y one column function per texture column.
-
-@group(0) @binding(6) var<uniform> wp: WarpParams;
-@group(0) @binding(7) var<storage, read> dv_bounds: array<u32>;
-@group(0) @binding(8) var warp_x: texture_2d<f32>;
-@group(0) @binding(9) var warp_y: texture_2d<f32>;
-
-fn dv_rect() -> vec4<f32> {
-    return dv_from_bounds(wp, vec4<u32>(dv_bounds[0], dv_bounds[1], dv_bounds[2], dv_bounds[3]));
-}
+// Applying a finished warp (depth, subdivision and evaluation passes). The map's bindings come
+// first: lookup_bind.wgsl's (one map: the uniform `wp`, the DV rectangle `dv_rect` and the two
+// warps at bindings 6-9 of group 0) or cube-notw's layered ones (cube/eval_notw.wgsl: the
+// evaluated face's layer). warp_x holds one row function per texture row (one row for RTW),
+// warp_y one column function per texture column; `warp_x_at(k, row)` and `warp_y_at(col, k)`
+// read them, `warp_x_size()` and `warp_y_size()` give their sizes.
 
 // Base map coordinates -> DV-cropped coordinates.
 fn to_dv(m: vec2<f32>, r: vec4<f32>) -> vec2<f32> {
@@ -18,7 +12,7 @@ fn to_dv(m: vec2<f32>, r: vec4<f32>) -> vec2<f32> {
 
 // o_x^(i)(x): row i (clamped to the texture), 0 outside [0,1).
 fn offset_x(i: u32, x: f32) -> f32 {
-    let d = textureDimensions(warp_x);
+    let d = warp_x_size();
     if x < 0.0 || x >= 1.0 {
         return 0.0;
     }
@@ -27,14 +21,14 @@ fn offset_x(i: u32, x: f32) -> f32 {
     let k = min(u32(s), d.x - 1u);
     var left = 0.0;
     if k > 0u {
-        left = textureLoad(warp_x, vec2<u32>(k - 1u, row), 0).x;
+        left = warp_x_at(k - 1u, row);
     }
-    return edge_lerp(left, textureLoad(warp_x, vec2<u32>(k, row), 0).x, s, k);
+    return edge_lerp(left, warp_x_at(k, row), s, k);
 }
 
 // o_y^(j)(y): column j (clamped to the texture), 0 outside [0,1).
 fn offset_y(j: u32, y: f32) -> f32 {
-    let d = textureDimensions(warp_y);
+    let d = warp_y_size();
     if y < 0.0 || y >= 1.0 {
         return 0.0;
     }
@@ -43,9 +37,9 @@ fn offset_y(j: u32, y: f32) -> f32 {
     let k = min(u32(s), d.y - 1u);
     var left = 0.0;
     if k > 0u {
-        left = textureLoad(warp_y, vec2<u32>(col, k - 1u), 0).x;
+        left = warp_y_at(col, k - 1u);
     }
-    return edge_lerp(left, textureLoad(warp_y, vec2<u32>(col, k), 0).x, s, k);
+    return edge_lerp(left, warp_y_at(col, k), s, k);
 }
 
 // Seed 000 eq. 6: (x + o_x^(i)(x), y + o_y^(j)(y)), i = floor(y w), j = floor(x' w); with
@@ -73,13 +67,13 @@ fn edge_warp(rows: bool, a: u32, b: u32, t: f32, k: u32, n: u32) -> f32 {
     var oa = 0.0;
     var ob = 0.0;
     if rows {
-        let h = textureDimensions(warp_x).y - 1u;
-        oa = textureLoad(warp_x, vec2<u32>(k - 1u, min(a, h)), 0).x;
-        ob = textureLoad(warp_x, vec2<u32>(k - 1u, min(b, h)), 0).x;
+        let h = warp_x_size().y - 1u;
+        oa = warp_x_at(k - 1u, min(a, h));
+        ob = warp_x_at(k - 1u, min(b, h));
     } else {
-        let w = textureDimensions(warp_y).x - 1u;
-        oa = textureLoad(warp_y, vec2<u32>(min(a, w), k - 1u), 0).x;
-        ob = textureLoad(warp_y, vec2<u32>(min(b, w), k - 1u), 0).x;
+        let w = warp_y_size().x - 1u;
+        oa = warp_y_at(min(a, w), k - 1u);
+        ob = warp_y_at(min(b, w), k - 1u);
     }
     return f32(k) / f32(n) + wp.strength * mix(oa, ob, t);
 }
@@ -97,9 +91,9 @@ fn invert_1d(rows: bool, a: u32, b: u32, t: f32, goal: f32, guess: f32) -> f32 {
     if goal < 0.0 || goal >= 1.0 {
         return goal;
     }
-    var n = textureDimensions(warp_y).y;
+    var n = warp_y_size().y;
     if rows {
-        n = textureDimensions(warp_x).x;
+        n = warp_x_size().x;
     }
     // invariant: f(lo) <= goal < f(hi), f(0) = 0 and f(n) = 1
     var lo = 0u;

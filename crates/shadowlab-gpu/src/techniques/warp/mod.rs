@@ -27,13 +27,16 @@ mod build;
 mod depth;
 mod eval;
 mod knobs;
+mod layers;
 mod occluders;
 mod params;
 mod report;
 mod settings;
 mod subdiv;
 
+pub(crate) use eval::{constants as eval_constants, sampler as eval_sampler, EVAL_FNS_WGSL};
 pub use knobs::Knobs;
+pub use layers::Layers;
 pub use params::*;
 pub use settings::*;
 pub use subdiv::SubdivScratch;
@@ -50,9 +53,14 @@ use crate::technique::{counted_evaluation, FrameInputs, Technique, TechniqueInfo
 use crate::{Gpu, GpuError};
 
 /// Every warp shader's prelude: `WarpParams`, the base projection, the DV rule, the offsets.
-const PARAMS_WGSL: &str = include_str!("params.wgsl");
-/// A finished warp applied (depth, subdivision, occluder and evaluation passes): bindings 6-9.
-const LOOKUP_WGSL: &str = include_str!("lookup.wgsl");
+pub(crate) const PARAMS_WGSL: &str = include_str!("params.wgsl");
+/// The desired view's reduction within a workgroup (analyze.wgsl, cube-notw's split).
+pub(crate) const DV_WGSL: &str = include_str!("dv.wgsl");
+/// A finished warp applied (depth, subdivision, occluder and evaluation passes): one map's
+/// bindings 6-9, then the functions.
+const LOOKUP_WGSL: &str = concat!(include_str!("lookup_bind.wgsl"), include_str!("lookup.wgsl"));
+/// The lookup's functions alone, for bindings of another shape (cube-notw's layered faces).
+pub(crate) const LOOKUP_FNS_WGSL: &str = include_str!("lookup.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
@@ -217,8 +225,15 @@ pub struct Warped {
     warp_x: wgpu::Texture,
     warp_y: wgpu::Texture,
     map: wgpu::Texture,
-    /// Views of `warp_x`, `warp_y` and `map`, made once.
+    /// Views of `warp_x`, `warp_y` and `map` (this map's layer of them), made once.
     views: [wgpu::TextureView; 3],
+    /// This map's layer of the three textures, and its byte offsets in `dv` and `counts`: 0
+    /// for a map with its own, else [`Layers`]' (one evaluation reads every layer).
+    layer: u32,
+    dv_offset: u64,
+    counts_offset: u64,
+    /// A layer of [`Layers`]: its owner reduces its desired view and evaluates it.
+    layered: bool,
     counts: wgpu::Buffer,
     /// Subdivision: finished pieces, counters + draw/dispatch args, two queues, one uniform per level.
     pieces: wgpu::Buffer,
@@ -226,6 +241,8 @@ pub struct Warped {
     queues: [wgpu::Buffer; 2],
     /// Whether `pieces` and `queues` were allocated here (false: lent by another map).
     owns_subdiv: bool,
+    /// Whether `pieces` is lent or borrowed: after the frame it holds the last map's pieces.
+    shares_subdiv: bool,
     /// Indirect dispatch args of the current level (copied from `counters`).
     dispatch: wgpu::Buffer,
     level_uniforms: Vec<wgpu::Buffer>,
@@ -259,7 +276,7 @@ pub(crate) struct Groups {
 
 /// The pipeline constants of every warp shader (params.wgsl): the projection and whether the map
 /// warps, from the map's uniform. Each pass adds its own.
-fn base_constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
+pub(crate) fn base_constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
     vec![("PARABOLOID", flag(p.projection != 0)), ("WARPED", flag(p.warped > 0.5))]
 }
 

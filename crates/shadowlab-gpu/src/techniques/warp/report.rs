@@ -31,7 +31,7 @@ fn offset_image(name: &str, w: u32, h: u32, o: &[f32]) -> NamedImage {
 pub(super) fn report(t: &Warped, gpu: &Gpu) -> TechniqueReport {
     let res = t.res;
     let n = (res * res) as usize;
-    let after: Vec<u32> = gpu.read_buffer_as(&t.counts, n);
+    let after = t.read_counts_final(gpu);
     let depth = t.read_map(gpu);
     let map_bytes = n as u64 * 4;
     let mut r = TechniqueReport {
@@ -126,12 +126,12 @@ fn warp_images(t: &Warped, gpu: &Gpu, r: &mut TechniqueReport) {
 impl Warped {
     /// The warped shadow map's depths (res x res, 1 where nothing was drawn).
     pub fn read_map(&self, gpu: &Gpu) -> Vec<f32> {
-        bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.map, 4))
+        bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(&self.map, 4, self.layer))
     }
 
     /// The DV rectangle (lo x, lo y, hi x, hi y) in base map coordinates, as the shaders use it.
     pub fn read_dv_rect(&self, gpu: &Gpu) -> [f32; 4] {
-        let b: Vec<u32> = gpu.read_buffer_as(&self.dv, 4);
+        let b: Vec<u32> = gpu.read_buffer_at(&self.dv, self.dv_offset, 4);
         if self.params.dv_mode == 0.0 || b[0] > b[2] || b[1] > b[3] {
             return [0.0, 0.0, 1.0, 1.0];
         }
@@ -160,7 +160,7 @@ impl Warped {
 
     /// The view samples per texel of the final (warped) map, counted by the last evaluation.
     pub fn read_counts_final(&self, gpu: &Gpu) -> Vec<u32> {
-        gpu.read_buffer_as(&self.counts, (self.res * self.res) as usize)
+        gpu.read_buffer_at(&self.counts, self.counts_offset, (self.res * self.res) as usize)
     }
 
     /// The count map rebuilt through the row warps (`notw`; fractional: each texel's count is
@@ -171,8 +171,8 @@ impl Warped {
 
     /// The warp textures of the last frame.
     pub fn read_warp(&self, gpu: &Gpu) -> Warp2D {
-        let ox: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.warp_x, 4));
-        let oy: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.warp_y, 4));
+        let ox: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(&self.warp_x, 4, self.layer));
+        let oy: Vec<f32> = bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(&self.warp_y, 4, self.layer));
         Warp2D {
             res: self.res as usize,
             rows_x: self.warp_x.height() as usize,
@@ -196,6 +196,8 @@ impl Warped {
     pub fn scratch_bytes(&self) -> u64 {
         let subdiv = if self.owns_subdiv { self.pieces.size() + 2 * self.queues[0].size() } else { 0 };
         let occ = self.occluders.as_ref().map_or(0, |o| o.bytes());
-        self.work.size() + self.fwork.size() + self.counts.size() + subdiv + occ
+        // the counts: this map's share when layered
+        let counts = 4 * self.res as u64 * self.res as u64;
+        self.work.size() + self.fwork.size() + counts + subdiv + occ
     }
 }

@@ -51,7 +51,8 @@ pub struct SubdivScratch {
 
 impl Warped {
     /// This map's subdivision buffers, to lend to maps rendered after it.
-    pub fn subdiv_scratch(&self) -> SubdivScratch {
+    pub fn subdiv_scratch(&mut self) -> SubdivScratch {
+        self.shares_subdiv = true;
         SubdivScratch { pieces: self.pieces.clone(), queues: self.queues.clone() }
     }
 
@@ -62,6 +63,7 @@ impl Warped {
             self.pieces = s.pieces.clone();
             self.queues = s.queues.clone();
             self.owns_subdiv = false;
+            self.shares_subdiv = true;
         }
     }
 
