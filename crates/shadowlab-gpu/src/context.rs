@@ -204,9 +204,14 @@ impl Gpu {
     }
 
     pub fn uniform<T: bytemuck::Pod>(&self, label: &str, value: &T) -> wgpu::Buffer {
+        self.uniform_array(label, std::slice::from_ref(value))
+    }
+
+    /// A uniform buffer holding an array of `values`.
+    pub fn uniform_array<T: bytemuck::Pod>(&self, label: &str, values: &[T]) -> wgpu::Buffer {
         // STORAGE: bound as read-only storage on lavapipe (crate::quirks)
         let usage = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
-        self.buffer_init(label, bytemuck::bytes_of(value), usage)
+        self.buffer_init(label, bytemuck::cast_slice(values), usage)
     }
 
     /// Whether the device clips by distances from the vertex stage (`CLIP_DISTANCES`): the

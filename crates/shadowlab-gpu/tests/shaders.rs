@@ -327,7 +327,13 @@ fn warp_struct_layouts_match_rust() {
     use shadowlab_gpu::techniques::warp::WarpParams;
     let all = shadowlab_gpu::registry::shaders();
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
-    for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl", "cube/eval_notw.wgsl"] {
+    let layered = [
+        "cube/eval_notw.wgsl (desired views)",
+        "cube/eval_notw.wgsl (evaluation)",
+        "dpsm/eval_maps.wgsl (desired views)",
+        "dpsm/eval_maps.wgsl (evaluation)",
+    ];
+    for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl"].into_iter().chain(layered) {
         check_all(
             &get(w),
             "WarpParams",

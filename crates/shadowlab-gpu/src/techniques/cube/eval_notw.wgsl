@@ -1,70 +1,12 @@
-// cube-notw's evaluation: every face in one pass. Each view sample picks its face (the same
-// rule as `split`), takes that face's uniform, DV bounds and layer of the warps and maps
-// (warp::Layers), and is evaluated by the warped map's own code (warp/eval.wgsl
-// `eval_sample`, through warp/lookup.wgsl); the counts of the analysis variant go to the
-// face's slice.
+// cube-notw's layers in one evaluation (warp/eval_layers.wgsl): a view sample is evaluated by
+// its face (the `split` rule), each face a spot light along its axis.
 
-// Words between two faces' DV bounds (warp::Layers::dv_stride / 4).
-override DV_STRIDE: u32;
+const LAYERS: u32 = 6u;
 
-@group(0) @binding(6) var<uniform> faces: array<WarpParams, 6>;
-@group(0) @binding(7) var<storage, read> dv_bounds: array<u32>;
-@group(0) @binding(8) var warp_x: texture_2d_array<f32>;
-@group(0) @binding(9) var warp_y: texture_2d_array<f32>;
-@group(0) @binding(10) var shadow_map: texture_depth_2d_array;
-@group(0) @binding(11) var cmp: sampler_comparison;
-@group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
-
-// The evaluated sample's face: its uniform and layer.
-var<private> wp: WarpParams;
-var<private> layer: u32;
-
-fn dv_rect() -> vec4<f32> {
-    let b = layer * DV_STRIDE;
-    return dv_from_bounds(wp, vec4<u32>(dv_bounds[b], dv_bounds[b + 1u], dv_bounds[b + 2u], dv_bounds[b + 3u]));
+fn layer_of(p: vec3<f32>) -> u32 {
+    return cube_face(p - light.position.xyz);
 }
 
-fn warp_x_size() -> vec2<u32> {
-    return textureDimensions(warp_x);
-}
-
-fn warp_y_size() -> vec2<u32> {
-    return textureDimensions(warp_y);
-}
-
-fn warp_x_at(k: u32, row: u32) -> f32 {
-    return textureLoad(warp_x, vec2<u32>(k, row), layer, 0).x;
-}
-
-fn warp_y_at(col: u32, k: u32) -> f32 {
-    return textureLoad(warp_y, vec2<u32>(col, k), layer, 0).x;
-}
-
-fn map_texel(t: vec2<i32>) -> f32 {
-    return textureLoad(shadow_map, t, layer, 0);
-}
-
-fn map_compare(uv: vec2<f32>, z: f32) -> f32 {
-    return textureSampleCompareLevel(shadow_map, cmp, uv, layer, z);
-}
-
-fn count_texel(t: u32) {
-    let res = u32(wp.res);
-    atomicAdd(&counts[layer * res * res + t], 1u);
-}
-
-// The face's axis (each face is a spot light along it).
 fn light_axis() -> vec3<f32> {
     return cube_basis(layer)[0];
-}
-
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    var s: Sample;
-    if !load_sample(id, &s) {
-        return;
-    }
-    layer = cube_face(s.p - light.position.xyz);
-    wp = faces[layer];
-    eval_sample(s);
 }

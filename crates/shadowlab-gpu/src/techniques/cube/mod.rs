@@ -36,11 +36,13 @@ use crate::{Gpu, GpuError};
 pub(crate) const FACES_WGSL: &str = include_str!("faces.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
+    let [dv, eval_notw] = notw::layer_sources();
     vec![
         ("cube/depth.wgsl", depth::source()),
         ("cube/eval.wgsl", eval::source()),
         ("cube/split.wgsl", notw::split_source()),
-        ("cube/eval_notw.wgsl", notw::eval_source()),
+        ("cube/eval_notw.wgsl (desired views)", dv),
+        ("cube/eval_notw.wgsl (evaluation)", eval_notw),
     ]
 }
 

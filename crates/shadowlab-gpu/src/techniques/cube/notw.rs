@@ -1,11 +1,11 @@
 //! `cube-notw`: NoTW per cube face (seed 002 chapter 5.3, "CubeSM w/ warping"). Each face is
 //! a 90 degree square perspective frustum, i.e. a spot light along the face axis, and is handled
 //! by one `warp::Warped` (notw's passes, unchanged) drawing into its layer of shared array
-//! textures (`warp::Layers`): a `split` pass gives each face a mask of the view samples that
-//! fall on it (the same face rule as `cube`), the face's desired view, count map, row and column
-//! warps and warped depth map are built from those samples only, and one evaluation over the
-//! view (eval_notw.wgsl) reads each sample's face. Faces without view samples are skipped (no
-//! analysis, no depth pass).
+//! textures (`warp::Layers`): one pass reduces every face's desired view from the view samples
+//! on it (the same face rule as `cube`, eval_notw.wgsl), a `split` pass gives each face a mask
+//! of those samples, the face's count map, row and column warps and warped depth map are built
+//! from them only, and one evaluation over the view reads each sample's face. Faces without
+//! view samples are skipped (no analysis, no depth pass).
 //! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
 //! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
 
@@ -19,22 +19,21 @@ use crate::gbuffer::GBuffer;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueReport};
-use crate::technique::EvalPipelines;
-use crate::techniques::warp::{self, Knobs, Layers, Warped, WarpParams};
+use crate::techniques::warp::{self, Knobs, LayerPasses, Layers, Warped};
 use crate::{binding, Gpu, GpuError};
 
 const SPLIT_WGSL: &str = include_str!("split.wgsl");
 const EVAL_NOTW_WGSL: &str = include_str!("eval_notw.wgsl");
 
-/// The `split` pass (split.wgsl, with the warped maps' DV reduction).
+/// The `split` pass (split.wgsl).
 pub(super) fn split_source() -> String {
-    compose_view(&format!("{FACES_WGSL}{}{}{SPLIT_WGSL}", warp::PARAMS_WGSL, warp::DV_WGSL), false)
+    compose_view(&format!("{FACES_WGSL}{SPLIT_WGSL}"), false)
 }
 
-/// The evaluation of every face (eval_notw.wgsl over the warped map's evaluation).
-pub(super) fn eval_source() -> String {
-    let (params, lookup, eval) = (warp::PARAMS_WGSL, warp::LOOKUP_FNS_WGSL, warp::EVAL_FNS_WGSL);
-    compose_view(&format!("{FACES_WGSL}{params}{lookup}{eval}{EVAL_NOTW_WGSL}"), false)
+/// The desired views and the evaluation of every face (warp/dv_layers.wgsl and
+/// warp/eval_layers.wgsl, a face a layer: eval_notw.wgsl).
+pub(super) fn layer_sources() -> [String; 2] {
+    [warp::layered_dv_source(FACES_WGSL, EVAL_NOTW_WGSL), warp::layered_eval_source(FACES_WGSL, EVAL_NOTW_WGSL)]
 }
 
 /// The names of the images of a face's `Warped` report that `cube-notw` passes on.
@@ -62,13 +61,8 @@ pub struct CubeNotw {
     layout: wgpu::BindGroupLayout,
     split: wgpu::ComputePipeline,
     pixels: u64,
-    /// The evaluation: the six faces' uniforms, the layers' array views, and its pipelines.
-    params: wgpu::Buffer,
-    views: [wgpu::TextureView; 3],
-    sampler: wgpu::Sampler,
-    eval_layout: wgpu::BindGroupLayout,
-    eval: EvalPipelines,
-    eval_groups: crate::binding::GroupCache,
+    /// The desired views and the evaluation of every face.
+    passes: LayerPasses,
 }
 
 impl CubeNotw {
@@ -92,7 +86,7 @@ impl CubeNotw {
         let mut scenes: Vec<Option<GpuScene>> = scenes.into_iter().map(Some).collect();
         let mut built: Vec<Option<Face>> = (0..6).map(|_| None).collect();
         let mut shared = None;
-        let layers = Layers::notw(gpu, "cube-notw", res, 6);
+        let layers = Layers::new(gpu, "cube-notw", &knobs, 6, true);
         for f in order {
             let face_scene = scenes[f].take().expect("each face once");
             // one face = a spot light along the axis whose fitted frustum is the face's square
@@ -112,24 +106,17 @@ impl CubeNotw {
         }
         let faces: Vec<Face> = built.into_iter().map(|f| f.expect("all six built")).collect();
         let rw = binding::storage(false);
-        let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw, rw, binding::uniform()]);
-        let params: [WarpParams; 6] = std::array::from_fn(|f| *faces[f].warped.params());
-        let (eval_layout, eval) = eval_pipelines(gpu, &params[0], layers.dv_stride());
-        let mut constants = warp::base_constants(&params[0]);
-        constants.push(("DV_STRIDE", (layers.dv_stride() / 4) as f64));
+        let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw]);
+        let maps: Vec<&Warped> = faces.iter().map(|f| &f.warped).collect();
+        let passes = LayerPasses::new(gpu, "cube-notw", &layers, &maps, FACES_WGSL, EVAL_NOTW_WGSL);
         Ok(CubeNotw {
             res,
             faces,
-            split: gpu.compute_pipeline_with("cube-notw.split", &split_source(), "split", &[&layout], &constants),
+            split: gpu.compute_pipeline("cube-notw.split", &split_source(), "split", &[&layout]),
             layout,
             pixels: 0,
-            params: gpu.uniform("cube-notw.faces", &params),
-            views: layers.array_views(),
             layers,
-            sampler: warp::eval_sampler(gpu),
-            eval_layout,
-            eval,
-            eval_groups: Default::default(),
+            passes,
         })
     }
 
@@ -145,13 +132,7 @@ impl CubeNotw {
 
     fn group(&self, gpu: &Gpu, f: &FrameInputs, face: &Face) -> wgpu::BindGroup {
         let mask = face.mask.as_ref().expect("sized in prepare");
-        f.view_group(
-            gpu,
-            &face.groups,
-            "cube-notw.split",
-            &self.layout,
-            &[face.sel.as_entire_binding(), mask.as_entire_binding(), self.layers.dv().as_entire_binding(), self.params.as_entire_binding()],
-        )
+        f.view_group(gpu, &face.groups, "cube-notw.split", &self.layout, &[face.sel.as_entire_binding(), mask.as_entire_binding()])
     }
 
     /// Runs `step` on every face with view samples, with that face's inputs (its light and
@@ -188,9 +169,9 @@ impl CubeNotw {
         result
     }
 
-    /// The `split` stage: each face's mask of the view samples on it (sized to the view) and its
-    /// desired view, and the samples per face read back (`cube-notw.face_samples`) so empty
-    /// faces are skipped.
+    /// Every face's desired view (stage `desired_view`), the `split` stage (each face's mask of
+    /// the view samples on it, sized to the view), and the samples per face read back
+    /// (`cube-notw.face_samples`: the DV bounds' sixth words) so empty faces are skipped.
     pub(super) fn split_samples(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
         let pixels = w as u64 * h as u64;
@@ -201,13 +182,8 @@ impl CubeNotw {
             self.pixels = pixels;
         }
         let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
-        // every face's DV bounds empty (min at the top, max and count 0)
+        self.passes.reduce_dv(gpu, f, rec, &self.layers);
         let stride = (self.layers.dv_stride() / 4) as usize;
-        let mut empty = vec![0u32; 6 * stride];
-        for f in 0..6 {
-            empty[f * stride..f * stride + 2].fill(u32::MAX);
-        }
-        rec.write_buffer(self.layers.dv(), 0, bytemuck::cast_slice(&empty));
         rec.stage("cube-notw.split", |enc| {
             for g in &groups {
                 gpu.dispatch_2d(enc, "cube-notw.split", &self.split, &[g], w, h);
@@ -222,18 +198,7 @@ impl CubeNotw {
     /// The evaluation of every face in one pass (`final_pass`); with `counting` the lab's
     /// analysis variant (each face's samples per warped texel, in its slice of the counts).
     pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
-        let extra = [
-            self.params.as_entire_binding(),
-            self.layers.dv().as_entire_binding(),
-            wgpu::BindingResource::TextureView(&self.views[0]),
-            wgpu::BindingResource::TextureView(&self.views[1]),
-            wgpu::BindingResource::TextureView(&self.views[2]),
-            wgpu::BindingResource::Sampler(&self.sampler),
-            self.layers.counts().as_entire_binding(),
-        ];
-        let group = f.view_group(gpu, &self.eval_groups, "cube-notw.final_pass", &self.eval_layout, &extra);
-        let (w, h) = (f.gbuffer.width, f.gbuffer.height);
-        self.eval.record(gpu, rec, "cube-notw.final_pass", self.layers.counts(), &group, w, h, counting);
+        self.passes.record(gpu, f, rec, &self.layers, counting);
         Ok(())
     }
 
@@ -286,28 +251,4 @@ impl CubeNotw {
         r.sampling = Some(sampling_stats(&after));
         r
     }
-}
-
-/// The evaluation's layout (the view; the faces' uniforms, DV bounds, warps, maps, comparison
-/// sampler and counts) and pipelines, specialised as a face's own evaluation would be.
-fn eval_pipelines(gpu: &Gpu, p: &WarpParams, dv_stride: u64) -> (wgpu::BindGroupLayout, EvalPipelines) {
-    let array = |sample_type| wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false };
-    let float = array(wgpu::TextureSampleType::Float { filterable: false });
-    let layout = view_layout(
-        gpu,
-        "cube-notw.final_pass",
-        &[
-            binding::uniform(),
-            binding::storage(true),
-            float,
-            float,
-            array(wgpu::TextureSampleType::Depth),
-            binding::comparison_sampler(),
-            binding::storage(false),
-        ],
-    );
-    let mut constants = warp::eval_constants(p);
-    constants.push(("DV_STRIDE", (dv_stride / 4) as f64));
-    let eval = EvalPipelines::new(gpu, "cube-notw.final_pass", &eval_source(), &layout, &constants);
-    (layout, eval)
 }

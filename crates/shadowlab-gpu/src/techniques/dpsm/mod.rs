@@ -9,8 +9,9 @@
 //!   count map, row and column warps over its own view samples (seed 002 section 5.3).
 //!
 //! Both are two instances of the warping module's `Warped` in its paraboloid projection mode
-//! (warp/params.wgsl `base_clip`): no pass is duplicated here. A view sample is evaluated by the
-//! map of its hemisphere (warp/params.wgsl `owns_sample`).
+//! (warp/params.wgsl `base_clip`), each drawing into its layer of shared array textures
+//! (`warp::Layers`): no pass is duplicated here. One evaluation reads both maps, each view sample
+//! through the map of its hemisphere (warp/params.wgsl `owns_sample`, eval_maps.wgsl).
 
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
@@ -21,7 +22,7 @@ use shadowlab_core::techniques::dpsm::{split_axis, DualParaboloid, Hemisphere, S
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::techniques::warp::{self, Knobs, NotwCore, Projection, Subdivision, Warped};
+use crate::techniques::warp::{self, Knobs, LayerPasses, Layers, NotwCore, Projection, Subdivision, Warped};
 use crate::{Gpu, GpuError};
 
 /// Side of each hemisphere's map (texels). The setting: 512 per hemisphere against
@@ -165,7 +166,7 @@ shadowlab_core::param_set! {
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "dpsm",
     summary: "dual-paraboloid shadow maps: two hemisphere depth maps of a point light, paraboloid mapping per vertex after GPU subdivision",
-    cost: "subdivision + two depth passes over the scene; 2 w^2 x 4 bytes; N^2 fetches per pixel",
+    cost: "subdivision + two depth passes over the scene, one evaluation of both maps; 2 w^2 x 4 bytes; N^2 fetches per pixel",
     quality: "resolution fixed per solid angle (twice as fine at the rim as at the centre), blind to the view: aliasing near the camera",
     source: "Brabec, Annen, Seidel 2002; seed 002 section 3.3.2 (eq. 3.3-3.10)",
     lights: &["point"],
@@ -174,14 +175,14 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     storage_buffers: 11,
     compare: &[""],
-    shaders: crate::techniques::warp::shaders,
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::plain(gpu, scene, &DpsmSettings::from_values(p), light)?)),
 };
 
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "dpsm-notw",
     summary: "dual-paraboloid maps warped by NoTW per hemisphere: desired view, count map, row and column warps of each hemisphere's view samples",
-    cost: "per hemisphere: DV reduction, count map, row and column warps (notw's analysis); subdivision + warped depth pass; 2 x (4 + 8) w^2 bytes",
+    cost: "per hemisphere: DV reduction, count map, row and column warps (notw's analysis); subdivision + warped depth pass; one evaluation of both; 2 x (4 + 8) w^2 bytes",
     quality: "the view samples of each hemisphere spread over its whole map; seam at the split plane",
     source: "seed 002 section 5.3 (DPSM with NoTW), seed 000 section 3",
     lights: &["point"],
@@ -190,13 +191,28 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     storage_buffers: 11,
     compare: &[""],
-    shaders: crate::techniques::warp::shaders,
+    shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Dpsm::notw(gpu, scene, &DpsmNotwSettings::from_values(p), light)?)),
 };
+
+/// Both maps' evaluation: a view sample goes to the map of its hemisphere.
+const EVAL_MAPS_WGSL: &str = include_str!("eval_maps.wgsl");
+
+/// The warping module's shaders, and the desired views (`dpsm-notw`) and evaluation of both maps.
+pub fn shaders() -> Vec<(&'static str, String)> {
+    let mut v = warp::shaders();
+    v.push(("dpsm/eval_maps.wgsl (desired views)", warp::layered_dv_source("", EVAL_MAPS_WGSL)));
+    v.push(("dpsm/eval_maps.wgsl (evaluation)", warp::layered_eval_source("", EVAL_MAPS_WGSL)));
+    v
+}
 
 /// A point light's two hemisphere maps.
 pub struct Dpsm {
     maps: [Warped; 2],
+    /// Their warps, maps, DV bounds and counts, a layer each, and the passes over both (the
+    /// desired views of `dpsm-notw`, the evaluation).
+    layers: Layers,
+    passes: LayerPasses,
     warped: bool,
     res: u32,
     pcf: u32,
@@ -225,21 +241,26 @@ impl Dpsm {
         let dp = DualParaboloid::fit(position, axis, &scene.bounds)
             .ok_or_else(|| GpuError::Invalid(format!("{name}: light position {position} or scene bounds not usable")))?;
         let labels: [&'static str; 2] = if warped { ["dpsm-notw.front", "dpsm-notw.back"] } else { ["dpsm.front", "dpsm.back"] };
+        // dpsm-notw: both desired views in one pass (dpsm crops none)
+        let layers = Layers::new(gpu, name, k, 2, warped);
         let make = |i: usize| {
             let h = Hemisphere::BOTH[i];
-            Warped::with_projection(gpu, scene, k, Projection::Paraboloid { view: dp.view(h), hemisphere: h }, labels[i])
+            let proj = Projection::Paraboloid { view: dp.view(h), hemisphere: h };
+            Warped::with_projection_in(gpu, scene, k, proj, labels[i], Some((&layers, i as u32)))
         };
         // the hemispheres render one after another: one set of subdivision buffers for both
         let mut front = make(0)?;
         let mut back = make(1)?;
         back.borrow_subdiv(&front.subdiv_scratch());
-        Ok(Dpsm { maps: [front, back], warped, res, pcf })
+        let passes = LayerPasses::new(gpu, name, &layers, &[&front, &back], "", EVAL_MAPS_WGSL);
+        Ok(Dpsm { maps: [front, back], layers, passes, warped, res, pcf })
     }
 }
 
 impl Technique for Dpsm {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         if self.warped {
+            self.passes.reduce_dv(gpu, f, rec, &self.layers);
             for m in &mut self.maps {
                 m.prepare(gpu, f, rec)?;
             }
@@ -254,18 +275,14 @@ impl Technique for Dpsm {
         Ok(())
     }
 
-    /// Each map writes the visibility of its hemisphere's samples.
+    /// One pass: each sample through the map of its hemisphere.
     fn evaluate(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        for m in &mut self.maps {
-            m.evaluate(gpu, f, rec)?;
-        }
+        self.passes.record(gpu, f, rec, &self.layers, false);
         Ok(())
     }
 
     fn analyze(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        for m in &mut self.maps {
-            m.analyze(gpu, f, rec)?;
-        }
+        self.passes.record(gpu, f, rec, &self.layers, true);
         Ok(())
     }
 

@@ -53,8 +53,8 @@ impl Warped {
     }
 
     /// This frame's desired view and warps (stages `desired_view`, with `edge_importance` the
-    /// `occluders` of the crop, and `importance_map`). A layer of [`super::Layers`] has its
-    /// desired view reduced by its owner (cube-notw's `split`) before this.
+    /// `occluders` of the crop, and `importance_map`). A layer whose desired view its owner
+    /// reduces ([`super::LayerPasses::reduce_dv`]) skips the first.
     pub(super) fn fit_warps(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let name = self.name();
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
@@ -74,8 +74,8 @@ impl Warped {
                 self.occluders.as_ref().map_or(&self.counts, |o| &o.hzb).as_entire_binding(),
             ],
         );
-        if !self.layered {
-            rec.write_buffer(&self.dv, 0, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
+        if !self.dv_by_owner {
+            rec.write_buffer(&self.dv, self.dv_offset, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
             rec.stage(&format!("{name}.desired_view"), |enc| {
                 gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
             });

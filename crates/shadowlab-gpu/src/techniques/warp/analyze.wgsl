@@ -29,18 +29,20 @@ fn dv_now() -> vec4<f32> {
 // DV: parallel min/max of the samples' map coordinates (fixed point), per workgroup in shared
 // memory (dv.wgsl), then one global atomic per workgroup; also the largest eye distance (RTW)
 // and the sample count.
+const DV_SLOTS: u32 = 1u;
+
 @compute @workgroup_size(8, 8)
 fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) t: u32) {
     var s: Sample;
     let counted = load_sample(id, &s) && owns_sample(wp, s.p);
-    let b = dv_workgroup(t, counted, wp, s.p);
+    dv_workgroup(t, 0u, counted, wp, s.p);
     if t == 0u {
-        atomicMin(&dv[0], b[0]);
-        atomicMin(&dv[1], b[1]);
-        atomicMax(&dv[2], b[2]);
-        atomicMax(&dv[3], b[3]);
-        atomicMax(&dv[4], b[4]);
-        atomicAdd(&dv[5], b[5]);
+        atomicMin(&dv[0], dv_slot(0u, 0u));
+        atomicMin(&dv[1], dv_slot(0u, 1u));
+        atomicMax(&dv[2], dv_slot(0u, 2u));
+        atomicMax(&dv[3], dv_slot(0u, 3u));
+        atomicMax(&dv[4], dv_slot(0u, 4u));
+        atomicAdd(&dv[5], dv_slot(0u, 5u));
     }
 }
 

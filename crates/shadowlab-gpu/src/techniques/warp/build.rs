@@ -27,7 +27,7 @@ impl Warped {
     }
 
     /// `new_sharing`, drawing into layer `layer` of `layers` (warps, map, DV bounds and
-    /// counts): a NoTW map of `layers`' resolution, evaluated with the others by the caller.
+    /// counts), evaluated with the others by the caller ([`super::LayerPasses`]).
     pub fn new_layer(
         gpu: &Gpu,
         scene: &GpuScene,
@@ -37,7 +37,6 @@ impl Warped {
         layers: &Layers,
         layer: u32,
     ) -> Result<Warped, GpuError> {
-        assert!(k.variant == Variant::Notw && k.res == layers.res && layer < layers.count(), "a layer fits a NoTW map of its resolution");
         Warped::planar(gpu, scene, k, light, shared, Some((layers, layer)))
     }
 
@@ -71,7 +70,9 @@ impl Warped {
         Warped::with_projection_in(gpu, scene, k, proj, name, None)
     }
 
-    fn with_projection_in(
+    /// `with_projection`, drawing into layer `target.1` of `target.0` when given (as
+    /// [`Warped::new_layer`]).
+    pub fn with_projection_in(
         gpu: &Gpu,
         scene: &GpuScene,
         k: &Knobs,
@@ -101,6 +102,7 @@ impl Warped {
             views: [&r.warp_x, &r.warp_y, &r.map].map(|t| t.create_view(&layer_view)),
             layer: r.layer,
             layered: r.layered,
+            dv_by_owner: r.dv_by_owner,
             dv_offset: r.dv_offset,
             counts_offset: r.counts_offset,
             variant: plan.variant,
@@ -166,15 +168,18 @@ impl Plan {
         Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, occluders })
     }
 
-    /// Texels of the two warp textures: NoTW one function per row and per column, RTW one 1D
-    /// function each way, the DV crop none (a stand-in texel).
     fn warp_sizes(&self) -> [(u32, u32); 2] {
-        let res = self.res;
-        match self.variant {
-            Variant::Notw => [(res, res), (res, res)],
-            Variant::Rtw => [(res, 1), (1, res)],
-            Variant::Dv => [(1, 1), (1, 1)],
-        }
+        warp_sizes(self.variant, self.res)
+    }
+}
+
+/// Texels of the two warp textures: NoTW one function per row and per column, RTW one 1D
+/// function each way, the DV crop none (a stand-in texel).
+pub(super) fn warp_sizes(variant: Variant, res: u32) -> [(u32, u32); 2] {
+    match variant {
+        Variant::Notw => [(res, res), (res, res)],
+        Variant::Rtw => [(res, 1), (1, res)],
+        Variant::Dv => [(1, 1), (1, 1)],
     }
 }
 
@@ -296,6 +301,7 @@ struct Resources {
     /// for a map with its own).
     layer: u32,
     layered: bool,
+    dv_by_owner: bool,
     dv_offset: u64,
     counts_offset: u64,
 }
@@ -310,7 +316,23 @@ impl Resources {
         let tris = plan.params.triangles as u64;
         let levels = plan.params.subdiv_levels;
         let (warp_x, warp_y, map, dv, counts, layer, dv_offset, counts_offset) = match target {
-            Some((l, i)) => (l.warp_x.clone(), l.warp_y.clone(), l.map.clone(), l.dv.clone(), l.counts.clone(), i, i as u64 * l.dv_stride, i as u64 * n * 4),
+            Some((l, i)) => {
+                let fits = l.res == res
+                    && i < l.count()
+                    && (l.warp_x.width(), l.warp_x.height()) == wx
+                    && (l.warp_y.width(), l.warp_y.height()) == wy;
+                assert!(fits, "{name}: layer {i} of layers made for other knobs");
+                (
+                    l.warp_x.clone(),
+                    l.warp_y.clone(),
+                    l.map.clone(),
+                    l.dv.clone(),
+                    l.counts.clone(),
+                    i,
+                    i as u64 * l.dv_stride,
+                    i as u64 * n * 4,
+                )
+            }
             None => (
                 r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1),
                 r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1),
@@ -328,6 +350,7 @@ impl Resources {
             map,
             layer,
             layered: target.is_some(),
+            dv_by_owner: target.is_some_and(|(l, _)| l.owner_reduces_dv),
             dv_offset,
             counts_offset,
             work: gpu.storage(&format!("{name}.work"), work_words(plan.variant, res)[0] * 4),

@@ -11,7 +11,7 @@ use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, Gpu, GpuError};
 
 /// The evaluation of one sample (`eval_sample`), for any bindings of the map.
-pub(crate) const EVAL_FNS_WGSL: &str = include_str!("eval.wgsl");
+pub(super) const EVAL_FNS_WGSL: &str = include_str!("eval.wgsl");
 /// One map's bindings and entry point.
 const EVAL_MAIN_WGSL: &str = include_str!("eval_main.wgsl");
 
@@ -21,7 +21,7 @@ pub(super) fn source() -> String {
 
 /// The evaluation's pipeline constants (eval.wgsl and params.wgsl): the knobs of `p` that choose
 /// code paths, so that the pipeline holds only the path this map takes.
-pub(crate) fn constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
+pub(super) fn constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
     let mut c = base_constants(p);
     c.extend([
         ("BIAS_MODE", p.bias_mode.round() as f64),
@@ -45,7 +45,7 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, p: &WarpParams) -> (wgpu::BindGro
 }
 
 /// The evaluation's depth comparison, nearest texel (the PCF taps are explicit).
-pub(crate) fn sampler(gpu: &Gpu) -> wgpu::Sampler {
+pub(super) fn sampler(gpu: &Gpu) -> wgpu::Sampler {
     gpu.device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("warp.cmp"),
         compare: Some(wgpu::CompareFunction::LessEqual),

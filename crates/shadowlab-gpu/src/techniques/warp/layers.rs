@@ -1,16 +1,24 @@
-//! Maps evaluated together (`cube-notw`'s six faces): each map keeps its own passes, but its
-//! warps and depth map are one layer of shared array textures, and its DV bounds and sample
-//! counts one slice of shared buffers, so that one evaluation pass reads every map
-//! (cube/eval_notw.wgsl) instead of one pass a map over the whole view.
+//! Maps evaluated together (`cube-notw`'s six faces, `dpsm`'s two hemispheres): each map keeps
+//! its own passes, but its warps and depth map are one layer of shared array textures, and its
+//! DV bounds and sample counts one slice of shared buffers, so that one pass over the view
+//! reduces every map's desired view (dv_layers.wgsl) and one evaluates every map
+//! (eval_layers.wgsl), instead of a pass a map ([`LayerPasses`]).
 
-use super::Warped;
-use crate::{raster, Gpu};
+use super::build::warp_sizes;
+use super::{base_constants, eval, Knobs, WarpParams, Warped, DV_WGSL, EVAL_FNS_WGSL, LOOKUP_FNS_WGSL, PARAMS_WGSL};
+use crate::record::Recorder;
+use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
+use crate::{binding, raster, Gpu};
 
-/// The shared targets of `count` NoTW maps of `res` (one function a row and a column, so both
-/// warps are `res x res` a layer).
+const EVAL_LAYERS_WGSL: &str = include_str!("eval_layers.wgsl");
+const DV_LAYERS_WGSL: &str = include_str!("dv_layers.wgsl");
+
+/// The shared targets of `count` maps of one kind of knobs.
 pub struct Layers {
     pub(super) res: u32,
     count: u32,
+    /// The maps' desired views are reduced together ([`LayerPasses::reduce_dv`]), not by each map.
+    pub(super) owner_reduces_dv: bool,
     pub(super) warp_x: wgpu::Texture,
     pub(super) warp_y: wgpu::Texture,
     pub(super) map: wgpu::Texture,
@@ -22,14 +30,19 @@ pub struct Layers {
 }
 
 impl Layers {
-    pub fn notw(gpu: &Gpu, name: &str, res: u32, count: u32) -> Layers {
+    /// `count` layers for maps made with `k`; with `owner_reduces_dv` the caller reduces every
+    /// layer's desired view ([`LayerPasses::reduce_dv`]) before the maps' analysis.
+    pub fn new(gpu: &Gpu, name: &str, k: &Knobs, count: u32, owner_reduces_dv: bool) -> Layers {
+        let res = k.res;
         let dv_stride = (gpu.limits.min_storage_buffer_offset_alignment as u64).max(32);
         let n = res as u64 * res as u64;
+        let [wx, wy] = warp_sizes(k.variant, res);
         Layers {
             res,
             count,
-            warp_x: r32_array(gpu, &format!("{name}.warp_x"), res, res, count),
-            warp_y: r32_array(gpu, &format!("{name}.warp_y"), res, res, count),
+            owner_reduces_dv,
+            warp_x: r32_array(gpu, &format!("{name}.warp_x"), wx, count),
+            warp_y: r32_array(gpu, &format!("{name}.warp_y"), wy, count),
             map: raster::depth_target(gpu, &format!("{name}.map"), res, res, count, wgpu::TextureUsages::empty()),
             dv: gpu.storage(&format!("{name}.dv"), dv_stride * count as u64),
             dv_stride,
@@ -42,12 +55,6 @@ impl Layers {
         self.count
     }
 
-    /// Array views of the row warps, the column warps and the depth maps.
-    pub fn array_views(&self) -> [wgpu::TextureView; 3] {
-        let d = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
-        [&self.warp_x, &self.warp_y, &self.map].map(|t| t.create_view(&d))
-    }
-
     /// Every layer's DV bounds (`dv_stride()` bytes apart).
     pub fn dv(&self) -> &wgpu::Buffer {
         &self.dv
@@ -56,14 +63,9 @@ impl Layers {
     pub fn dv_stride(&self) -> u64 {
         self.dv_stride
     }
-
-    /// Every layer's sample counts of the analysis variant (`res^2` words a layer).
-    pub fn counts(&self) -> &wgpu::Buffer {
-        &self.counts
-    }
 }
 
-fn r32_array(gpu: &Gpu, label: &str, w: u32, h: u32, layers: u32) -> wgpu::Texture {
+fn r32_array(gpu: &Gpu, label: &str, (w, h): (u32, u32), layers: u32) -> wgpu::Texture {
     gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
@@ -76,6 +78,126 @@ fn r32_array(gpu: &Gpu, label: &str, w: u32, h: u32, layers: u32) -> wgpu::Textu
     })
 }
 
+/// The evaluation of a [`LayerPasses`]: `prelude` (what `select` calls), the warped map's
+/// evaluation over layers, and `select`, which defines `LAYERS`, `layer_of` and `light_axis`
+/// (eval_layers.wgsl).
+pub fn layered_eval_source(prelude: &str, select: &str) -> String {
+    compose_view(&format!("{prelude}{PARAMS_WGSL}{LOOKUP_FNS_WGSL}{EVAL_FNS_WGSL}{EVAL_LAYERS_WGSL}{select}"), false)
+}
+
+/// The desired views of a [`LayerPasses`] (dv_layers.wgsl), with the same `prelude` and
+/// `select`.
+pub fn layered_dv_source(prelude: &str, select: &str) -> String {
+    compose_view(&format!("{prelude}{PARAMS_WGSL}{DV_WGSL}{DV_LAYERS_WGSL}{select}"), false)
+}
+
+/// The passes over every layer of a [`Layers`] at once: the evaluation (stage
+/// `{name}.final_pass`) and, where the layers' owner reduces their desired views, that
+/// reduction (stage `{name}.desired_view`).
+pub struct LayerPasses {
+    name: &'static str,
+    /// The layers' uniforms, in layer order.
+    params: wgpu::Buffer,
+    /// Array views of the warps and maps.
+    views: [wgpu::TextureView; 3],
+    sampler: wgpu::Sampler,
+    layout: wgpu::BindGroupLayout,
+    eval: EvalPipelines,
+    groups: binding::GroupCache,
+    /// The desired views' pass (`Layers::owner_reduces_dv`): its layout and pipeline.
+    dv: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
+    dv_groups: binding::GroupCache,
+}
+
+impl LayerPasses {
+    /// `maps[i]` draws layer i of `layers` (made with the same knobs); `prelude` and `select`
+    /// as [`layered_eval_source`] takes them.
+    pub fn new(gpu: &Gpu, name: &'static str, layers: &Layers, maps: &[&Warped], prelude: &str, select: &str) -> LayerPasses {
+        assert_eq!(maps.len() as u32, layers.count(), "{name}: one map a layer");
+        assert!(maps.iter().enumerate().all(|(i, m)| m.layered && m.layer == i as u32), "{name}: map i draws layer i");
+        let params: Vec<WarpParams> = maps.iter().map(|m| m.params).collect();
+        let array = |sample_type| wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        };
+        let float = array(wgpu::TextureSampleType::Float { filterable: false });
+        let label = format!("{name}.final_pass");
+        let layout = view_layout(
+            gpu,
+            &label,
+            &[
+                binding::uniform(),
+                binding::storage(true),
+                float,
+                float,
+                array(wgpu::TextureSampleType::Depth),
+                binding::comparison_sampler(),
+                binding::storage(false),
+            ],
+        );
+        // the layers share the knobs that choose code paths
+        let stride = ("DV_STRIDE", (layers.dv_stride / 4) as f64);
+        let mut constants = eval::constants(&params[0]);
+        constants.push(stride);
+        let dv = layers.owner_reduces_dv.then(|| {
+            let label = format!("{name}.desired_view");
+            let layout = view_layout(gpu, &label, &[binding::uniform(), binding::storage(false)]);
+            let mut c = base_constants(&params[0]);
+            c.push(stride);
+            let pipeline = gpu.compute_pipeline_with(&label, &layered_dv_source(prelude, select), "dv_layers", &[&layout], &c);
+            (layout, pipeline)
+        });
+        let source = layered_eval_source(prelude, select);
+        let d = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
+        LayerPasses {
+            name,
+            params: gpu.uniform_array(&format!("{name}.layers"), &params),
+            views: [&layers.warp_x, &layers.warp_y, &layers.map].map(|t| t.create_view(&d)),
+            sampler: eval::sampler(gpu),
+            eval: EvalPipelines::new(gpu, &label, &source, &layout, &constants),
+            layout,
+            groups: Default::default(),
+            dv,
+            dv_groups: Default::default(),
+        }
+    }
+
+    /// Every layer's desired view from the view samples in one pass (stage
+    /// `{name}.desired_view`), each sample counted by the layer that evaluates it; the sixth
+    /// word of each slice counts its samples. Only for layers whose owner reduces them.
+    pub fn reduce_dv(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, layers: &Layers) {
+        let (layout, pipeline) = self.dv.as_ref().expect("the layers' owner reduces their desired views");
+        let label = format!("{}.desired_view", self.name);
+        let group = f.view_group(gpu, &self.dv_groups, &label, layout, &[self.params.as_entire_binding(), layers.dv.as_entire_binding()]);
+        // every slice empty: min at the top, max and count 0
+        let stride = (layers.dv_stride / 4) as usize;
+        let mut empty = vec![0u32; layers.count as usize * stride];
+        for slice in empty.chunks_mut(stride) {
+            slice[..2].fill(u32::MAX);
+        }
+        rec.write_buffer(&layers.dv, 0, bytemuck::cast_slice(&empty));
+        rec.stage(&label, |enc| gpu.dispatch_2d(enc, &label, pipeline, &[&group], f.gbuffer.width, f.gbuffer.height));
+    }
+
+    /// The evaluation over the view; with `counting` the lab's analysis variant (each layer's
+    /// samples per warped texel, in its slice of the counts).
+    pub fn record(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, layers: &Layers, counting: bool) {
+        let extra = [
+            self.params.as_entire_binding(),
+            layers.dv.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&self.views[0]),
+            wgpu::BindingResource::TextureView(&self.views[1]),
+            wgpu::BindingResource::TextureView(&self.views[2]),
+            wgpu::BindingResource::Sampler(&self.sampler),
+            layers.counts.as_entire_binding(),
+        ];
+        let label = format!("{}.final_pass", self.name);
+        let group = f.view_group(gpu, &self.groups, &label, &self.layout, &extra);
+        self.eval.record(gpu, rec, &label, &layers.counts, &group, f.gbuffer.width, f.gbuffer.height, counting);
+    }
+}
+
 impl Warped {
     /// The DV bounds as this map's passes bind them (its slice of a shared buffer when layered).
     pub(super) fn dv_binding(&self) -> wgpu::BindingResource<'_> {
@@ -85,11 +207,10 @@ impl Warped {
     /// The sample counts as the evaluation binds them.
     pub(super) fn counts_binding(&self) -> wgpu::BindingResource<'_> {
         let n = self.res as u64 * self.res as u64;
-        wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer: &self.counts, offset: self.counts_offset, size: wgpu::BufferSize::new(n * 4) })
-    }
-
-    /// The uniform as written at creation (the layered evaluation gathers the faces').
-    pub fn params(&self) -> &super::WarpParams {
-        &self.params
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.counts,
+            offset: self.counts_offset,
+            size: wgpu::BufferSize::new(n * 4),
+        })
     }
 }

@@ -34,9 +34,9 @@ mod report;
 mod settings;
 mod subdiv;
 
-pub(crate) use eval::{constants as eval_constants, sampler as eval_sampler, EVAL_FNS_WGSL};
+use eval::EVAL_FNS_WGSL;
 pub use knobs::Knobs;
-pub use layers::Layers;
+pub use layers::{layered_dv_source, layered_eval_source, LayerPasses, Layers};
 pub use params::*;
 pub use settings::*;
 pub use subdiv::SubdivScratch;
@@ -53,14 +53,14 @@ use crate::technique::{counted_evaluation, FrameInputs, Technique, TechniqueInfo
 use crate::{Gpu, GpuError};
 
 /// Every warp shader's prelude: `WarpParams`, the base projection, the DV rule, the offsets.
-pub(crate) const PARAMS_WGSL: &str = include_str!("params.wgsl");
-/// The desired view's reduction within a workgroup (analyze.wgsl, cube-notw's split).
-pub(crate) const DV_WGSL: &str = include_str!("dv.wgsl");
+const PARAMS_WGSL: &str = include_str!("params.wgsl");
+/// The desired view's reduction within a workgroup (analyze.wgsl, dv_layers.wgsl).
+const DV_WGSL: &str = include_str!("dv.wgsl");
 /// A finished warp applied (depth, subdivision, occluder and evaluation passes): one map's
 /// bindings 6-9, then the functions.
 const LOOKUP_WGSL: &str = concat!(include_str!("lookup_bind.wgsl"), include_str!("lookup.wgsl"));
-/// The lookup's functions alone, for bindings of another shape (cube-notw's layered faces).
-pub(crate) const LOOKUP_FNS_WGSL: &str = include_str!("lookup.wgsl");
+/// The lookup's functions alone, for bindings of another shape (eval_layers.wgsl).
+const LOOKUP_FNS_WGSL: &str = include_str!("lookup.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
     vec![
@@ -232,8 +232,10 @@ pub struct Warped {
     layer: u32,
     dv_offset: u64,
     counts_offset: u64,
-    /// A layer of [`Layers`]: its owner reduces its desired view and evaluates it.
+    /// A layer of [`Layers`]: evaluated by its owner ([`LayerPasses`]).
     layered: bool,
+    /// Its desired view reduced by its owner (`Layers::owner_reduces_dv`).
+    dv_by_owner: bool,
     counts: wgpu::Buffer,
     /// Subdivision: finished pieces, counters + draw/dispatch args, two queues, one uniform per level.
     pieces: wgpu::Buffer,
@@ -276,7 +278,7 @@ pub(crate) struct Groups {
 
 /// The pipeline constants of every warp shader (params.wgsl): the projection and whether the map
 /// warps, from the map's uniform. Each pass adds its own.
-pub(crate) fn base_constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
+fn base_constants(p: &WarpParams) -> Vec<(&'static str, f64)> {
     vec![("PARABOLOID", flag(p.projection != 0)), ("WARPED", flag(p.warped > 0.5))]
 }
 
@@ -300,6 +302,11 @@ pub enum Projection {
 impl Warped {
     fn name(&self) -> &'static str {
         self.label
+    }
+
+    /// The uniform as written at creation.
+    pub fn params(&self) -> &WarpParams {
+        &self.params
     }
 }
 

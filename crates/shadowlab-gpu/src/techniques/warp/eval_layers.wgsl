@@ -1,0 +1,66 @@
+// Every layer of a warp::Layers evaluated in one pass (cube-notw's faces, dpsm's hemispheres):
+// each view sample takes its layer (`layer_of`), that layer's uniform, DV bounds, warps and map,
+// and is evaluated by the warped map's own code (eval.wgsl `eval_sample`, through lookup.wgsl);
+// the counts of the analysis variant go to the layer's slice. The technique's file defines
+// `const LAYERS: u32`, `fn layer_of(p: vec3<f32>) -> u32` and `fn light_axis() -> vec3<f32>`
+// (a perspective layer's axis, read while `layer` is set).
+
+// Words between two layers' DV bounds (warp::Layers::dv_stride / 4).
+override DV_STRIDE: u32;
+
+@group(0) @binding(6) var<uniform> layer_params: array<WarpParams, LAYERS>;
+@group(0) @binding(7) var<storage, read> dv_bounds: array<u32>;
+@group(0) @binding(8) var warp_x: texture_2d_array<f32>;
+@group(0) @binding(9) var warp_y: texture_2d_array<f32>;
+@group(0) @binding(10) var shadow_map: texture_depth_2d_array;
+@group(0) @binding(11) var cmp: sampler_comparison;
+@group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
+
+// The evaluated sample's layer and its uniform.
+var<private> wp: WarpParams;
+var<private> layer: u32;
+
+fn dv_rect() -> vec4<f32> {
+    let b = layer * DV_STRIDE;
+    return dv_from_bounds(wp, vec4<u32>(dv_bounds[b], dv_bounds[b + 1u], dv_bounds[b + 2u], dv_bounds[b + 3u]));
+}
+
+fn warp_x_size() -> vec2<u32> {
+    return textureDimensions(warp_x);
+}
+
+fn warp_y_size() -> vec2<u32> {
+    return textureDimensions(warp_y);
+}
+
+fn warp_x_at(k: u32, row: u32) -> f32 {
+    return textureLoad(warp_x, vec2<u32>(k, row), layer, 0).x;
+}
+
+fn warp_y_at(col: u32, k: u32) -> f32 {
+    return textureLoad(warp_y, vec2<u32>(col, k), layer, 0).x;
+}
+
+fn map_texel(t: vec2<i32>) -> f32 {
+    return textureLoad(shadow_map, t, layer, 0);
+}
+
+fn map_compare(uv: vec2<f32>, z: f32) -> f32 {
+    return textureSampleCompareLevel(shadow_map, cmp, uv, layer, z);
+}
+
+fn count_texel(t: u32) {
+    let res = u32(wp.res);
+    atomicAdd(&counts[layer * res * res + t], 1u);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    var s: Sample;
+    if !load_sample(id, &s) {
+        return;
+    }
+    layer = layer_of(s.p);
+    wp = layer_params[layer];
+    eval_sample(s);
+}
