@@ -7,6 +7,7 @@ use shadowlab_core::light::Light;
 use shadowlab_core::lightspace;
 use shadowlab_core::techniques::dpsm::Hemisphere;
 
+use super::layers::r32_array;
 use super::{analyze, depth, eval, occluders, subdiv};
 use super::{Groups, Knobs, Layers, Projection, SubdivScratch, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
 use crate::prefix_sum::PrefixSum;
@@ -334,8 +335,8 @@ impl Resources {
                 )
             }
             None => (
-                r32_texture(gpu, &format!("{name}.warp_x"), wx.0, wx.1),
-                r32_texture(gpu, &format!("{name}.warp_y"), wy.0, wy.1),
+                r32_array(gpu, &format!("{name}.warp_x"), wx, 1),
+                r32_array(gpu, &format!("{name}.warp_y"), wy, 1),
                 raster::depth_target(gpu, &format!("{name}.map"), res, res, 1, wgpu::TextureUsages::empty()),
                 gpu.storage(&format!("{name}.dv"), 32),
                 gpu.storage(&format!("{name}.counts"), n * 4),
@@ -393,18 +394,6 @@ fn work_words(variant: Variant, res: u32) -> [u64; 2] {
     }
 }
 
-fn r32_texture(gpu: &Gpu, label: &str, w: u32, h: u32) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
-}
 
 /// Every pass's layouts and pipelines, in the order the passes run.
 struct Pipelines {

@@ -65,7 +65,8 @@ impl Layers {
     }
 }
 
-fn r32_array(gpu: &Gpu, label: &str, (w, h): (u32, u32), layers: u32) -> wgpu::Texture {
+/// An R32Float texture of `layers` layers that passes write as storage and read as a texture.
+pub(super) fn r32_array(gpu: &Gpu, label: &str, (w, h): (u32, u32), layers: u32) -> wgpu::Texture {
     gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
