@@ -151,6 +151,28 @@ pub fn begin_pass_with<'e>(
     })
 }
 
+/// A `w x h x layers` 2D (array) texture of `format`, one mip level, one sample.
+pub fn texture_2d(
+    gpu: &Gpu,
+    label: &str,
+    w: u32,
+    h: u32,
+    layers: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
 /// A `w x h` render target of `format` that later passes sample, plus `extra_usage`.
 pub fn render_target(
     gpu: &Gpu,
@@ -160,31 +182,14 @@ pub fn render_target(
     format: wgpu::TextureFormat,
     extra_usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra_usage,
-        view_formats: &[],
-    })
+    texture_2d(gpu, label, w, h, 1, format, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra_usage)
 }
 
 /// A `w x h x layers` Depth32Float target of the shadow passes: render attachment, sampled
 /// (`texture_depth_2d[_array]`) and copyable for the report's pictures, plus `extra_usage`.
 pub fn depth_target(gpu: &Gpu, label: &str, w: u32, h: u32, layers: u32, extra_usage: wgpu::TextureUsages) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC | extra_usage,
-        view_formats: &[],
-    })
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC | extra_usage;
+    texture_2d(gpu, label, w, h, layers, DEPTH_FORMAT, usage)
 }
 
 /// The shadow maps' comparison sampler: `LessEqual` against the reference depth, nearest

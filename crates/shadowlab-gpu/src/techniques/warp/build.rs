@@ -394,7 +394,6 @@ fn work_words(variant: Variant, res: u32) -> [u64; 2] {
     }
 }
 
-
 /// Every pass's layouts and pipelines, in the order the passes run.
 struct Pipelines {
     analyze_layout: wgpu::BindGroupLayout,

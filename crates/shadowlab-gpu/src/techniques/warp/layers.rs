@@ -67,16 +67,8 @@ impl Layers {
 
 /// An R32Float texture of `layers` layers that passes write as storage and read as a texture.
 pub(super) fn r32_array(gpu: &Gpu, label: &str, (w, h): (u32, u32), layers: u32) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R32Float,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+    let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    raster::texture_2d(gpu, label, w, h, layers, wgpu::TextureFormat::R32Float, usage)
 }
 
 /// The evaluation of a [`LayerPasses`]: `prelude` (what `select` calls), the warped map's

@@ -303,11 +303,6 @@ impl Warped {
     fn name(&self) -> &'static str {
         self.label
     }
-
-    /// The uniform as written at creation.
-    pub fn params(&self) -> &WarpParams {
-        &self.params
-    }
 }
 
 /// A frame of a warped map: the desired view and the warps fitted to the view samples
