@@ -2,10 +2,10 @@
 //! a 90 degree square perspective frustum, i.e. a spot light along the face axis, and is handled
 //! by one `warp::Warped` (notw's passes, unchanged) drawing into its layer of shared array
 //! textures (`warp::Layers`): one pass reduces every face's desired view from the view samples
-//! on it (the same face rule as `cube`, eval_notw.wgsl), a `split` pass gives each face a mask
-//! of those samples, the face's count map, row and column warps and warped depth map are built
-//! from them only, and one evaluation over the view reads each sample's face. Faces without
-//! view samples are skipped (no analysis, no depth pass).
+//! on it (the same face rule as `cube`, eval_notw.wgsl), one counts them into the faces' count
+//! maps (after each face's occluder map, `edge_importance`), each face's row and column warps and
+//! warped depth map are built from its count map, and one evaluation over the view reads each
+//! sample's face. Faces without view samples are skipped (no occluders, analysis or depth pass).
 //! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
 //! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
 
@@ -15,40 +15,33 @@ use shadowlab_core::techniques::cube::FACES;
 
 use super::{clip, point_position, CubeNotwSettings, FACES_WGSL};
 use crate::frame::LightUniform;
-use crate::gbuffer::GBuffer;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::technique::{compose_view, view_layout, FrameInputs, Technique, TechniqueReport};
+use crate::technique::{FrameInputs, Technique, TechniqueReport};
 use crate::techniques::warp::{self, Knobs, LayerPasses, Layers, Warped};
-use crate::{binding, Gpu, GpuError};
+use crate::{Gpu, GpuError};
 
-const SPLIT_WGSL: &str = include_str!("split.wgsl");
 const EVAL_NOTW_WGSL: &str = include_str!("eval_notw.wgsl");
 
-/// The `split` pass (split.wgsl).
-pub(super) fn split_source() -> String {
-    compose_view(&format!("{FACES_WGSL}{SPLIT_WGSL}"), false)
-}
-
-/// The desired views and the evaluation of every face (warp/dv_layers.wgsl and
-/// warp/eval_layers.wgsl, a face a layer: eval_notw.wgsl).
-pub(super) fn layer_sources() -> [String; 2] {
-    [warp::layered_dv_source(FACES_WGSL, EVAL_NOTW_WGSL), warp::layered_eval_source(FACES_WGSL, EVAL_NOTW_WGSL)]
+/// The desired views, the count maps and the evaluation of every face (warp/dv_layers.wgsl,
+/// warp/count_layers.wgsl and warp/eval_layers.wgsl, a face a layer: eval_notw.wgsl).
+pub(super) fn layer_sources() -> [String; 3] {
+    [
+        warp::layered_dv_source(FACES_WGSL, EVAL_NOTW_WGSL),
+        warp::layered_count_source(FACES_WGSL, EVAL_NOTW_WGSL),
+        warp::layered_eval_source(FACES_WGSL, EVAL_NOTW_WGSL),
+    ]
 }
 
 /// The names of the images of a face's `Warped` report that `cube-notw` passes on.
 const FACE_IMAGES: &[&str] = &["count map before warping", "count map after warping", "warped shadow map", "row warping", "column warping"];
 
 struct Face {
-    pub(crate) groups: crate::binding::GroupCache,
     warped: Warped,
     /// The scene's triangles clipped to this face (clip.rs).
     scene: GpuScene,
     light: Light,
     light_buf: wgpu::Buffer,
-    sel: wgpu::Buffer,
-    /// u32 per pixel: 1 where the view sample falls on this face.
-    mask: Option<wgpu::Buffer>,
     /// View samples on the face in the current frame.
     samples: u32,
 }
@@ -56,12 +49,9 @@ struct Face {
 pub struct CubeNotw {
     res: u32,
     faces: Vec<Face>,
-    /// The faces' warps, maps, DV bounds and counts, a layer each.
+    /// The faces' warps, maps, occluder maps, DV bounds, count maps and counts, a layer each.
     layers: Layers,
-    layout: wgpu::BindGroupLayout,
-    split: wgpu::ComputePipeline,
-    pixels: u64,
-    /// The desired views and the evaluation of every face.
+    /// The desired views, the count maps and the evaluation of every face.
     passes: LayerPasses,
 }
 
@@ -94,30 +84,17 @@ impl CubeNotw {
             let mut warped = Warped::new_layer(gpu, &face_scene, &knobs, &light, shared.as_ref(), &layers, f as u32)?;
             shared.get_or_insert_with(|| warped.subdiv_scratch());
             built[f] = Some(Face {
-                groups: Default::default(),
                 warped,
                 scene: face_scene,
                 light,
                 light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
-                sel: gpu.uniform(&format!("cube-notw.face{f}"), &[f as u32, 0, 0, 0]),
-                mask: None,
                 samples: 0,
             });
         }
         let faces: Vec<Face> = built.into_iter().map(|f| f.expect("all six built")).collect();
-        let rw = binding::storage(false);
-        let layout = view_layout(gpu, "cube-notw.split", &[binding::uniform(), rw]);
         let maps: Vec<&Warped> = faces.iter().map(|f| &f.warped).collect();
         let passes = LayerPasses::new(gpu, "cube-notw", &layers, &maps, FACES_WGSL, EVAL_NOTW_WGSL);
-        Ok(CubeNotw {
-            res,
-            faces,
-            split: gpu.compute_pipeline("cube-notw.split", &split_source(), "split", &[&layout]),
-            layout,
-            pixels: 0,
-            layers,
-            passes,
-        })
+        Ok(CubeNotw { res, faces, layers, passes })
     }
 
     /// View samples per face of the last frame (+x, -x, +y, -y, +z, -z).
@@ -130,14 +107,8 @@ impl CubeNotw {
         &self.faces[f].warped
     }
 
-    fn group(&self, gpu: &Gpu, f: &FrameInputs, face: &Face) -> wgpu::BindGroup {
-        let mask = face.mask.as_ref().expect("sized in prepare");
-        f.view_group(gpu, &face.groups, "cube-notw.split", &self.layout, &[face.sel.as_entire_binding(), mask.as_entire_binding()])
-    }
-
-    /// Runs `step` on every face with view samples, with that face's inputs (its light and
-    /// mask; the analysis passes zero the visibility of the other samples, which the
-    /// evaluation then writes), and records the stages summed over the faces as `cube-notw.*`.
+    /// Runs `step` on every face with view samples, with that face's inputs (its scene and
+    /// light), and records the stages summed over the faces as `cube-notw.*`.
     pub(super) fn each_face(
         &mut self,
         gpu: &Gpu,
@@ -148,11 +119,9 @@ impl CubeNotw {
         let outer = rec.set_rename(Some(("notw.".into(), "cube-notw.".into())));
         let mut result = Ok(());
         for face in self.faces.iter_mut().filter(|face| face.samples > 0) {
-            let g = f.gbuffer;
-            let gbuffer = GBuffer { mask: face.mask.clone().expect("sized in prepare"), ..g.clone() };
             let fi = FrameInputs {
                 scene: &face.scene,
-                gbuffer: &gbuffer,
+                gbuffer: f.gbuffer,
                 light: face.light,
                 camera: f.camera,
                 prev_camera: f.prev_camera,
@@ -169,30 +138,23 @@ impl CubeNotw {
         result
     }
 
-    /// Every face's desired view (stage `desired_view`), the `split` stage (each face's mask of
-    /// the view samples on it, sized to the view), and the samples per face read back
-    /// (`cube-notw.face_samples`: the DV bounds' sixth words) so empty faces are skipped.
-    pub(super) fn split_samples(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
-        let (w, h) = (f.gbuffer.width, f.gbuffer.height);
-        let pixels = w as u64 * h as u64;
-        if pixels != self.pixels {
-            for (i, face) in self.faces.iter_mut().enumerate() {
-                face.mask = Some(gpu.storage(&format!("cube-notw.mask{i}"), pixels * 4));
-            }
-            self.pixels = pixels;
-        }
-        let groups: Vec<wgpu::BindGroup> = self.faces.iter().map(|face| self.group(gpu, f, face)).collect();
+    /// What the faces read of the view: every face's desired view (stage `desired_view`), the
+    /// samples per face read back (`cube-notw.face_samples`: the DV bounds' sixth words) so that
+    /// empty faces are skipped, the occluder maps of the others (`edge_importance`) and every
+    /// face's count map (stage `importance_map`).
+    pub(super) fn read_view(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.passes.reduce_dv(gpu, f, rec, &self.layers);
         let stride = (self.layers.dv_stride() / 4) as usize;
-        rec.stage("cube-notw.split", |enc| {
-            for g in &groups {
-                gpu.dispatch_2d(enc, "cube-notw.split", &self.split, &[g], w, h);
-            }
-        });
         let bounds: Vec<u32> = rec.read_buffer_as(self.layers.dv(), 6 * stride, "cube-notw.face_samples");
         for (f, face) in self.faces.iter_mut().enumerate() {
             face.samples = bounds[f * stride + 5];
         }
+        self.each_face(gpu, f, rec, |w, gpu, fi, rec| {
+            w.draw_occluders(gpu, fi, rec);
+            Ok(())
+        })?;
+        self.passes.count(gpu, f, rec, &self.layers);
+        Ok(())
     }
 
     /// The evaluation of every face in one pass (`final_pass`); with `counting` the lab's

@@ -198,10 +198,12 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
 /// Both maps' evaluation: a view sample goes to the map of its hemisphere.
 const EVAL_MAPS_WGSL: &str = include_str!("eval_maps.wgsl");
 
-/// The warping module's shaders, and the desired views (`dpsm-notw`) and evaluation of both maps.
+/// The warping module's shaders, and the desired views and count maps (`dpsm-notw`) and the
+/// evaluation of both maps.
 pub fn shaders() -> Vec<(&'static str, String)> {
     let mut v = warp::shaders();
     v.push(("dpsm/eval_maps.wgsl (desired views)", warp::layered_dv_source("", EVAL_MAPS_WGSL)));
+    v.push(("dpsm/eval_maps.wgsl (count maps)", warp::layered_count_source("", EVAL_MAPS_WGSL)));
     v.push(("dpsm/eval_maps.wgsl (evaluation)", warp::layered_eval_source("", EVAL_MAPS_WGSL)));
     v
 }
@@ -261,6 +263,7 @@ impl Technique for Dpsm {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         if self.warped {
             self.passes.reduce_dv(gpu, f, rec, &self.layers);
+            self.passes.count(gpu, f, rec, &self.layers);
             for m in &mut self.maps {
                 m.prepare(gpu, f, rec)?;
             }

@@ -3,7 +3,7 @@
 //! cropped map and the warps built from it: NoTW's row warps, the count map rebuilt through
 //! them and the column warps; RTW's 1D collapse, blur and offsets.
 
-use super::{base_constants, Variant, WarpParams, Warped, DV_WGSL, PARAMS_WGSL, SMOOTH_BLOCK};
+use super::{base_constants, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, PARAMS_WGSL, SMOOTH_BLOCK};
 use crate::prefix_sum::ScanParams;
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, FrameInputs};
@@ -12,7 +12,7 @@ use crate::{binding, Gpu};
 const ANALYZE_WGSL: &str = include_str!("analyze.wgsl");
 
 pub(super) fn source() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{DV_WGSL}{ANALYZE_WGSL}"), false)
+    compose_view(&format!("{PARAMS_WGSL}{DV_WGSL}{COUNT_WGSL}{ANALYZE_WGSL}"), false)
 }
 
 /// The entry points a variant dispatches.
@@ -53,11 +53,17 @@ impl Warped {
     }
 
     /// This frame's desired view and warps (stages `desired_view`, with `edge_importance` the
-    /// `occluders` of the crop, and `importance_map`). A layer whose desired view its owner
-    /// reduces ([`super::LayerPasses::reduce_dv`]) skips the first.
+    /// `occluders` of the crop, and `importance_map`). A layer whose owner reads the view
+    /// ([`super::LayerPasses::reduce_dv`], [`super::LayerPasses::count`]) skips all but the
+    /// warps.
     pub(super) fn fit_warps(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         let name = self.name();
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
+        let work = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.work,
+            offset: self.work_offset,
+            size: wgpu::BufferSize::new(self.work_size),
+        });
         let group = f.view_group(
             gpu,
             &self.groups.analyze,
@@ -66,7 +72,7 @@ impl Warped {
             &[
                 self.uniform.as_entire_binding(),
                 self.dv_binding(),
-                self.work.as_entire_binding(),
+                work,
                 self.fwork.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&self.views[0]),
                 wgpu::BindingResource::TextureView(&self.views[1]),
@@ -74,7 +80,7 @@ impl Warped {
                 self.occluders.as_ref().map_or(&self.counts, |o| &o.hzb).as_entire_binding(),
             ],
         );
-        if !self.dv_by_owner {
+        if !self.view_by_owner {
             rec.write_buffer(&self.dv, self.dv_offset, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
             rec.stage(&format!("{name}.desired_view"), |enc| {
                 gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
@@ -83,20 +89,28 @@ impl Warped {
         if self.variant == Variant::Dv {
             return;
         }
-        // `edge_importance`: the occluder map of this frame's DV crop before the count map
-        // (render then reuses it for `cull_hidden`)
-        if let (Some(o), true) = (&self.occluders, self.params.edge_importance > 0) {
-            let depth_group = self.depth_group(gpu);
-            rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, &depth_group, f.scene));
+        if !self.view_by_owner {
+            self.draw_occluders(gpu, f, rec);
         }
         rec.stage(&format!("{name}.importance_map"), |enc| {
-            enc.clear_buffer(&self.work, 0, None);
-            gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
+            if !self.view_by_owner {
+                enc.clear_buffer(&self.work, 0, None);
+                gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
+            }
             match self.variant {
                 Variant::Notw => self.notw_warps(gpu, enc, &group),
                 _ => self.rtw_warps(gpu, enc, &group),
             }
         });
+    }
+
+    /// With `edge_importance`, the occluder map of this frame's DV crop (stage `occluders`),
+    /// which the count map reads (render then reuses it for `cull_hidden`); else nothing.
+    pub fn draw_occluders(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        if let (Some(o), true) = (&self.occluders, self.params.edge_importance > 0) {
+            let depth_group = self.depth_group(gpu);
+            rec.stage(&format!("{}.occluders", self.name()), |enc| o.record(gpu, enc, &depth_group, f.scene));
+        }
     }
 
     /// NoTW after the count map, per direction: the functions (blur, prefix sum and offsets, one

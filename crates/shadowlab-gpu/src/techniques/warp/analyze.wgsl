@@ -46,69 +46,28 @@ fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
     }
 }
 
-fn sample_dv(p: vec3<f32>) -> vec2<f32> {
-    let r = dv_now();
-    return (clip_to_map(base_clip(wp, p)).xy - r.xy) / (r.zw - r.xy);
+// the count's occluder texel (count.wgsl): level 0 of the pyramid
+fn occ_at(x: u32, y: u32) -> f32 {
+    return occ[y * res_u() + x];
 }
 
-fn inside(u: vec2<f32>) -> bool {
-    return all(u >= vec2<f32>(0.0)) && all(u < vec2<f32>(1.0));
-}
-
-// Whether occluder depth o is clearly nearer the light than depth z: by 2 % of the distance
-// (perspective: 1 - depth grows about as 1 / distance) or 0.5 % of the depth range.
-fn clearly_nearer(o: f32, z: f32) -> bool {
-    if wp.perspective > 0.5 {
-        return 1.0 - o > (1.0 - z) * 1.02;
-    }
-    return o < z - 0.005;
-}
-
-// Whether the sample at DV texel t (depth z) lies on a shadow edge of the occluder map: among
-// its 3x3 texels, one clearly nearer (an occluder) and one not (its own surface, or lit).
-fn on_shadow_edge(tx: u32, ty: u32, z: f32) -> bool {
-    let w = res_u();
-    var near = false;
-    var open = false;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let x = u32(clamp(i32(tx) + dx, 0, i32(w) - 1));
-            let y = u32(clamp(i32(ty) + dy, 0, i32(w) - 1));
-            if clearly_nearer(occ[y * w + x], z) {
-                near = true;
-            } else {
-                open = true;
-            }
-        }
-    }
-    return near && open;
-}
-
-// A sample's count at DV coordinates u: 1, or 1 + edge_importance on a shadow edge.
-fn sample_weight(p: vec3<f32>, u: vec2<f32>) -> u32 {
-    let w = res_u();
-    if wp.edge_importance > 0u && on_shadow_edge(texel_of(u.x, w), texel_of(u.y, w), clip_to_map(base_clip(wp, p)).z) {
-        return 1u + wp.edge_importance;
-    }
-    return 1u;
-}
-
-// Count map (NoTW importance) by atomic adds (a shadow-edge sample counts 1 + edge_importance);
-// RTW: importance map, maximum per texel.
+// Count map (NoTW importance) by atomic adds (a shadow-edge sample counts 1 + edge_importance,
+// count.wgsl); RTW: importance map, maximum per texel. Maps of a warp::Layers whose owner reads
+// the view are counted by count_layers.wgsl instead.
 @compute @workgroup_size(8, 8)
 fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     var s: Sample;
     if !load_sample(id, &s) || !owns_sample(wp, s.p) {
         return;
     }
-    let u = sample_dv(s.p);
+    let u = map_coords(s.p, dv_now());
     if !inside(u) {
         return;
     }
-    let w = res_u();
-    let t = texel_of(u.y, w) * w + texel_of(u.x, w);
+    let t = count_index(u);
     atomicAdd(&work[t], sample_weight(s.p, u));
     if wp.rtw_importance != 0u {
+        let w = res_u();
         let maxd = bitcast<f32>(atomicLoad(&dv[4]));
         let d = distance(s.p, frame.camera_pos.xyz);
         let imp = wp.w_dv + wp.w_eye * clamp((maxd - d) / max(maxd, 1e-20), 0.0, 1.0);

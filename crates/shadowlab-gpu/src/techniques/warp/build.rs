@@ -83,7 +83,7 @@ impl Warped {
     ) -> Result<Warped, GpuError> {
         let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size)?;
         let resources = Resources::new(gpu, &plan, target);
-        let pipelines = Pipelines::new(gpu, scene, &plan);
+        let pipelines = Pipelines::new(gpu, scene, &plan, target.map(|(l, i)| (&l.occluders, i)));
         let scene =
             depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None, counting: Default::default() };
         Ok(Warped::assemble(plan, resources, pipelines, scene))
@@ -103,7 +103,7 @@ impl Warped {
             views: [&r.warp_x, &r.warp_y, &r.map].map(|t| t.create_view(&layer_view)),
             layer: r.layer,
             layered: r.layered,
-            dv_by_owner: r.dv_by_owner,
+            view_by_owner: r.view_by_owner,
             dv_offset: r.dv_offset,
             counts_offset: r.counts_offset,
             variant: plan.variant,
@@ -114,6 +114,8 @@ impl Warped {
             uniform: r.uniform,
             dv: r.dv,
             work: r.work,
+            work_offset: r.work_offset,
+            work_size: r.work_size,
             fwork: r.fwork,
             warp_x: r.warp_x,
             warp_y: r.warp_y,
@@ -289,6 +291,8 @@ struct Resources {
     warp_y: wgpu::Texture,
     map: wgpu::Texture,
     work: wgpu::Buffer,
+    work_offset: u64,
+    work_size: u64,
     fwork: wgpu::Buffer,
     pieces: wgpu::Buffer,
     queues: [wgpu::Buffer; 2],
@@ -302,14 +306,14 @@ struct Resources {
     /// for a map with its own).
     layer: u32,
     layered: bool,
-    dv_by_owner: bool,
+    view_by_owner: bool,
     dv_offset: u64,
     counts_offset: u64,
 }
 
 impl Resources {
-    /// The plan's resources; with `target` its warps, map, DV bounds and counts are that
-    /// layer of shared ones ([`Layers`]).
+    /// The plan's resources; with `target` its warps, map, DV bounds and counts (and the count
+    /// map where the owner counts) are that layer of shared ones ([`Layers`]).
     fn new(gpu: &Gpu, plan: &Plan, target: Option<(&Layers, u32)>) -> Resources {
         let (name, res, queue) = (plan.name, plan.res, plan.queue);
         let n = res as u64 * res as u64;
@@ -345,17 +349,24 @@ impl Resources {
                 0,
             ),
         };
+        let words = work_words(plan.variant, res);
+        let (work, work_offset, work_size) = match target.and_then(|(l, i)| l.work.as_ref().map(|w| (w, i as u64 * l.work_stride))) {
+            Some((w, offset)) => (w.clone(), offset, words[0] * 4),
+            None => (gpu.storage(&format!("{name}.work"), words[0] * 4), 0, words[0] * 4),
+        };
         Resources {
             warp_x,
             warp_y,
             map,
             layer,
             layered: target.is_some(),
-            dv_by_owner: target.is_some_and(|(l, _)| l.owner_reduces_dv),
+            view_by_owner: target.is_some_and(|(l, _)| l.owner_reads_view),
             dv_offset,
             counts_offset,
-            work: gpu.storage(&format!("{name}.work"), work_words(plan.variant, res)[0] * 4),
-            fwork: gpu.storage(&format!("{name}.fwork"), work_words(plan.variant, res)[1] * 4),
+            work,
+            work_offset,
+            work_size,
+            fwork: gpu.storage(&format!("{name}.fwork"), words[1] * 4),
             pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
             queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16)),
             counters: gpu.buffer(&wgpu::BufferDescriptor {
@@ -410,11 +421,13 @@ struct Pipelines {
 }
 
 impl Pipelines {
-    fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan) -> Pipelines {
+    /// `occluders`: the array texture and layer the occluder map draws into (else its own).
+    fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan, occluders: Option<(&wgpu::Texture, u32)>) -> Pipelines {
         let name = plan.name;
         let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant, &plan.params);
         let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, &plan.params);
-        let occluders = plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &plan.params, &lookup_layout, scene));
+        let occluders =
+            plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &plan.params, &lookup_layout, scene, occluders));
         let (split_layout, split) = subdiv::pipelines(gpu, name, scene, &plan.params);
         let (eval_layout, eval) = eval::pipelines(gpu, name, &plan.params);
         let sampler = eval::sampler(gpu);

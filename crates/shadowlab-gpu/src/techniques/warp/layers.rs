@@ -1,24 +1,27 @@
 //! Maps evaluated together (`cube-notw`'s six faces, `dpsm`'s two hemispheres): each map keeps
-//! its own passes, but its warps and depth map are one layer of shared array textures, and its
-//! DV bounds and sample counts one slice of shared buffers, so that one pass over the view
-//! reduces every map's desired view (dv_layers.wgsl) and one evaluates every map
+//! its own passes over its map, but its warps, depth map and occluder map are one layer of
+//! shared array textures, and its DV bounds, count map and sample counts one slice of shared
+//! buffers, so that one pass over the view reduces every map's desired view (dv_layers.wgsl),
+//! one counts every map's view samples (count_layers.wgsl) and one evaluates every map
 //! (eval_layers.wgsl), instead of a pass a map ([`LayerPasses`]).
 
 use super::build::warp_sizes;
-use super::{base_constants, eval, Knobs, WarpParams, Warped, DV_WGSL, EVAL_FNS_WGSL, LOOKUP_FNS_WGSL, PARAMS_WGSL};
+use super::{base_constants, eval, Knobs, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, EVAL_FNS_WGSL, LOOKUP_FNS_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, raster, Gpu};
 
 const EVAL_LAYERS_WGSL: &str = include_str!("eval_layers.wgsl");
 const DV_LAYERS_WGSL: &str = include_str!("dv_layers.wgsl");
+const COUNT_LAYERS_WGSL: &str = include_str!("count_layers.wgsl");
 
 /// The shared targets of `count` maps of one kind of knobs.
 pub struct Layers {
     pub(super) res: u32,
     count: u32,
-    /// The maps' desired views are reduced together ([`LayerPasses::reduce_dv`]), not by each map.
-    pub(super) owner_reduces_dv: bool,
+    /// The maps' desired views are reduced and their count maps counted together
+    /// ([`LayerPasses::reduce_dv`], [`LayerPasses::count`]), not by each map.
+    pub(super) owner_reads_view: bool,
     pub(super) warp_x: wgpu::Texture,
     pub(super) warp_y: wgpu::Texture,
     pub(super) map: wgpu::Texture,
@@ -27,20 +30,34 @@ pub struct Layers {
     pub(super) dv_stride: u64,
     /// The analysis variant's samples per warped texel, `res^2` words a layer.
     pub(super) counts: wgpu::Buffer,
+    /// NoTW maps counted by their owner: the count maps, `work_stride` bytes apart (`res^2`
+    /// words rounded up to the storage offset alignment).
+    pub(super) work: Option<wgpu::Buffer>,
+    pub(super) work_stride: u64,
+    /// The occluder maps (`edge_importance`, `cull_hidden`), or a 1x1 stand-in.
+    pub(super) occluders: wgpu::Texture,
 }
 
 impl Layers {
-    /// `count` layers for maps made with `k`; with `owner_reduces_dv` the caller reduces every
-    /// layer's desired view ([`LayerPasses::reduce_dv`]) before the maps' analysis.
-    pub fn new(gpu: &Gpu, name: &str, k: &Knobs, count: u32, owner_reduces_dv: bool) -> Layers {
+    /// `count` layers for maps made with `k`; with `owner_reads_view` the caller reduces every
+    /// layer's desired view ([`LayerPasses::reduce_dv`]) and, for NoTW, counts every layer's
+    /// view samples ([`LayerPasses::count`], after the occluder maps) before the maps' analysis.
+    pub fn new(gpu: &Gpu, name: &str, k: &Knobs, count: u32, owner_reads_view: bool) -> Layers {
         let res = k.res;
-        let dv_stride = (gpu.limits.min_storage_buffer_offset_alignment as u64).max(32);
+        let align = gpu.limits.min_storage_buffer_offset_alignment as u64;
+        let dv_stride = align.max(32);
         let n = res as u64 * res as u64;
         let [wx, wy] = warp_sizes(k.variant, res);
+        let work_stride = (n * 4).div_ceil(align) * align;
+        let counted = owner_reads_view && k.variant == Variant::Notw;
+        let occ = if k.cull_hidden || k.edge_importance > 0 { res } else { 1 };
         Layers {
             res,
             count,
-            owner_reduces_dv,
+            owner_reads_view,
+            work: counted.then(|| gpu.storage(&format!("{name}.work"), work_stride * count as u64)),
+            work_stride,
+            occluders: raster::depth_target(gpu, &format!("{name}.occluders"), occ, occ, count, wgpu::TextureUsages::empty()),
             warp_x: r32_array(gpu, &format!("{name}.warp_x"), wx, count),
             warp_y: r32_array(gpu, &format!("{name}.warp_y"), wy, count),
             map: raster::depth_target(gpu, &format!("{name}.map"), res, res, count, wgpu::TextureUsages::empty()),
@@ -84,9 +101,16 @@ pub fn layered_dv_source(prelude: &str, select: &str) -> String {
     compose_view(&format!("{prelude}{PARAMS_WGSL}{DV_WGSL}{DV_LAYERS_WGSL}{select}"), false)
 }
 
+/// The count maps of a [`LayerPasses`] (count_layers.wgsl), with the same `prelude` and
+/// `select`.
+pub fn layered_count_source(prelude: &str, select: &str) -> String {
+    compose_view(&format!("{prelude}{PARAMS_WGSL}{COUNT_WGSL}{COUNT_LAYERS_WGSL}{select}"), false)
+}
+
 /// The passes over every layer of a [`Layers`] at once: the evaluation (stage
-/// `{name}.final_pass`) and, where the layers' owner reduces their desired views, that
-/// reduction (stage `{name}.desired_view`).
+/// `{name}.final_pass`) and, where the layers' owner reads the view, the reduction of their
+/// desired views (stage `{name}.desired_view`) and of NoTW maps their count maps (stage
+/// `{name}.importance_map`).
 pub struct LayerPasses {
     name: &'static str,
     /// The layers' uniforms, in layer order.
@@ -97,9 +121,14 @@ pub struct LayerPasses {
     layout: wgpu::BindGroupLayout,
     eval: EvalPipelines,
     groups: binding::GroupCache,
-    /// The desired views' pass (`Layers::owner_reduces_dv`): its layout and pipeline.
+    /// The desired views' pass (`Layers::owner_reads_view`): its layout and pipeline.
     dv: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
     dv_groups: binding::GroupCache,
+    /// The count maps' pass (NoTW layers with `Layers::owner_reads_view`) and the occluder maps'
+    /// array view it reads.
+    count: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
+    count_groups: binding::GroupCache,
+    occluders: wgpu::TextureView,
 }
 
 impl LayerPasses {
@@ -133,12 +162,21 @@ impl LayerPasses {
         let stride = ("DV_STRIDE", (layers.dv_stride / 4) as f64);
         let mut constants = eval::constants(&params[0]);
         constants.push(stride);
-        let dv = layers.owner_reduces_dv.then(|| {
+        let dv = layers.owner_reads_view.then(|| {
             let label = format!("{name}.desired_view");
             let layout = view_layout(gpu, &label, &[binding::uniform(), binding::storage(false)]);
             let mut c = base_constants(&params[0]);
             c.push(stride);
             let pipeline = gpu.compute_pipeline_with(&label, &layered_dv_source(prelude, select), "dv_layers", &[&layout], &c);
+            (layout, pipeline)
+        });
+        let count = layers.work.as_ref().map(|_| {
+            let label = format!("{name}.count");
+            let depth = array(wgpu::TextureSampleType::Depth);
+            let layout = view_layout(gpu, &label, &[binding::uniform(), binding::storage(true), binding::storage(false), depth]);
+            let mut c = base_constants(&params[0]);
+            c.extend([stride, ("WORK_STRIDE", (layers.work_stride / 4) as f64)]);
+            let pipeline = gpu.compute_pipeline_with(&label, &layered_count_source(prelude, select), "count_layers", &[&layout], &c);
             (layout, pipeline)
         });
         let source = layered_eval_source(prelude, select);
@@ -147,12 +185,15 @@ impl LayerPasses {
             name,
             params: gpu.uniform_array(&format!("{name}.layers"), &params),
             views: [&layers.warp_x, &layers.warp_y, &layers.map].map(|t| t.create_view(&d)),
+            occluders: layers.occluders.create_view(&d),
             sampler: eval::sampler(gpu),
             eval: EvalPipelines::new(gpu, &label, &source, &layout, &constants),
             layout,
             groups: Default::default(),
             dv,
             dv_groups: Default::default(),
+            count,
+            count_groups: Default::default(),
         }
     }
 
@@ -171,6 +212,27 @@ impl LayerPasses {
         }
         rec.write_buffer(&layers.dv, 0, bytemuck::cast_slice(&empty));
         rec.stage(&label, |enc| gpu.dispatch_2d(enc, &label, pipeline, &[&group], f.gbuffer.width, f.gbuffer.height));
+    }
+
+    /// Every NoTW layer's count map from the view samples in one pass (stage
+    /// `{name}.importance_map`), each sample counted by the layer that evaluates it, after their
+    /// desired views and, with `edge_importance`, their occluder maps
+    /// ([`Warped::draw_occluders`]). Only for layers whose owner reads the view.
+    pub fn count(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, layers: &Layers) {
+        let (layout, pipeline) = self.count.as_ref().expect("the layers' owner counts NoTW maps");
+        let work = layers.work.as_ref().expect("made with the count pass");
+        let label = format!("{}.count", self.name);
+        let extra = [
+            self.params.as_entire_binding(),
+            layers.dv.as_entire_binding(),
+            work.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&self.occluders),
+        ];
+        let group = f.view_group(gpu, &self.count_groups, &label, layout, &extra);
+        rec.stage(&format!("{}.importance_map", self.name), |enc| {
+            enc.clear_buffer(work, 0, None);
+            gpu.dispatch_2d(enc, &label, pipeline, &[&group], f.gbuffer.width, f.gbuffer.height);
+        });
     }
 
     /// The evaluation over the view; with `counting` the lab's analysis variant (each layer's

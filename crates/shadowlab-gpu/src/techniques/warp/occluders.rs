@@ -22,8 +22,10 @@ pub(super) fn hzb_src() -> String {
 
 pub(super) struct Occluders {
     res: u32,
+    /// The occluder map: `layer` of `depth` (its own texture, or a layer of [`super::Layers`]').
     depth: wgpu::Texture,
-    /// `depth`'s view, made once.
+    layer: u32,
+    /// The layer's view, made once.
     view: wgpu::TextureView,
     /// The pyramid, level 0 (res x res) first (params.wgsl `hzb_offset`).
     pub hzb: wgpu::Buffer,
@@ -51,11 +53,29 @@ pub fn pyramid_len(res: u32) -> u64 {
 }
 
 impl Occluders {
-    pub fn new(gpu: &Gpu, name: &str, res: u32, p: &WarpParams, lookup: &wgpu::BindGroupLayout, scene: &GpuScene) -> Occluders {
+    /// With `target` the map is that layer of that array texture (res x res), else its own.
+    pub fn new(
+        gpu: &Gpu,
+        name: &str,
+        res: u32,
+        p: &WarpParams,
+        lookup: &wgpu::BindGroupLayout,
+        scene: &GpuScene,
+        target: Option<(&wgpu::Texture, u32)>,
+    ) -> Occluders {
         let label = format!("{name}.occluders");
         let constants = base_constants(p);
         let raster = raster::depth_pipeline_with(gpu, &label, &occluders_src(), &[lookup, &scene.layout], scene.has_cutouts, &constants);
-        let depth = raster::depth_target(gpu, &label, res, res, 1, wgpu::TextureUsages::empty());
+        let (depth, layer) = match target {
+            Some((t, layer)) => {
+                assert!(
+                    t.width() == res && t.height() == res && layer < t.depth_or_array_layers(),
+                    "{name}: occluder layers of another size"
+                );
+                (t.clone(), layer)
+            }
+            None => (raster::depth_target(gpu, &label, res, res, 1, wgpu::TextureUsages::empty()), 0),
+        };
         let layout = layout_at(
             gpu,
             &format!("{name}.hzb"),
@@ -64,7 +84,12 @@ impl Occluders {
         );
         let src = hzb_src();
         let hzb = gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4);
-        let view = depth.create_view(&Default::default());
+        let view = depth.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        });
         let groups = (0..=top_level(res))
             .map(|l| {
                 let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);
@@ -87,12 +112,14 @@ impl Occluders {
             groups,
             view,
             depth,
+            layer,
             raster,
         }
     }
 
-    pub fn depth(&self) -> &wgpu::Texture {
-        &self.depth
+    /// The occluder map's texture and layer.
+    pub fn depth(&self) -> (&wgpu::Texture, u32) {
+        (&self.depth, self.layer)
     }
 
     /// Bytes of the occluder map and its pyramid.

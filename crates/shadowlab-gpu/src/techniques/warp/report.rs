@@ -148,14 +148,18 @@ impl Warped {
     /// The count map of the last frame before warping (`notw`, `rtw`).
     pub fn read_counts_before(&self, gpu: &Gpu) -> Vec<u32> {
         let n = (self.res * self.res) as usize;
-        gpu.read_buffer_as(&self.work, n)
+        gpu.read_buffer_at(&self.work, self.work_offset, n)
     }
 
     /// `cull_hidden`: the last frame's occluder map (res x res) and its pyramid of maxima (all
     /// levels, level 0 first).
     pub fn read_occluders(&self, gpu: &Gpu) -> Option<(Vec<f32>, Vec<f32>)> {
         let o = self.occluders.as_ref()?;
-        Some((bytemuck::pod_collect_to_vec(&gpu.read_texture(o.depth(), 4)), gpu.read_buffer_as(&o.hzb, (o.hzb.size() / 4) as usize)))
+        let (depth, layer) = o.depth();
+        Some((
+            bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(depth, 4, layer)),
+            gpu.read_buffer_as(&o.hzb, (o.hzb.size() / 4) as usize),
+        ))
     }
 
     /// The view samples per texel of the final (warped) map, counted by the last evaluation.
@@ -198,6 +202,6 @@ impl Warped {
         let occ = self.occluders.as_ref().map_or(0, |o| o.bytes());
         // the counts: this map's share when layered
         let counts = 4 * self.res as u64 * self.res as u64;
-        self.work.size() + self.fwork.size() + counts + subdiv + occ
+        self.work_size + self.fwork.size() + counts + subdiv + occ
     }
 }
