@@ -329,9 +329,13 @@ fn warp_struct_layouts_match_rust() {
     let get = |n: &str| parse(n, &all.iter().find(|(name, _)| *name == n).unwrap().1);
     let layered = [
         "cube/eval_notw.wgsl (desired views)",
+        "cube/eval_notw.wgsl (count maps)",
         "cube/eval_notw.wgsl (evaluation)",
+        "warp/analyze_layers.wgsl (six faces)",
         "dpsm/eval_maps.wgsl (desired views)",
+        "dpsm/eval_maps.wgsl (count maps)",
         "dpsm/eval_maps.wgsl (evaluation)",
+        "warp/analyze_layers.wgsl (two hemispheres)",
     ];
     for w in ["warp/analyze.wgsl", "warp/depth.wgsl", "warp/subdiv.wgsl", "warp/eval.wgsl"].into_iter().chain(layered) {
         check_all(

@@ -36,12 +36,13 @@ use crate::{Gpu, GpuError};
 pub(crate) const FACES_WGSL: &str = include_str!("faces.wgsl");
 
 pub fn shaders() -> Vec<(&'static str, String)> {
-    let [dv, count, eval_notw] = notw::layer_sources();
+    let [dv, count, analysis, eval_notw] = notw::layer_sources();
     vec![
         ("cube/depth.wgsl", depth::source()),
         ("cube/eval.wgsl", eval::source()),
         ("cube/eval_notw.wgsl (desired views)", dv),
         ("cube/eval_notw.wgsl (count maps)", count),
+        ("warp/analyze_layers.wgsl (six faces)", analysis),
         ("cube/eval_notw.wgsl (evaluation)", eval_notw),
     ]
 }
@@ -310,8 +311,7 @@ impl Technique for CubeMap {
 /// every face.
 impl Technique for CubeNotw {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.read_view(gpu, f, rec)?;
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.prepare(gpu, fi, t))
+        self.fit_warps(gpu, f, rec)
     }
 
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {

@@ -3,9 +3,10 @@
 //! by one `warp::Warped` (notw's passes, unchanged) drawing into its layer of shared array
 //! textures (`warp::Layers`): one pass reduces every face's desired view from the view samples
 //! on it (the same face rule as `cube`, eval_notw.wgsl), one counts them into the faces' count
-//! maps (after each face's occluder map, `edge_importance`), each face's row and column warps and
-//! warped depth map are built from its count map, and one evaluation over the view reads each
-//! sample's face. Faces without view samples are skipped (no occluders, analysis or depth pass).
+//! maps (after each face's occluder map, `edge_importance`), one dispatch a step builds every
+//! face's row and column warps from its count map, each face's warped depth map is drawn, and
+//! one evaluation over the view reads each sample's face. Faces without view samples are skipped
+//! (no occluders, warps, subdivision or depth pass).
 //! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
 //! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
 
@@ -23,12 +24,14 @@ use crate::{Gpu, GpuError};
 
 const EVAL_NOTW_WGSL: &str = include_str!("eval_notw.wgsl");
 
-/// The desired views, the count maps and the evaluation of every face (warp/dv_layers.wgsl,
-/// warp/count_layers.wgsl and warp/eval_layers.wgsl, a face a layer: eval_notw.wgsl).
-pub(super) fn layer_sources() -> [String; 3] {
+/// The desired views, the count maps, the warps and the evaluation of every face
+/// (warp/dv_layers.wgsl, warp/count_layers.wgsl, warp/analyze_layers.wgsl and
+/// warp/eval_layers.wgsl, a face a layer: eval_notw.wgsl).
+pub(super) fn layer_sources() -> [String; 4] {
     [
         warp::layered_dv_source(FACES_WGSL, EVAL_NOTW_WGSL),
         warp::layered_count_source(FACES_WGSL, EVAL_NOTW_WGSL),
+        warp::layered_analysis_source(6),
         warp::layered_eval_source(FACES_WGSL, EVAL_NOTW_WGSL),
     ]
 }
@@ -51,7 +54,7 @@ pub struct CubeNotw {
     faces: Vec<Face>,
     /// The faces' warps, maps, occluder maps, DV bounds, count maps and counts, a layer each.
     layers: Layers,
-    /// The desired views, the count maps and the evaluation of every face.
+    /// The desired views, the count maps, the warps and the evaluation of every face.
     passes: LayerPasses,
 }
 
@@ -138,11 +141,11 @@ impl CubeNotw {
         result
     }
 
-    /// What the faces read of the view: every face's desired view (stage `desired_view`), the
+    /// The faces' warps from the view: every face's desired view (stage `desired_view`), the
     /// samples per face read back (`cube-notw.face_samples`: the DV bounds' sixth words) so that
-    /// empty faces are skipped, the occluder maps of the others (`edge_importance`) and every
-    /// face's count map (stage `importance_map`).
-    pub(super) fn read_view(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+    /// empty faces are skipped, the occluder maps of the others (`edge_importance`), every face's
+    /// count map and warps (stage `importance_map`).
+    pub(super) fn fit_warps(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.passes.reduce_dv(gpu, f, rec, &self.layers);
         let stride = (self.layers.dv_stride() / 4) as usize;
         let bounds: Vec<u32> = rec.read_buffer_as(self.layers.dv(), 6 * stride, "cube-notw.face_samples");
@@ -154,6 +157,7 @@ impl CubeNotw {
             Ok(())
         })?;
         self.passes.count(gpu, f, rec, &self.layers);
+        self.passes.analyze(gpu, rec, &self.layers);
         Ok(())
     }
 

@@ -204,6 +204,7 @@ pub fn shaders() -> Vec<(&'static str, String)> {
     let mut v = warp::shaders();
     v.push(("dpsm/eval_maps.wgsl (desired views)", warp::layered_dv_source("", EVAL_MAPS_WGSL)));
     v.push(("dpsm/eval_maps.wgsl (count maps)", warp::layered_count_source("", EVAL_MAPS_WGSL)));
+    v.push(("warp/analyze_layers.wgsl (two hemispheres)", warp::layered_analysis_source(2)));
     v.push(("dpsm/eval_maps.wgsl (evaluation)", warp::layered_eval_source("", EVAL_MAPS_WGSL)));
     v
 }
@@ -264,9 +265,7 @@ impl Technique for Dpsm {
         if self.warped {
             self.passes.reduce_dv(gpu, f, rec, &self.layers);
             self.passes.count(gpu, f, rec, &self.layers);
-            for m in &mut self.maps {
-                m.prepare(gpu, f, rec)?;
-            }
+            self.passes.analyze(gpu, rec, &self.layers);
         }
         Ok(())
     }

@@ -3,7 +3,7 @@
 //! cropped map and the warps built from it: NoTW's row warps, the count map rebuilt through
 //! them and the column warps; RTW's 1D collapse, blur and offsets.
 
-use super::{base_constants, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, PARAMS_WGSL, SMOOTH_BLOCK};
+use super::{base_constants, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, NOTW_WGSL, PARAMS_WGSL, SMOOTH_BLOCK};
 use crate::prefix_sum::ScanParams;
 use crate::record::Recorder;
 use crate::technique::{compose_view, view_layout, FrameInputs};
@@ -12,7 +12,7 @@ use crate::{binding, Gpu};
 const ANALYZE_WGSL: &str = include_str!("analyze.wgsl");
 
 pub(super) fn source() -> String {
-    compose_view(&format!("{PARAMS_WGSL}{DV_WGSL}{COUNT_WGSL}{ANALYZE_WGSL}"), false)
+    compose_view(&format!("{PARAMS_WGSL}{DV_WGSL}{COUNT_WGSL}{NOTW_WGSL}{ANALYZE_WGSL}"), false)
 }
 
 /// The entry points a variant dispatches.
@@ -25,25 +25,28 @@ fn entries(variant: Variant) -> &'static [&'static str] {
 }
 
 /// The analysis layout (the view, then the uniform, the DV bounds, the two work buffers, the two
-/// warps written and the occluder pyramid) and a pipeline per entry point of `variant`.
+/// warps written and the occluder map) and, with `own`, a pipeline per entry point of `variant`
+/// (none for a map its owner analyses).
 pub(super) fn pipelines(
     gpu: &Gpu,
     name: &str,
     variant: Variant,
     p: &WarpParams,
+    own: bool,
 ) -> (wgpu::BindGroupLayout, Vec<(&'static str, wgpu::ComputePipeline)>) {
-    let (ro, rw) = (binding::storage(true), binding::storage(false));
+    let rw = binding::storage(false);
     let store = wgpu::BindingType::StorageTexture {
         access: wgpu::StorageTextureAccess::WriteOnly,
         format: wgpu::TextureFormat::R32Float,
         view_dimension: wgpu::TextureViewDimension::D2,
     };
-    let layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store, ro]);
+    let layout = view_layout(gpu, &format!("{name}.analyze"), &[binding::uniform(), rw, rw, rw, store, store, binding::texture_depth()]);
     let src = source();
     let mut constants = base_constants(p);
     constants.push(("SMOOTH_BLOCK", SMOOTH_BLOCK as f64));
+    let entries = if own { entries(variant) } else { &[] };
     let pipelines =
-        entries(variant).iter().map(|&e| (e, gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout], &constants))).collect();
+        entries.iter().map(|&e| (e, gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout], &constants))).collect();
     (layout, pipelines)
 }
 
@@ -53,17 +56,14 @@ impl Warped {
     }
 
     /// This frame's desired view and warps (stages `desired_view`, with `edge_importance` the
-    /// `occluders` of the crop, and `importance_map`). A layer whose owner reads the view
-    /// ([`super::LayerPasses::reduce_dv`], [`super::LayerPasses::count`]) skips all but the
-    /// warps.
+    /// `occluders` of the crop, and `importance_map`). A layer whose owner reads the view has
+    /// them made by its owner ([`super::LayerPasses`]: `reduce_dv`, `count`, `analyze`).
     pub(super) fn fit_warps(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        if self.view_by_owner {
+            return;
+        }
         let name = self.name();
         let (w, h) = (f.gbuffer.width, f.gbuffer.height);
-        let work = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &self.work,
-            offset: self.work_offset,
-            size: wgpu::BufferSize::new(self.work_size),
-        });
         let group = f.view_group(
             gpu,
             &self.groups.analyze,
@@ -72,31 +72,25 @@ impl Warped {
             &[
                 self.uniform.as_entire_binding(),
                 self.dv_binding(),
-                work,
+                self.work.as_entire_binding(),
                 self.fwork.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&self.views[0]),
                 wgpu::BindingResource::TextureView(&self.views[1]),
-                // the occluder pyramid (`edge_importance`), or a stand-in never read
-                self.occluders.as_ref().map_or(&self.counts, |o| &o.hzb).as_entire_binding(),
+                // the occluder map (`edge_importance`), or a stand-in never read (the map's layer)
+                wgpu::BindingResource::TextureView(self.occluders.as_ref().map_or(&self.views[2], |o| o.view())),
             ],
         );
-        if !self.view_by_owner {
-            rec.write_buffer(&self.dv, self.dv_offset, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
-            rec.stage(&format!("{name}.desired_view"), |enc| {
-                gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
-            });
-        }
+        rec.write_buffer(&self.dv, self.dv_offset, bytemuck::cast_slice(&[u32::MAX, u32::MAX, 0, 0, 0, 0, 0, 0]));
+        rec.stage(&format!("{name}.desired_view"), |enc| {
+            gpu.dispatch_2d(enc, &format!("{name}.desired_view"), self.pipeline("dv_reduce"), &[&group], w, h);
+        });
         if self.variant == Variant::Dv {
             return;
         }
-        if !self.view_by_owner {
-            self.draw_occluders(gpu, f, rec);
-        }
+        self.draw_occluders(gpu, f, rec);
         rec.stage(&format!("{name}.importance_map"), |enc| {
-            if !self.view_by_owner {
-                enc.clear_buffer(&self.work, 0, None);
-                gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
-            }
+            enc.clear_buffer(&self.work, 0, None);
+            gpu.dispatch_2d(enc, &format!("{name}.count"), self.pipeline("count"), &[&group], w, h);
             match self.variant {
                 Variant::Notw => self.notw_warps(gpu, enc, &group),
                 _ => self.rtw_warps(gpu, enc, &group),

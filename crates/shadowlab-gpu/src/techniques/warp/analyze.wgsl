@@ -15,12 +15,8 @@
 @group(0) @binding(9) var<storage, read_write> fwork: array<f32>;
 @group(0) @binding(10) var warp_x_out: texture_storage_2d<r32float, write>;
 @group(0) @binding(11) var warp_y_out: texture_storage_2d<r32float, write>;
-// the occluder map's pyramid (level 0 first: the unwarped DV-cropped depth), `edge_importance`
-@group(0) @binding(12) var<storage, read> occ: array<f32>;
-
-fn res_u() -> u32 {
-    return u32(wp.res);
-}
+// the occluder map (the unwarped DV-cropped depth), `edge_importance`; a stand-in when off
+@group(0) @binding(12) var occ: texture_depth_2d;
 
 fn dv_now() -> vec4<f32> {
     return dv_from_bounds(wp, vec4<u32>(atomicLoad(&dv[0]), atomicLoad(&dv[1]), atomicLoad(&dv[2]), atomicLoad(&dv[3])));
@@ -46,9 +42,9 @@ fn dv_reduce(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
     }
 }
 
-// the count's occluder texel (count.wgsl): level 0 of the pyramid
+// the count's occluder texel (count.wgsl)
 fn occ_at(x: u32, y: u32) -> f32 {
-    return occ[y * res_u() + x];
+    return textureLoad(occ, vec2<u32>(x, y), 0);
 }
 
 // Count map (NoTW importance) by atomic adds (a shadow-edge sample counts 1 + edge_importance,
@@ -75,63 +71,34 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 }
 
-// Index of edge k of function r: rows (axis 0) are row-major, columns (axis 1) column-major.
-fn at(axis: u32, r: u32, k: u32) -> u32 {
-    let w = res_u();
-    return select(k * w + r, r * w + k, axis == 0u);
+// The map's sample count and its warps' texels (notw.wgsl).
+fn samples_total() -> u32 {
+    return atomicLoad(&dv[5]);
 }
 
-// Texel k's count along function r: the sample counts (rows) or the counts rebuilt through the
-// row warps (columns).
-fn count_at(axis: u32, r: u32, k: u32) -> f32 {
-    if axis == 0u {
-        return f32(atomicLoad(&work[at(0u, r, k)]));
-    }
-    return fwork[at(1u, r, k)];
+fn store_warp_x(t: vec2<u32>, o: f32) {
+    textureStore(warp_x_out, t, vec4<f32>(o, 0.0, 0.0, 0.0));
 }
 
-// One warping function per invocation (eq. 4), in two sweeps along it: the counts box-blurred
-// (half-width `blur`, normalised by the taps inside; a sliding sum, exact for whole counts)
-// plus a uniform floor (`mix` x the mean count per texel of the whole map) and their prefix
-// sums, then the offsets o = g / N - x (identity for an empty function) and the total N. The
-// floor bounds the magnification where a function has few samples; without the blur the
-// per-texel count noise puts a kink into the warp at every texel, which linear rasterisation
-// cannot follow (docs/bench/warp.md). The same sums in the same order as core warp::notw.
-fn build_function(axis: u32, r: u32) {
-    let w = res_u();
-    if r >= w {
-        return;
-    }
-    let n = w * w;
-    let rad = u32(wp.blur);
-    let floor_density = wp.mix * f32(atomicLoad(&dv[5])) / f32(n);
-    var win = 0.0;
-    for (var j = 0u; j <= min(rad, w - 1u); j++) {
-        win += count_at(axis, r, j);
-    }
-    var g = 0.0;
-    for (var k = 0u; k < w; k++) {
-        let a = u32(max(i32(k) - i32(rad), 0));
-        let b = min(k + rad, w - 1u);
-        g += win / f32(b - a + 1u) + floor_density;
-        fwork[n + at(axis, r, k)] = g;
-        if k + rad + 1u < w {
-            win += count_at(axis, r, k + rad + 1u);
-        }
-        if k >= rad {
-            win -= count_at(axis, r, k - rad);
-        }
-    }
-    for (var k = 0u; k < w; k++) {
-        let i = n + at(axis, r, k);
-        fwork[i] = select(0.0, fwork[i] / g - f32(k + 1u) / f32(w), g > 0.0);
-    }
-    fwork[3u * n + r] = g;
+fn store_warp_y(t: vec2<u32>, o: f32) {
+    textureStore(warp_y_out, t, vec4<f32>(o, 0.0, 0.0, 0.0));
 }
 
+// NoTW's passes (notw.wgsl): a function per invocation; the smoothing over (position k, block
+// of SMOOTH_BLOCK functions); a row rebuilt per invocation.
 @compute @workgroup_size(64)
 fn functions_rows(@builtin(global_invocation_id) id: vec3<u32>) {
     build_function(0u, id.x);
+}
+
+@compute @workgroup_size(8, 8)
+fn smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    smooth_block(0u, id.x, id.y);
+}
+
+@compute @workgroup_size(64)
+fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
+    rebuild_row(id.x);
 }
 
 @compute @workgroup_size(64)
@@ -139,130 +106,9 @@ fn functions_cols(@builtin(global_invocation_id) id: vec3<u32>) {
     build_function(1u, id.x);
 }
 
-// Smoothing across neighbouring functions: the average over [r - window/2, r + window/2]
-// weighted by their sample totals (seed 000 Figure 4). One invocation smooths SMOOTH_BLOCK
-// consecutive functions r at one position k: it sums its first window directly, then slides
-// it (adds the function that enters, removes the one that leaves), so a texel costs about
-// window / SMOOTH_BLOCK + 2 reads instead of window + 1 (cube-notw's window 128 made this
-// the largest stage of its frame). The totals are whole sample counts, exact in f32 below
-// 2^24 samples, so only the weighted sum drifts, by rounding over at most SMOOTH_BLOCK slides.
-// `window_tent`: the weights also fall off as half + 1 - |r - j| (core warp::smooth); the sum
-// slides by the two half-window sums, which slide like the box's.
-// Set by the pipeline (warp::SMOOTH_BLOCK, which also sizes the dispatch).
-override SMOOTH_BLOCK: u32;
-
-fn weighted(axis: u32, j: u32, k: u32) -> vec2<f32> {
-    let n = res_u() * res_u();
-    let tj = fwork[3u * n + j];
-    return vec2<f32>(tj * fwork[n + at(axis, j, k)], tj);
-}
-
-fn smooth_block(axis: u32, k: u32, block: u32) {
-    let w = res_u();
-    let half = i32(u32(wp.window) / 2u);
-    let r0 = block * SMOOTH_BLOCK;
-    if k >= w || r0 >= w {
-        return;
-    }
-    let tent = wp.tent > 0.5;
-    var acc = vec2<f32>(0.0);
-    // tent: the sums of the functions just above r (r + 1 ..= r + half + 1) and at or below it
-    // (r - half ..= r), which move the tent's weighted sum by one step
-    var above = vec2<f32>(0.0);
-    var below = vec2<f32>(0.0);
-    for (var j = max(i32(r0) - half, 0); j <= min(i32(r0) + half + 1, i32(w) - 1); j++) {
-        let x = weighted(axis, u32(j), k);
-        let d = abs(j - i32(r0));
-        if d <= half {
-            acc += select(x, x * f32(half + 1 - d), tent);
-        }
-        if j > i32(r0) {
-            above += x;
-        } else {
-            below += x;
-        }
-    }
-    for (var r = r0; r < min(r0 + SMOOTH_BLOCK, w); r++) {
-        if r > r0 && tent {
-            // from r - 1 to r: sum + above - below; then the two halves move up by one
-            acc += above - below;
-            let p = i32(r) - 1;
-            let mid = weighted(axis, u32(r), k);
-            above -= mid;
-            below += mid;
-            if p + half + 2 < i32(w) {
-                above += weighted(axis, u32(p + half + 2), k);
-            }
-            if p - half >= 0 {
-                below -= weighted(axis, u32(p - half), k);
-            }
-        } else if r > r0 {
-            let enter = i32(r) + half;
-            let leave = i32(r) - half - 1;
-            if enter < i32(w) {
-                acc += weighted(axis, u32(enter), k);
-            }
-            if leave >= 0 {
-                acc -= weighted(axis, u32(leave), k);
-            }
-        }
-        let o = select(0.0, acc.x / acc.y, acc.y > 0.0);
-        if axis == 0u {
-            fwork[2u * w * w + r * w + k] = o;
-            textureStore(warp_x_out, vec2<u32>(k, r), vec4<f32>(o, 0.0, 0.0, 0.0));
-        } else {
-            // r = column, k = edge: stored as an image, (column, edge)
-            textureStore(warp_y_out, vec2<u32>(r, k), vec4<f32>(o, 0.0, 0.0, 0.0));
-        }
-    }
-}
-
-// Dispatched over (position k, block of SMOOTH_BLOCK functions).
-@compute @workgroup_size(8, 8)
-fn smooth_rows(@builtin(global_invocation_id) id: vec3<u32>) {
-    smooth_block(0u, id.x, id.y);
-}
-
 @compute @workgroup_size(8, 8)
 fn smooth_cols(@builtin(global_invocation_id) id: vec3<u32>) {
     smooth_block(1u, id.x, id.y);
-}
-
-// The count map rebuilt through the smoothed row warps (step 6), one row per invocation: each
-// texel's count spread evenly over its image [x'(k / w), x'((k + 1) / w)] under the row's own
-// warp (the function at the texel's centre), the texels it covers taking their overlap's share.
-// A sweep along the row (the warp is monotonic), without atomics: the same sums on every run.
-// The samples are taken as spread evenly over their texel, which is what the piecewise-linear
-// warp assumes; core warp::rebuild_rows is the reference.
-@compute @workgroup_size(64)
-fn rebuild(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = res_u();
-    let i = id.x;
-    if i >= w {
-        return;
-    }
-    for (var j = 0u; j < w; j++) {
-        fwork[i * w + j] = 0.0;
-    }
-    let fw = f32(w);
-    var x0 = 0.0;
-    for (var k = 0u; k < w; k++) {
-        let x1 = select(f32(k + 1u) / fw + fwork[2u * w * w + i * w + k], 1.0, k + 1u == w);
-        let c = f32(atomicLoad(&work[i * w + k]));
-        if c > 0.0 {
-            let ja = texel_of(x0, w);
-            let jb = texel_of(x1, w);
-            if ja == jb || x1 <= x0 {
-                fwork[i * w + ja] += c;
-            } else {
-                for (var j = ja; j <= jb; j++) {
-                    let part = min(x1, f32(j + 1u) / fw) - max(x0, f32(j) / fw);
-                    fwork[i * w + j] += c * max(part, 0.0) / (x1 - x0);
-                }
-            }
-        }
-        x0 = x1;
-    }
 }
 
 // RTW: importance collapsed by maximum per column (t < w: the density of x) and per row

@@ -83,7 +83,8 @@ impl Warped {
     ) -> Result<Warped, GpuError> {
         let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size)?;
         let resources = Resources::new(gpu, &plan, target);
-        let pipelines = Pipelines::new(gpu, scene, &plan, target.map(|(l, i)| (&l.occluders, i)));
+        let by_owner = target.is_some_and(|(l, _)| l.owner_reads_view);
+        let pipelines = Pipelines::new(gpu, scene, &plan, target.map(|(l, i)| (&l.occluders, i)), by_owner);
         let scene =
             depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None, counting: Default::default() };
         Ok(Warped::assemble(plan, resources, pipelines, scene))
@@ -115,8 +116,8 @@ impl Warped {
             dv: r.dv,
             work: r.work,
             work_offset: r.work_offset,
-            work_size: r.work_size,
             fwork: r.fwork,
+            fwork_offset: r.fwork_offset,
             warp_x: r.warp_x,
             warp_y: r.warp_y,
             map: r.map,
@@ -292,8 +293,8 @@ struct Resources {
     map: wgpu::Texture,
     work: wgpu::Buffer,
     work_offset: u64,
-    work_size: u64,
     fwork: wgpu::Buffer,
+    fwork_offset: u64,
     pieces: wgpu::Buffer,
     queues: [wgpu::Buffer; 2],
     counters: wgpu::Buffer,
@@ -313,7 +314,8 @@ struct Resources {
 
 impl Resources {
     /// The plan's resources; with `target` its warps, map, DV bounds and counts (and the count
-    /// map where the owner counts) are that layer of shared ones ([`Layers`]).
+    /// map and analysis scratch where the owner analyses) are that layer of shared ones
+    /// ([`Layers`]).
     fn new(gpu: &Gpu, plan: &Plan, target: Option<(&Layers, u32)>) -> Resources {
         let (name, res, queue) = (plan.name, plan.res, plan.queue);
         let n = res as u64 * res as u64;
@@ -350,9 +352,11 @@ impl Resources {
             ),
         };
         let words = work_words(plan.variant, res);
-        let (work, work_offset, work_size) = match target.and_then(|(l, i)| l.work.as_ref().map(|w| (w, i as u64 * l.work_stride))) {
-            Some((w, offset)) => (w.clone(), offset, words[0] * 4),
-            None => (gpu.storage(&format!("{name}.work"), words[0] * 4), 0, words[0] * 4),
+        let shared =
+            target.and_then(|(l, i)| Some((l.work.as_ref()?, l.fwork.as_ref()?, i as u64 * l.work_stride, i as u64 * l.fwork_stride)));
+        let (work, work_offset, fwork, fwork_offset) = match shared {
+            Some((w, fw, wo, fo)) => (w.clone(), wo, fw.clone(), fo),
+            None => (gpu.storage(&format!("{name}.work"), words[0] * 4), 0, gpu.storage(&format!("{name}.fwork"), words[1] * 4), 0),
         };
         Resources {
             warp_x,
@@ -365,8 +369,8 @@ impl Resources {
             counts_offset,
             work,
             work_offset,
-            work_size,
-            fwork: gpu.storage(&format!("{name}.fwork"), words[1] * 4),
+            fwork,
+            fwork_offset,
             pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
             queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16)),
             counters: gpu.buffer(&wgpu::BufferDescriptor {
@@ -396,7 +400,7 @@ impl Resources {
 
 /// Words of the analysis's two work buffers (analyze.wgsl's layouts): NoTW's counts, then its
 /// rebuilt counts, offsets and totals; RTW's importance and 1D functions; the DV alone: none.
-fn work_words(variant: Variant, res: u32) -> [u64; 2] {
+pub(super) fn work_words(variant: Variant, res: u32) -> [u64; 2] {
     let (n, w) = (res as u64 * res as u64, res as u64);
     match variant {
         Variant::Notw => [n, 3 * n + w],
@@ -421,10 +425,11 @@ struct Pipelines {
 }
 
 impl Pipelines {
-    /// `occluders`: the array texture and layer the occluder map draws into (else its own).
-    fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan, occluders: Option<(&wgpu::Texture, u32)>) -> Pipelines {
+    /// `occluders`: the array texture and layer the occluder map draws into (else its own);
+    /// `by_owner`: the map's analysis is its owner's (no analysis pipelines).
+    fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan, occluders: Option<(&wgpu::Texture, u32)>, by_owner: bool) -> Pipelines {
         let name = plan.name;
-        let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant, &plan.params);
+        let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant, &plan.params, !by_owner);
         let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, &plan.params);
         let occluders =
             plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &plan.params, &lookup_layout, scene, occluders));

@@ -2,18 +2,25 @@
 //! its own passes over its map, but its warps, depth map and occluder map are one layer of
 //! shared array textures, and its DV bounds, count map and sample counts one slice of shared
 //! buffers, so that one pass over the view reduces every map's desired view (dv_layers.wgsl),
-//! one counts every map's view samples (count_layers.wgsl) and one evaluates every map
-//! (eval_layers.wgsl), instead of a pass a map ([`LayerPasses`]).
+//! one counts every map's view samples (count_layers.wgsl), one dispatch a step builds every
+//! map's NoTW warps (analyze_layers.wgsl) and one pass evaluates every map (eval_layers.wgsl),
+//! instead of a pass a map ([`LayerPasses`]).
 
 use super::build::warp_sizes;
-use super::{base_constants, eval, Knobs, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, EVAL_FNS_WGSL, LOOKUP_FNS_WGSL, PARAMS_WGSL};
+use super::build::work_words;
+use super::{
+    base_constants, eval, Knobs, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, EVAL_FNS_WGSL, LOOKUP_FNS_WGSL, NOTW_WGSL, PARAMS_WGSL,
+    SMOOTH_BLOCK,
+};
 use crate::record::Recorder;
+use crate::shaders::compose;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, raster, Gpu};
 
 const EVAL_LAYERS_WGSL: &str = include_str!("eval_layers.wgsl");
 const DV_LAYERS_WGSL: &str = include_str!("dv_layers.wgsl");
 const COUNT_LAYERS_WGSL: &str = include_str!("count_layers.wgsl");
+const ANALYZE_LAYERS_WGSL: &str = include_str!("analyze_layers.wgsl");
 
 /// The shared targets of `count` maps of one kind of knobs.
 pub struct Layers {
@@ -30,10 +37,12 @@ pub struct Layers {
     pub(super) dv_stride: u64,
     /// The analysis variant's samples per warped texel, `res^2` words a layer.
     pub(super) counts: wgpu::Buffer,
-    /// NoTW maps counted by their owner: the count maps, `work_stride` bytes apart (`res^2`
-    /// words rounded up to the storage offset alignment).
+    /// NoTW maps analysed by their owner: the count maps and the analysis's scratch,
+    /// `work_stride` and `fwork_stride` bytes apart (rounded up to the storage offset alignment).
     pub(super) work: Option<wgpu::Buffer>,
     pub(super) work_stride: u64,
+    pub(super) fwork: Option<wgpu::Buffer>,
+    pub(super) fwork_stride: u64,
     /// The occluder maps (`edge_importance`, `cull_hidden`), or a 1x1 stand-in.
     pub(super) occluders: wgpu::Texture,
 }
@@ -41,14 +50,17 @@ pub struct Layers {
 impl Layers {
     /// `count` layers for maps made with `k`; with `owner_reads_view` the caller reduces every
     /// layer's desired view ([`LayerPasses::reduce_dv`]) and, for NoTW, counts every layer's
-    /// view samples ([`LayerPasses::count`], after the occluder maps) before the maps' analysis.
+    /// view samples ([`LayerPasses::count`], after the occluder maps) and builds every layer's
+    /// warps ([`LayerPasses::analyze`]) before the maps' subdivision and depth passes.
     pub fn new(gpu: &Gpu, name: &str, k: &Knobs, count: u32, owner_reads_view: bool) -> Layers {
         let res = k.res;
         let align = gpu.limits.min_storage_buffer_offset_alignment as u64;
         let dv_stride = align.max(32);
         let n = res as u64 * res as u64;
         let [wx, wy] = warp_sizes(k.variant, res);
-        let work_stride = (n * 4).div_ceil(align) * align;
+        let aligned = |words: u64| (words * 4).div_ceil(align) * align;
+        let [work_words, fwork_words] = work_words(k.variant, res);
+        let (work_stride, fwork_stride) = (aligned(work_words), aligned(fwork_words));
         let counted = owner_reads_view && k.variant == Variant::Notw;
         let occ = if k.cull_hidden || k.edge_importance > 0 { res } else { 1 };
         Layers {
@@ -57,6 +69,8 @@ impl Layers {
             owner_reads_view,
             work: counted.then(|| gpu.storage(&format!("{name}.work"), work_stride * count as u64)),
             work_stride,
+            fwork: counted.then(|| gpu.storage(&format!("{name}.fwork"), fwork_stride * count as u64)),
+            fwork_stride,
             occluders: raster::depth_target(gpu, &format!("{name}.occluders"), occ, occ, count, wgpu::TextureUsages::empty()),
             warp_x: r32_array(gpu, &format!("{name}.warp_x"), wx, count),
             warp_y: r32_array(gpu, &format!("{name}.warp_y"), wy, count),
@@ -107,10 +121,18 @@ pub fn layered_count_source(prelude: &str, select: &str) -> String {
     compose_view(&format!("{prelude}{PARAMS_WGSL}{COUNT_WGSL}{COUNT_LAYERS_WGSL}{select}"), false)
 }
 
+/// NoTW's analysis of `layers` layers at once (analyze_layers.wgsl).
+pub fn layered_analysis_source(layers: u32) -> String {
+    compose(&format!("const LAYERS: u32 = {layers}u;\n{PARAMS_WGSL}{NOTW_WGSL}{ANALYZE_LAYERS_WGSL}"), false)
+}
+
+/// NoTW's analysis passes, in order (notw.wgsl).
+const ANALYSIS: [&str; 5] = ["functions_rows", "smooth_rows", "rebuild", "functions_cols", "smooth_cols"];
+
 /// The passes over every layer of a [`Layers`] at once: the evaluation (stage
 /// `{name}.final_pass`) and, where the layers' owner reads the view, the reduction of their
-/// desired views (stage `{name}.desired_view`) and of NoTW maps their count maps (stage
-/// `{name}.importance_map`).
+/// desired views (stage `{name}.desired_view`) and of NoTW maps their count maps and warps
+/// (stage `{name}.importance_map`).
 pub struct LayerPasses {
     name: &'static str,
     /// The layers' uniforms, in layer order.
@@ -129,6 +151,9 @@ pub struct LayerPasses {
     count: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
     count_groups: binding::GroupCache,
     occluders: wgpu::TextureView,
+    /// NoTW's analysis passes over every layer (with the count pass) and their group.
+    analysis: Option<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; 5])>,
+    analysis_groups: binding::GroupCache,
 }
 
 impl LayerPasses {
@@ -179,6 +204,26 @@ impl LayerPasses {
             let pipeline = gpu.compute_pipeline_with(&label, &layered_count_source(prelude, select), "count_layers", &[&layout], &c);
             (layout, pipeline)
         });
+        let analysis = layers.work.as_ref().map(|_| {
+            let label = format!("{name}.analyze");
+            let store = wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: wgpu::TextureFormat::R32Float,
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+            };
+            let (ro, rw) = (binding::storage(true), binding::storage(false));
+            let layout = binding::layout(&gpu.device, &label, wgpu::ShaderStages::COMPUTE, &[binding::uniform(), ro, rw, rw, store, store]);
+            let mut c = base_constants(&params[0]);
+            c.extend([
+                stride,
+                ("WORK_STRIDE", (layers.work_stride / 4) as f64),
+                ("FWORK_STRIDE", (layers.fwork_stride / 4) as f64),
+                ("SMOOTH_BLOCK", SMOOTH_BLOCK as f64),
+            ]);
+            let src = layered_analysis_source(layers.count);
+            let pipelines = ANALYSIS.map(|e| gpu.compute_pipeline_with(&format!("{label}.{e}"), &src, e, &[&layout], &c));
+            (layout, pipelines)
+        });
         let source = layered_eval_source(prelude, select);
         let d = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
         LayerPasses {
@@ -194,6 +239,8 @@ impl LayerPasses {
             dv_groups: Default::default(),
             count,
             count_groups: Default::default(),
+            analysis,
+            analysis_groups: Default::default(),
         }
     }
 
@@ -232,6 +279,37 @@ impl LayerPasses {
         rec.stage(&format!("{}.importance_map", self.name), |enc| {
             enc.clear_buffer(work, 0, None);
             gpu.dispatch_2d(enc, &label, pipeline, &[&group], f.gbuffer.width, f.gbuffer.height);
+        });
+    }
+
+    /// Every NoTW layer's warps from its count map ([`LayerPasses::count`]), one dispatch a step
+    /// over all layers (stage `{name}.importance_map`; layers without view samples are left as
+    /// they were). Only for layers whose owner reads the view.
+    pub fn analyze(&self, gpu: &Gpu, rec: &mut Recorder, layers: &Layers) {
+        let (layout, pipelines) = self.analysis.as_ref().expect("the layers' owner analyses NoTW maps");
+        let (work, fwork) = (layers.work.as_ref().expect("with the analysis"), layers.fwork.as_ref().expect("with the analysis"));
+        let label = format!("{}.analyze", self.name);
+        let entries = [
+            self.params.as_entire_binding(),
+            layers.dv.as_entire_binding(),
+            work.as_entire_binding(),
+            fwork.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&self.views[0]),
+            wgpu::BindingResource::TextureView(&self.views[1]),
+        ];
+        let entries: Vec<wgpu::BindGroupEntry> =
+            entries.into_iter().enumerate().map(|(i, resource)| wgpu::BindGroupEntry { binding: i as u32, resource }).collect();
+        let group = self.analysis_groups.entries(gpu, &label, layout, &entries);
+        let (res, n) = (layers.res, layers.count);
+        let functions = [res.div_ceil(64), 1, n];
+        let smooth = [res.div_ceil(8), res.div_ceil(SMOOTH_BLOCK).div_ceil(8), n];
+        rec.stage(&format!("{}.importance_map", self.name), |enc| {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(&label), timestamp_writes: None });
+            pass.set_bind_group(0, &group, &[]);
+            for (pipeline, groups) in pipelines.iter().zip([functions, smooth, functions, functions, smooth]) {
+                pass.set_pipeline(pipeline);
+                gpu.dispatch(&mut pass, groups);
+            }
         });
     }
 

@@ -36,7 +36,7 @@ mod subdiv;
 
 use eval::EVAL_FNS_WGSL;
 pub use knobs::Knobs;
-pub use layers::{layered_count_source, layered_dv_source, layered_eval_source, LayerPasses, Layers};
+pub use layers::{layered_analysis_source, layered_count_source, layered_dv_source, layered_eval_source, LayerPasses, Layers};
 pub use params::*;
 pub use settings::*;
 pub use subdiv::SubdivScratch;
@@ -58,6 +58,8 @@ const PARAMS_WGSL: &str = include_str!("params.wgsl");
 const DV_WGSL: &str = include_str!("dv.wgsl");
 /// A view sample's place and weight in its count map (analyze.wgsl, count_layers.wgsl).
 const COUNT_WGSL: &str = include_str!("count.wgsl");
+/// NoTW's warps from a count map (analyze.wgsl, analyze_layers.wgsl).
+const NOTW_WGSL: &str = include_str!("notw.wgsl");
 /// A finished warp applied (depth, subdivision, occluder and evaluation passes): one map's
 /// bindings 6-9, then the functions.
 const LOOKUP_WGSL: &str = concat!(include_str!("lookup_bind.wgsl"), include_str!("lookup.wgsl"));
@@ -222,12 +224,12 @@ pub struct Warped {
     uniform: wgpu::Buffer,
     /// Reduced DV bounds (fixed point) and the largest eye distance: 8 words.
     dv: wgpu::Buffer,
-    /// The count map (and RTW's importance): its own, or its slice of [`Layers`]' (the
-    /// bytes from `work_offset`, `work_size` of them).
+    /// The count map (and RTW's importance) and the analysis's scratch: its own, or its slices
+    /// of [`Layers`]' (from these byte offsets).
     work: wgpu::Buffer,
     work_offset: u64,
-    work_size: u64,
     fwork: wgpu::Buffer,
+    fwork_offset: u64,
     warp_x: wgpu::Texture,
     warp_y: wgpu::Texture,
     map: wgpu::Texture,
@@ -240,8 +242,8 @@ pub struct Warped {
     counts_offset: u64,
     /// A layer of [`Layers`]: evaluated by its owner ([`LayerPasses`]).
     layered: bool,
-    /// Its desired view reduced and (NoTW) its count map counted by its owner
-    /// (`Layers::owner_reads_view`).
+    /// Its desired view reduced and (NoTW) its count map counted and warps built by its owner
+    /// (`Layers::owner_reads_view`): it has no analysis of its own.
     view_by_owner: bool,
     counts: wgpu::Buffer,
     /// Subdivision: finished pieces, counters + draw/dispatch args, two queues, one uniform per level.

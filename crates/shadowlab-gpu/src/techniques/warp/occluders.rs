@@ -1,6 +1,7 @@
-//! `cull_hidden` (planar warped maps): before subdivision, the scene is drawn into the
-//! DV-cropped map without the warp (occluders.wgsl, a plain shadow map, res x res), and its
-//! depths reduced to a pyramid of 2x2 maxima (hzb.wgsl). subdiv.wgsl then leaves an edge unsplit
+//! `cull_hidden`, `edge_importance` (planar warped maps): the scene drawn into the DV-cropped
+//! map without the warp (occluders.wgsl, a plain shadow map, res x res), which the count map
+//! reads for `edge_importance`; for `cull_hidden` its depths are reduced to a pyramid of 2x2
+//! maxima (hzb.wgsl). subdiv.wgsl then leaves an edge unsplit
 //! when everything around it is nearer to the light than the edge: its bend cannot show. The
 //! decision is a function of the edge (both pieces on it agree: no cracks) and of the map (the
 //! same on every run), and an unsplit edge is still drawn, coarser, never dropped.
@@ -27,9 +28,14 @@ pub(super) struct Occluders {
     layer: u32,
     /// The layer's view, made once.
     view: wgpu::TextureView,
-    /// The pyramid, level 0 (res x res) first (params.wgsl `hzb_offset`).
-    pub hzb: wgpu::Buffer,
     raster: wgpu::RenderPipeline,
+    /// `cull_hidden`: the pyramid of maxima, level 0 (res x res) first (params.wgsl
+    /// `hzb_offset`), and how it is built; else none (`edge_importance` reads the map only).
+    pub hzb: Option<Pyramid>,
+}
+
+pub(super) struct Pyramid {
+    pub buffer: wgpu::Buffer,
     base: wgpu::ComputePipeline,
     reduce: wgpu::ComputePipeline,
     /// One bind group per level (the occluder map, the pyramid, the level's uniform (res, level)),
@@ -76,45 +82,14 @@ impl Occluders {
             }
             None => (raster::depth_target(gpu, &label, res, res, 1, wgpu::TextureUsages::empty()), 0),
         };
-        let layout = layout_at(
-            gpu,
-            &format!("{name}.hzb"),
-            wgpu::ShaderStages::COMPUTE,
-            &[(0, binding::texture_depth()), (1, binding::storage(false)), (2, binding::uniform())],
-        );
-        let src = hzb_src();
-        let hzb = gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4);
         let view = depth.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2),
             base_array_layer: layer,
             array_layer_count: Some(1),
             ..Default::default()
         });
-        let groups = (0..=top_level(res))
-            .map(|l| {
-                let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);
-                gpu.bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("hzb"),
-                    layout: &layout,
-                    entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                        wgpu::BindGroupEntry { binding: 1, resource: hzb.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 2, resource: u.as_entire_binding() },
-                    ],
-                })
-            })
-            .collect();
-        Occluders {
-            res,
-            hzb,
-            base: gpu.compute_pipeline_with(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout], &constants),
-            reduce: gpu.compute_pipeline_with(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout], &constants),
-            groups,
-            view,
-            depth,
-            layer,
-            raster,
-        }
+        let hzb = (p.cull_hidden > 0.5).then(|| Pyramid::new(gpu, name, res, &constants, &view));
+        Occluders { res, hzb, view, depth, layer, raster }
     }
 
     /// The occluder map's texture and layer.
@@ -122,12 +97,18 @@ impl Occluders {
         (&self.depth, self.layer)
     }
 
-    /// Bytes of the occluder map and its pyramid.
-    pub fn bytes(&self) -> u64 {
-        4 * self.res as u64 * self.res as u64 + self.hzb.size()
+    /// The occluder map's view.
+    pub fn view(&self) -> &wgpu::TextureView {
+        &self.view
     }
 
-    /// The occluder pass and the pyramid; `lookup` is the depth pass's group (the DV rectangle).
+    /// Bytes of the occluder map and its pyramid.
+    pub fn bytes(&self) -> u64 {
+        4 * self.res as u64 * self.res as u64 + self.hzb.as_ref().map_or(0, |h| h.buffer.size())
+    }
+
+    /// The occluder pass and (`cull_hidden`) the pyramid; `lookup` is the depth pass's group
+    /// (the DV rectangle).
     pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, lookup: &wgpu::BindGroup, scene: &GpuScene) {
         {
             let mut pass = raster::begin_pass(enc, "occluders", &[], &self.view);
@@ -136,10 +117,45 @@ impl Occluders {
             pass.set_bind_group(1, &scene.group, &[]);
             pass.draw(0..scene.triangle_count * 3, 0..1);
         }
-        for (l, group) in self.groups.iter().enumerate() {
-            let side = side(self.res, l as u32);
-            let pipeline = if l == 0 { &self.base } else { &self.reduce };
-            gpu.dispatch_2d(enc, "hzb", pipeline, &[group], side, side);
+        if let Some(h) = &self.hzb {
+            for (l, group) in h.groups.iter().enumerate() {
+                let side = side(self.res, l as u32);
+                let pipeline = if l == 0 { &h.base } else { &h.reduce };
+                gpu.dispatch_2d(enc, "hzb", pipeline, &[group], side, side);
+            }
+        }
+    }
+}
+
+impl Pyramid {
+    fn new(gpu: &Gpu, name: &str, res: u32, constants: &[(&str, f64)], view: &wgpu::TextureView) -> Pyramid {
+        let layout = layout_at(
+            gpu,
+            &format!("{name}.hzb"),
+            wgpu::ShaderStages::COMPUTE,
+            &[(0, binding::texture_depth()), (1, binding::storage(false)), (2, binding::uniform())],
+        );
+        let src = hzb_src();
+        let buffer = gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4);
+        let groups = (0..=top_level(res))
+            .map(|l| {
+                let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);
+                gpu.bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("hzb"),
+                    layout: &layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) },
+                        wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: u.as_entire_binding() },
+                    ],
+                })
+            })
+            .collect();
+        Pyramid {
+            base: gpu.compute_pipeline_with(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout], constants),
+            reduce: gpu.compute_pipeline_with(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout], constants),
+            buffer,
+            groups,
         }
     }
 }

@@ -151,15 +151,13 @@ impl Warped {
         gpu.read_buffer_at(&self.work, self.work_offset, n)
     }
 
-    /// `cull_hidden`: the last frame's occluder map (res x res) and its pyramid of maxima (all
-    /// levels, level 0 first).
+    /// `cull_hidden`, `edge_importance`: the last frame's occluder map (res x res) and, with
+    /// `cull_hidden`, its pyramid of maxima (all levels, level 0 first; else empty).
     pub fn read_occluders(&self, gpu: &Gpu) -> Option<(Vec<f32>, Vec<f32>)> {
         let o = self.occluders.as_ref()?;
         let (depth, layer) = o.depth();
-        Some((
-            bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(depth, 4, layer)),
-            gpu.read_buffer_as(&o.hzb, (o.hzb.size() / 4) as usize),
-        ))
+        let pyramid = o.hzb.as_ref().map_or(Vec::new(), |h| gpu.read_buffer_as(&h.buffer, (h.buffer.size() / 4) as usize));
+        Some((bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(depth, 4, layer)), pyramid))
     }
 
     /// The view samples per texel of the final (warped) map, counted by the last evaluation.
@@ -170,7 +168,7 @@ impl Warped {
     /// The count map rebuilt through the row warps (`notw`; fractional: each texel's count is
     /// spread over the texels of its image).
     pub fn read_counts_rows(&self, gpu: &Gpu) -> Vec<f32> {
-        gpu.read_buffer_as(&self.fwork, (self.res * self.res) as usize)
+        gpu.read_buffer_at(&self.fwork, self.fwork_offset, (self.res * self.res) as usize)
     }
 
     /// The warp textures of the last frame.
@@ -200,8 +198,9 @@ impl Warped {
     pub fn scratch_bytes(&self) -> u64 {
         let subdiv = if self.owns_subdiv { self.pieces.size() + 2 * self.queues[0].size() } else { 0 };
         let occ = self.occluders.as_ref().map_or(0, |o| o.bytes());
-        // the counts: this map's share when layered
+        // the work buffers and counts: this map's share when layered
         let counts = 4 * self.res as u64 * self.res as u64;
-        self.work_size + self.fwork.size() + counts + subdiv + occ
+        let [work, fwork] = super::build::work_words(self.variant, self.res);
+        4 * (work + fwork) + counts + subdiv + occ
     }
 }
