@@ -226,7 +226,7 @@ pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
     lights: &["point"],
     params: ParamTable::of::<CubeNotwSettings>(),
-    stalls: "cube-notw.face_samples: the samples per face are read back to skip empty faces",
+    stalls: "",
     needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
     storage_buffers: 11,
     compare: &[""],

@@ -5,8 +5,9 @@
 //! on it (the same face rule as `cube`, eval_notw.wgsl), one counts them into the faces' count
 //! maps (after each face's occluder map, `edge_importance`), one dispatch a step builds every
 //! face's row and column warps from its count map, each face's warped depth map is drawn, and
-//! one evaluation over the view reads each sample's face. Faces without view samples are skipped
-//! (no occluders, warps, subdivision or depth pass).
+//! one evaluation over the view reads each sample's face. Nothing is read back during the
+//! frame: a face without view samples keeps its warps and draws no pieces (its subdivision
+//! reads the count on the GPU), and the report reads the counts after the frame.
 //! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
 //! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
 
@@ -45,8 +46,6 @@ struct Face {
     scene: GpuScene,
     light: Light,
     light_buf: wgpu::Buffer,
-    /// View samples on the face in the current frame.
-    samples: u32,
 }
 
 pub struct CubeNotw {
@@ -91,7 +90,6 @@ impl CubeNotw {
                 scene: face_scene,
                 light,
                 light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
-                samples: 0,
             });
         }
         let faces: Vec<Face> = built.into_iter().map(|f| f.expect("all six built")).collect();
@@ -100,9 +98,12 @@ impl CubeNotw {
         Ok(CubeNotw { res, faces, layers, passes })
     }
 
-    /// View samples per face of the last frame (+x, -x, +y, -y, +z, -z).
-    pub fn face_samples(&self) -> [u32; 6] {
-        std::array::from_fn(|f| self.faces[f].samples)
+    /// View samples per face of the last frame (+x, -x, +y, -y, +z, -z): the sixth words of
+    /// the faces' DV bounds, read back.
+    pub fn face_samples(&self, gpu: &Gpu) -> [u32; 6] {
+        let stride = (self.layers.dv_stride() / 4) as usize;
+        let bounds: Vec<u32> = gpu.read_buffer_as(self.layers.dv(), 6 * stride);
+        std::array::from_fn(|f| bounds[f * stride + 5])
     }
 
     /// The `Warped` of face `f` (its warps, count maps and map, for tests and pictures).
@@ -110,8 +111,8 @@ impl CubeNotw {
         &self.faces[f].warped
     }
 
-    /// Runs `step` on every face with view samples, with that face's inputs (its scene and
-    /// light), and records the stages summed over the faces as `cube-notw.*`.
+    /// Runs `step` on every face, with that face's inputs (its scene and light), and records the
+    /// stages summed over the faces as `cube-notw.*`.
     pub(super) fn each_face(
         &mut self,
         gpu: &Gpu,
@@ -121,7 +122,7 @@ impl CubeNotw {
     ) -> Result<(), GpuError> {
         let outer = rec.set_rename(Some(("notw.".into(), "cube-notw.".into())));
         let mut result = Ok(());
-        for face in self.faces.iter_mut().filter(|face| face.samples > 0) {
+        for face in self.faces.iter_mut() {
             let fi = FrameInputs {
                 scene: &face.scene,
                 gbuffer: f.gbuffer,
@@ -142,16 +143,10 @@ impl CubeNotw {
     }
 
     /// The faces' warps from the view: every face's desired view (stage `desired_view`), the
-    /// samples per face read back (`cube-notw.face_samples`: the DV bounds' sixth words) so that
-    /// empty faces are skipped, the occluder maps of the others (`edge_importance`), every face's
-    /// count map and warps (stage `importance_map`).
+    /// occluder maps (`edge_importance`), every face's count map and warps (stage
+    /// `importance_map`; faces without samples keep theirs).
     pub(super) fn fit_warps(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.passes.reduce_dv(gpu, f, rec, &self.layers);
-        let stride = (self.layers.dv_stride() / 4) as usize;
-        let bounds: Vec<u32> = rec.read_buffer_as(self.layers.dv(), 6 * stride, "cube-notw.face_samples");
-        for (f, face) in self.faces.iter_mut().enumerate() {
-            face.samples = bounds[f * stride + 5];
-        }
         self.each_face(gpu, f, rec, |w, gpu, fi, rec| {
             w.draw_occluders(gpu, fi, rec);
             Ok(())
@@ -175,12 +170,13 @@ impl CubeNotw {
         let mut r = TechniqueReport::default();
         let mut after = Vec::with_capacity(6 * n);
         let mut active = 0;
+        let samples = self.face_samples(gpu);
         for (i, face) in self.faces.iter_mut().enumerate() {
             let name = FACES[i].name;
-            r.counters.insert(format!("view_samples_face_{name}"), face.samples as f64);
+            r.counters.insert(format!("view_samples_face_{name}"), samples[i] as f64);
             r.counters.insert(format!("clipped_triangles_face_{name}"), face.scene.triangle_count as f64);
-            if face.samples == 0 {
-                // not rendered this frame: no samples, nothing to report but its memory
+            if samples[i] == 0 {
+                // no samples: no pieces drawn this frame, nothing to report but its memory
                 after.extend(std::iter::repeat_n(0, n));
                 r.shadow_data_bytes += n as u64 * 4 + face.warped.warp_bytes() + 32;
                 continue;

@@ -6,6 +6,12 @@
 @group(0) @binding(8) var warp_x: texture_2d<f32>;
 @group(0) @binding(9) var warp_y: texture_2d<f32>;
 
+// Whether the map is cropped to a desired view that holds no view sample: nothing evaluates it
+// (an uncropped map, `dpsm`, reduces no desired view).
+fn no_samples() -> bool {
+    return wp.dv_mode > 0.5 && dv_bounds[5] == 0u;
+}
+
 fn dv_rect() -> vec4<f32> {
     return dv_from_bounds(wp, vec4<u32>(dv_bounds[0], dv_bounds[1], dv_bounds[2], dv_bounds[3]));
 }

@@ -326,7 +326,8 @@ const ROOT_CORNERS = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
 @compute @workgroup_size(64)
 fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
-    if tri >= wp.triangles {
+    if tri >= wp.triangles || no_samples() {
+        // no view sample on the map (an empty cube face): nothing evaluates it, nothing is drawn
         return;
     }
     let c = ROOT_CORNERS;
@@ -504,7 +505,8 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
 @compute @workgroup_size(1)
 fn draw_args() {
     let appended = min(atomicLoad(&counters[0]), wp.extra_capacity);
-    atomicStore(&counters[4], 3u * (wp.triangles + appended));
+    // a map without view samples draws nothing (split_root left its slots as they were)
+    atomicStore(&counters[4], select(3u * (wp.triangles + appended), 0u, no_samples()));
     atomicStore(&counters[5], 1u);
     atomicStore(&counters[6], 0u);
     atomicStore(&counters[7], 0u);
