@@ -157,6 +157,16 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     if wrong > 1.05 || wrong >= 0.8 * cube_wrong {
         panic!("cube-notw {wrong:.3}% wrong on room (cube {cube_wrong:.3}%); {}", save_images("cube-notw-room", &v, &notw, &rt));
     }
+    // the faces' exact-depth fragments: each face's pieces subdivided again after the frame (the
+    // faces share one set of subdivision buffers), so the same count on every run
+    let again = lab.run(&v, &spec("cube-notw:res=128,window=64,edge_importance=0"), 1).unwrap();
+    let frags = notw.report.counters["exact_depth_fragments"];
+    assert!(
+        frags > 0.0 && frags == again.report.counters["exact_depth_fragments"],
+        "{frags} vs {:?}",
+        again.report.counters.get("exact_depth_fragments")
+    );
+    assert_eq!(notw.report.counters["exact_depth_fragments_per_texel"], frags / (6.0 * 128.0 * 128.0));
     let edged = lab.run(&v, &spec("cube-notw:res=128,window=64"), 1).unwrap();
     let edged_wrong = 100.0 - agreement(&edged.visibility, &rt.visibility, &v.mask);
     eprintln!("room 256, 128 per face: cube {cube_wrong:.3} %, cube-notw seeds' importance {wrong:.3} %, with edges {edged_wrong:.3} %");

@@ -103,6 +103,13 @@ fn dpsm_notw_beats_dpsm_on_room() {
     let (sd, sn) = (dpsm.report.sampling.unwrap(), notw.report.sampling.unwrap());
     assert!(sn.used_texel_fraction > 1.3 * sd.used_texel_fraction, "{sn:?} vs {sd:?}");
     assert!(sn.samples_per_used_texel_cv < 0.7 * sd.samples_per_used_texel_cv, "{sn:?} vs {sd:?}");
+    // the hemispheres' exact-depth fragments (each map's pieces subdivided again after the
+    // frame: they share one set of subdivision buffers): 0 without exact_depth, and with it the
+    // same on every run
+    assert_eq!(dpsm.report.counters["exact_depth_fragments"], 0.0);
+    let (e1, e2) = (run("dpsm:exact_depth=true"), run("dpsm:exact_depth=true"));
+    let frags = e1.report.counters["exact_depth_fragments"];
+    assert!(frags > 0.0 && frags == e2.report.counters["exact_depth_fragments"], "{frags} vs {:?}", e2.report.counters);
     // memory: two 512^2 f32 maps; dpsm-notw adds two warps (8 w^2 bytes each) and DV bounds
     let n = 512u64 * 512;
     assert_eq!(dpsm.report.shadow_data_bytes, 2 * 4 * n);

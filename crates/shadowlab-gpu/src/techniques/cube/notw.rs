@@ -189,6 +189,8 @@ impl CubeNotw {
             for (k, v) in fr.counters {
                 if k == "fetches_per_pixel" {
                     r.counters.insert(k, v);
+                } else if k == "exact_depth_fragments" {
+                    *r.counters.entry(k).or_default() += v;
                 } else if k.starts_with("subdiv_") {
                     // pieces drawn, dropped (holes: subdivision capacity) and queue-full finishes;
                     // the pieces per face too (where the cost goes)
@@ -205,6 +207,9 @@ impl CubeNotw {
             }
         }
         r.counters.insert("faces_rendered".into(), active as f64);
+        // the faces' exact-depth fragments (each one inversion of its warp), per texel of the six
+        let frags = *r.counters.entry("exact_depth_fragments".into()).or_default();
+        r.counters.insert("exact_depth_fragments_per_texel".into(), frags / (6 * n) as f64);
         // every face's buffers, rendered this frame or not (the subdivision set once: shared)
         r.counters.insert("scratch_bytes".into(), self.faces.iter().map(|f| f.warped.scratch_bytes()).sum::<u64>() as f64);
         r.counters.insert("warp_bytes_per_face".into(), 8.0 * n as f64);

@@ -303,6 +303,8 @@ impl Technique for Dpsm {
             for (k, v) in sub.counters {
                 if k.starts_with("subdiv_") || k.ends_with("_before_warp") || k == "dv_area_fraction" {
                     r.counters.insert(format!("{h}.{k}"), v);
+                } else if k == "exact_depth_fragments" {
+                    *r.counters.entry(k).or_default() += v;
                 }
             }
             for mut img in sub.images {
@@ -324,6 +326,9 @@ impl Technique for Dpsm {
         let c = &mut r.counters;
         c.insert("fetches_per_pixel".into(), (self.pcf * self.pcf) as f64);
         c.insert("shadow_map_texels".into(), 2.0 * n as f64);
+        // both maps' exact-depth fragments, per texel of the two (0 without exact_depth)
+        let frags = *c.entry("exact_depth_fragments".into()).or_default();
+        c.insert("exact_depth_fragments_per_texel".into(), frags / (2 * n) as f64);
         c.insert("warp_bytes".into(), warp_bytes as f64);
         // work buffers of both maps + the one shared set of subdivision buffers
         c.insert("scratch_bytes".into(), self.maps.iter().map(|m| m.scratch_bytes()).sum::<u64>() as f64);

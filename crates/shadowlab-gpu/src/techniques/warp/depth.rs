@@ -146,16 +146,13 @@ impl Warped {
     /// Fragments the last frame's exact-depth pass shaded and kept (each one inversion of the
     /// warp; discarded ones, behind a paraboloid's split plane or cut out, not counted): its
     /// draw again, with the depth test off, under an occlusion query (the map is kept).
-    /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame, and for a
-    /// map whose subdivision buffers are shared (cube-notw's faces, dpsm's hemispheres: after
-    /// the frame they hold another map's pieces, so the redraw would count those).
+    /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame. A map whose
+    /// subdivision buffers are shared (cube-notw's faces, dpsm's hemispheres: after the frame
+    /// they hold another map's pieces) subdivides again first.
     pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
         let (scene_group, triangles) = self.scene.last.as_ref()?;
         if self.params.exact_depth == 0 {
             return Some(0);
-        }
-        if self.shares_subdiv && self.params.subdiv > 0.0 {
-            return None;
         }
         let (pipeline, set, resolve) = self.scene.counting.get_or_init(|| {
             let pipeline = counting_pipeline(gpu, self.name(), &self.lookup_layout, &self.scene, &self.params);
@@ -174,6 +171,11 @@ impl Warped {
         });
         let depth_group = self.depth_group(gpu);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
+        if self.shares_subdiv && self.params.subdiv > 0.0 {
+            // the shared pieces hold the last map's: this map's again (the same pieces as in
+            // its frame: the subdivision is a function of the warps, the crop and the scene)
+            self.record_subdivision(gpu, &mut enc, scene_group);
+        }
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("warp.exact_count"),

@@ -71,33 +71,36 @@ impl Warped {
     /// `depth_group` is the depth pass's group, which the occluder pass shares.
     pub(super) fn subdivide(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, depth_group: &wgpu::BindGroup) {
         let name = self.name();
-        let groups = self.level_groups(gpu);
         if let (Some(o), true) = (&self.occluders, self.params.edge_importance == 0) {
             rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, depth_group, f.scene));
         }
-        let tris = self.params.triangles;
-        let n = tris.div_ceil(64);
-        rec.stage(&format!("{name}.subdivide"), |enc| {
-            enc.clear_buffer(&self.counters, 0, None);
-            let pass = |enc: &mut wgpu::CommandEncoder, g: &wgpu::BindGroup, p: usize, groups: Option<u32>| {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
-                pass.set_bind_group(1, &f.scene.group, &[]);
-                pass.set_bind_group(0, g, &[]);
-                pass.set_pipeline(&self.split[p]);
-                match groups {
-                    Some(n) => gpu.dispatch(&mut pass, [n.min(65535), n.div_ceil(65535), 1]),
-                    None => gpu.dispatch_indirect(&mut pass, &self.dispatch, 0),
-                }
-            };
-            pass(enc, &groups[0], 0, Some(n));
-            for (l, g) in groups.iter().enumerate().skip(1) {
-                pass(enc, g, 1, Some(1));
-                // the input queue's group counts, out of the storage buffer into the indirect one
-                enc.copy_buffer_to_buffer(&self.counters, 32 + 16 * ((l as u64 + 1) % 2) + 4, &self.dispatch, 0, 12);
-                pass(enc, g, 2, None);
+        rec.stage(&format!("{name}.subdivide"), |enc| self.record_subdivision(gpu, enc, &f.scene.group));
+    }
+
+    /// The subdivision's passes over the scene of `scene_group` (the root, each level, the draw
+    /// arguments), after this frame's warps and occluder map: the same pieces every time.
+    pub(super) fn record_subdivision(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene_group: &wgpu::BindGroup) {
+        let groups = self.level_groups(gpu);
+        let n = self.params.triangles.div_ceil(64);
+        enc.clear_buffer(&self.counters, 0, None);
+        let pass = |enc: &mut wgpu::CommandEncoder, g: &wgpu::BindGroup, p: usize, groups: Option<u32>| {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
+            pass.set_bind_group(1, scene_group, &[]);
+            pass.set_bind_group(0, g, &[]);
+            pass.set_pipeline(&self.split[p]);
+            match groups {
+                Some(n) => gpu.dispatch(&mut pass, [n.min(65535), n.div_ceil(65535), 1]),
+                None => gpu.dispatch_indirect(&mut pass, &self.dispatch, 0),
             }
-            pass(enc, &groups[0], 3, Some(1));
-        });
+        };
+        pass(enc, &groups[0], 0, Some(n));
+        for (l, g) in groups.iter().enumerate().skip(1) {
+            pass(enc, g, 1, Some(1));
+            // the input queue's group counts, out of the storage buffer into the indirect one
+            enc.copy_buffer_to_buffer(&self.counters, 32 + 16 * ((l as u64 + 1) % 2) + 4, &self.dispatch, 0, 12);
+            pass(enc, g, 2, None);
+        }
+        pass(enc, &groups[0], 3, Some(1));
     }
 
     /// One group per level (0: the root): the depth pass's bindings, the counters, the level's
