@@ -221,7 +221,7 @@ shadowlab_core::param_set! {
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "cube-notw",
     summary: "NoTW per cube face: each face's view samples get their own desired view, count map and row/column warps",
-    cost: "notw's analysis + warped depth pass for every face that has view samples, one evaluation over all faces; 8 w^2 bytes of warps per face",
+    cost: "one pass each over the view for all faces' desired views, count maps and evaluation, one dispatch a step of notw's analysis for all faces; per face a subdivision and warped depth pass (none drawn on a face without view samples); 8 w^2 bytes of warps per face",
     quality: "spreads the view samples over each face; faces with few samples gain little",
     source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
     lights: &["point"],

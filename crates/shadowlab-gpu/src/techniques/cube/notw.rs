@@ -197,7 +197,14 @@ impl CubeNotw {
                     if k == "subdiv_triangles_drawn" {
                         r.counters.insert(format!("subdiv_pieces_face_{name}"), v);
                     }
-                    *r.counters.entry(k).or_default() += v;
+                    let total = r.counters.entry(k.clone()).or_default();
+                    match k.as_str() {
+                        // a ratio: over the six faces below
+                        "subdiv_pieces_per_texel" => {}
+                        // the deepest first cut of any face (0: none)
+                        "subdiv_cut_level" => *total = total.max(v),
+                        _ => *total += v,
+                    }
                 } else if k.ends_with("fraction") || k.ends_with("warp") {
                     r.counters.insert(format!("{k}_face_{name}"), v);
                 }
@@ -207,6 +214,11 @@ impl CubeNotw {
             }
         }
         r.counters.insert("faces_rendered".into(), active as f64);
+        // pieces per texel of the six faces (until 2026-12-07 the sum of the faces' ratios:
+        // pieces per texel of one face, 6x this)
+        if let Some(&pieces) = r.counters.get("subdiv_triangles_drawn") {
+            r.counters.insert("subdiv_pieces_per_texel".into(), pieces / (6 * n) as f64);
+        }
         // the faces' exact-depth fragments (each one inversion of its warp), per texel of the six
         let frags = *r.counters.entry("exact_depth_fragments".into()).or_default();
         r.counters.insert("exact_depth_fragments_per_texel".into(), frags / (6 * n) as f64);

@@ -182,7 +182,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "dpsm-notw",
     summary: "dual-paraboloid maps warped by NoTW per hemisphere: desired view, count map, row and column warps of each hemisphere's view samples",
-    cost: "per hemisphere: DV reduction, count map, row and column warps (notw's analysis); subdivision + warped depth pass; one evaluation of both; 2 x (4 + 8) w^2 bytes",
+    cost: "one pass each over the view for both hemispheres' desired views, count maps and evaluation, one dispatch a step of notw's analysis for both; per hemisphere a subdivision + warped depth pass; 2 x (4 + 8) w^2 bytes",
     quality: "the view samples of each hemisphere spread over its whole map; seam at the split plane",
     source: "seed 002 section 5.3 (DPSM with NoTW), seed 000 section 3",
     lights: &["point"],
