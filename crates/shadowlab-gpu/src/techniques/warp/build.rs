@@ -173,17 +173,7 @@ impl Plan {
     }
 
     fn warp_sizes(&self) -> [(u32, u32); 2] {
-        warp_sizes(self.variant, self.res)
-    }
-}
-
-/// Texels of the two warp textures: NoTW one function per row and per column, RTW one 1D
-/// function each way, the DV crop none (a stand-in texel).
-pub(super) fn warp_sizes(variant: Variant, res: u32) -> [(u32, u32); 2] {
-    match variant {
-        Variant::Notw => [(res, res), (res, res)],
-        Variant::Rtw => [(res, 1), (1, res)],
-        Variant::Dv => [(1, 1), (1, 1)],
+        self.variant.warp_sizes(self.res)
     }
 }
 
@@ -351,7 +341,7 @@ impl Resources {
                 0,
             ),
         };
-        let words = work_words(plan.variant, res);
+        let words = plan.variant.work_words(res);
         let shared =
             target.and_then(|(l, i)| Some((l.work.as_ref()?, l.fwork.as_ref()?, i as u64 * l.work_stride, i as u64 * l.fwork_stride)));
         let (work, work_offset, fwork, fwork_offset) = match shared {
@@ -395,17 +385,6 @@ impl Resources {
                 mapped_at_creation: false,
             }),
         }
-    }
-}
-
-/// Words of the analysis's two work buffers (analyze.wgsl's layouts): NoTW's counts, then its
-/// rebuilt counts, offsets and totals; RTW's importance and 1D functions; the DV alone: none.
-pub(super) fn work_words(variant: Variant, res: u32) -> [u64; 2] {
-    let (n, w) = (res as u64 * res as u64, res as u64);
-    match variant {
-        Variant::Notw => [n, 3 * n + w],
-        Variant::Rtw => [2 * n + 2 * w, 4 * w],
-        Variant::Dv => [1, 1],
     }
 }
 

@@ -6,8 +6,6 @@
 //! map's NoTW warps (analyze_layers.wgsl) and one pass evaluates every map (eval_layers.wgsl),
 //! instead of a pass a map ([`LayerPasses`]).
 
-use super::build::warp_sizes;
-use super::build::work_words;
 use super::{
     base_constants, eval, Knobs, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, EVAL_FNS_WGSL, LOOKUP_FNS_WGSL, NOTW_WGSL, PARAMS_WGSL,
     SMOOTH_BLOCK,
@@ -57,9 +55,9 @@ impl Layers {
         let align = gpu.limits.min_storage_buffer_offset_alignment as u64;
         let dv_stride = align.max(32);
         let n = res as u64 * res as u64;
-        let [wx, wy] = warp_sizes(k.variant, res);
+        let [wx, wy] = k.variant.warp_sizes(res);
         let aligned = |words: u64| (words * 4).div_ceil(align) * align;
-        let [work_words, fwork_words] = work_words(k.variant, res);
+        let [work_words, fwork_words] = k.variant.work_words(res);
         let (work_stride, fwork_stride) = (aligned(work_words), aligned(fwork_words));
         let counted = owner_reads_view && k.variant == Variant::Notw;
         let occ = if k.cull_hidden || k.edge_importance > 0 { res } else { 1 };

@@ -144,6 +144,28 @@ impl Variant {
             Variant::Dv => "notw-dv",
         }
     }
+
+    /// Texels of the two warp textures: NoTW one function per row and per column, RTW one 1D
+    /// function each way, the DV crop none (a stand-in texel).
+    pub(super) fn warp_sizes(self, res: u32) -> [(u32, u32); 2] {
+        match self {
+            Variant::Notw => [(res, res), (res, res)],
+            Variant::Rtw => [(res, 1), (1, res)],
+            Variant::Dv => [(1, 1), (1, 1)],
+        }
+    }
+
+    /// Words of the analysis's two work buffers (analyze.wgsl's layouts): NoTW's counts, then
+    /// its rebuilt counts, offsets and totals; RTW's importance and 1D functions; the DV alone:
+    /// none.
+    pub(super) fn work_words(self, res: u32) -> [u64; 2] {
+        let (n, w) = (res as u64 * res as u64, res as u64);
+        match self {
+            Variant::Notw => [n, 3 * n + w],
+            Variant::Rtw => [2 * n + 2 * w, 4 * w],
+            Variant::Dv => [1, 1],
+        }
+    }
 }
 
 /// `WarpParams::dv_mode`: the map is cropped to the desired view.

@@ -200,7 +200,7 @@ impl Warped {
         let occ = self.occluders.as_ref().map_or(0, |o| o.bytes());
         // the work buffers and counts: this map's share when layered
         let counts = 4 * self.res as u64 * self.res as u64;
-        let [work, fwork] = super::build::work_words(self.variant, self.res);
+        let [work, fwork] = self.variant.work_words(self.res);
         4 * (work + fwork) + counts + subdiv + occ
     }
 }
