@@ -1,5 +1,6 @@
-// cube-notw's layers in one evaluation (warp/eval_layers.wgsl): a view sample is evaluated by
-// its face (the `split` rule), each face a spot light along its axis.
+// cube-notw's faces as the layers of warp::Layers (desired views, count maps, evaluation): a
+// view sample belongs to its face (`cube`'s rule, faces.wgsl `cube_face`), each face a spot
+// light along its axis.
 
 const LAYERS: u32 = 6u;
 

@@ -306,9 +306,9 @@ impl Technique for CubeMap {
     }
 }
 
-/// A frame of `cube-notw`: the view samples split by face (one readback of their counts), then
-/// each face with samples runs `notw`'s passes on its own samples, and one evaluation reads
-/// every face.
+/// A frame of `cube-notw`: one pass each for every face's desired view and count map and one
+/// analysis dispatch a step (notw.rs `fit_warps`), each face's subdivision and warped depth
+/// pass, and one evaluation over every face; nothing read back during the frame.
 impl Technique for CubeNotw {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.fit_warps(gpu, f, rec)

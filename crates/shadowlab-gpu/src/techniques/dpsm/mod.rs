@@ -244,7 +244,7 @@ impl Dpsm {
         let dp = DualParaboloid::fit(position, axis, &scene.bounds)
             .ok_or_else(|| GpuError::Invalid(format!("{name}: light position {position} or scene bounds not usable")))?;
         let labels: [&'static str; 2] = if warped { ["dpsm-notw.front", "dpsm-notw.back"] } else { ["dpsm.front", "dpsm.back"] };
-        // dpsm-notw: both desired views in one pass (dpsm crops none)
+        // dpsm-notw: both desired views, count maps and warps made together (dpsm crops none)
         let layers = Layers::new(gpu, name, k, 2, warped);
         let make = |i: usize| {
             let h = Hemisphere::BOTH[i];

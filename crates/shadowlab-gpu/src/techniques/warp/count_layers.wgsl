@@ -4,19 +4,12 @@
 // file, as in eval_layers.wgsl), inside that layer's DV crop. The sums do not depend on the
 // order, so each layer's map is the one its own pass over its samples made.
 
-// Words between two layers' DV bounds and between their count maps.
-override DV_STRIDE: u32;
+// Words between two layers' count maps (the uniforms and DV bounds: layer_bind.wgsl).
 override WORK_STRIDE: u32;
 
-@group(0) @binding(6) var<uniform> layer_params: array<WarpParams, LAYERS>;
-@group(0) @binding(7) var<storage, read> dv: array<u32>;
 @group(0) @binding(8) var<storage, read_write> work: array<atomic<u32>>;
 // each layer's occluder map (`edge_importance`; a stand-in when off)
 @group(0) @binding(9) var occ: texture_depth_2d_array;
-
-// The sample's layer and its uniform (what count.wgsl and `light_axis` read).
-var<private> layer: u32;
-var<private> wp: WarpParams;
 
 fn occ_at(x: u32, y: u32) -> f32 {
     return textureLoad(occ, vec2<u32>(x, y), layer, 0);
@@ -28,10 +21,8 @@ fn count_layers(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    layer = layer_of(s.p);
-    wp = layer_params[layer];
-    let o = layer * DV_STRIDE;
-    let u = map_coords(s.p, dv_from_bounds(wp, vec4<u32>(dv[o], dv[o + 1u], dv[o + 2u], dv[o + 3u])));
+    enter_layer(s.p);
+    let u = map_coords(s.p, dv_rect());
     if !inside(u) {
         return;
     }

@@ -5,25 +5,12 @@
 // `const LAYERS: u32`, `fn layer_of(p: vec3<f32>) -> u32` and `fn light_axis() -> vec3<f32>`
 // (a perspective layer's axis, read while `layer` is set).
 
-// Words between two layers' DV bounds (warp::Layers::dv_stride / 4).
-override DV_STRIDE: u32;
-
-@group(0) @binding(6) var<uniform> layer_params: array<WarpParams, LAYERS>;
-@group(0) @binding(7) var<storage, read> dv_bounds: array<u32>;
+// (The uniforms and DV bounds, bindings 6-7, and the sample's layer: layer_bind.wgsl.)
 @group(0) @binding(8) var warp_x: texture_2d_array<f32>;
 @group(0) @binding(9) var warp_y: texture_2d_array<f32>;
 @group(0) @binding(10) var shadow_map: texture_depth_2d_array;
 @group(0) @binding(11) var cmp: sampler_comparison;
 @group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
-
-// The evaluated sample's layer and its uniform.
-var<private> wp: WarpParams;
-var<private> layer: u32;
-
-fn dv_rect() -> vec4<f32> {
-    let b = layer * DV_STRIDE;
-    return dv_from_bounds(wp, vec4<u32>(dv_bounds[b], dv_bounds[b + 1u], dv_bounds[b + 2u], dv_bounds[b + 3u]));
-}
 
 fn warp_x_size() -> vec2<u32> {
     return textureDimensions(warp_x);
@@ -60,7 +47,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    layer = layer_of(s.p);
-    wp = layer_params[layer];
+    enter_layer(s.p);
     eval_sample(s);
 }

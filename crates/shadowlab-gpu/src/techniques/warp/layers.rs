@@ -15,6 +15,8 @@ use crate::shaders::compose;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, raster, Gpu};
 
+/// The layers' uniforms and DV bounds in a pass over the view (count and evaluation).
+const LAYER_BIND_WGSL: &str = include_str!("layer_bind.wgsl");
 const EVAL_LAYERS_WGSL: &str = include_str!("eval_layers.wgsl");
 const DV_LAYERS_WGSL: &str = include_str!("dv_layers.wgsl");
 const COUNT_LAYERS_WGSL: &str = include_str!("count_layers.wgsl");
@@ -104,7 +106,7 @@ pub(super) fn r32_array(gpu: &Gpu, label: &str, (w, h): (u32, u32), layers: u32)
 /// evaluation over layers, and `select`, which defines `LAYERS`, `layer_of` and `light_axis`
 /// (eval_layers.wgsl).
 pub fn layered_eval_source(prelude: &str, select: &str) -> String {
-    compose_view(&format!("{prelude}{PARAMS_WGSL}{LOOKUP_FNS_WGSL}{EVAL_FNS_WGSL}{EVAL_LAYERS_WGSL}{select}"), false)
+    compose_view(&format!("{prelude}{PARAMS_WGSL}{LAYER_BIND_WGSL}{LOOKUP_FNS_WGSL}{EVAL_FNS_WGSL}{EVAL_LAYERS_WGSL}{select}"), false)
 }
 
 /// The desired views of a [`LayerPasses`] (dv_layers.wgsl), with the same `prelude` and
@@ -116,7 +118,7 @@ pub fn layered_dv_source(prelude: &str, select: &str) -> String {
 /// The count maps of a [`LayerPasses`] (count_layers.wgsl), with the same `prelude` and
 /// `select`.
 pub fn layered_count_source(prelude: &str, select: &str) -> String {
-    compose_view(&format!("{prelude}{PARAMS_WGSL}{COUNT_WGSL}{COUNT_LAYERS_WGSL}{select}"), false)
+    compose_view(&format!("{prelude}{PARAMS_WGSL}{LAYER_BIND_WGSL}{COUNT_WGSL}{COUNT_LAYERS_WGSL}{select}"), false)
 }
 
 /// NoTW's analysis of `layers` layers at once (analyze_layers.wgsl).

@@ -1,10 +1,10 @@
 //! `cull_hidden`, `edge_importance` (planar warped maps): the scene drawn into the DV-cropped
 //! map without the warp (occluders.wgsl, a plain shadow map, res x res), which the count map
 //! reads for `edge_importance`; for `cull_hidden` its depths are reduced to a pyramid of 2x2
-//! maxima (hzb.wgsl). subdiv.wgsl then leaves an edge unsplit
-//! when everything around it is nearer to the light than the edge: its bend cannot show. The
-//! decision is a function of the edge (both pieces on it agree: no cracks) and of the map (the
-//! same on every run), and an unsplit edge is still drawn, coarser, never dropped.
+//! maxima (hzb.wgsl). subdiv.wgsl then leaves an edge unsplit when everything around it is
+//! nearer to the light than the edge: its bend cannot show. The decision is a function of the
+//! edge (both pieces on it agree: no cracks) and of the map (the same on every run), and an
+//! unsplit edge is still drawn, coarser, never dropped.
 
 use super::{base_constants, compose, layout_at, WarpParams, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::scene_gpu::GpuScene;
