@@ -157,8 +157,8 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     if wrong > 1.05 || wrong >= 0.8 * cube_wrong {
         panic!("cube-notw {wrong:.3}% wrong on room (cube {cube_wrong:.3}%); {}", save_images("cube-notw-room", &v, &notw, &rt));
     }
-    // the faces' exact-depth fragments: each face's pieces subdivided again after the frame (the
-    // faces share one set of subdivision buffers), so the same count on every run
+    // the faces' exact-depth fragments: each face's pieces (one subdivision of all faces, listed
+    // by face) drawn again after the frame, so the same count on every run
     let again = lab.run(&v, &spec("cube-notw:res=128,window=64,edge_importance=0"), 1).unwrap();
     let frags = notw.report.counters["exact_depth_fragments"];
     assert!(
@@ -188,9 +188,12 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     assert_eq!(r["faces_rendered"], with_samples as f64);
     assert_eq!(r["subdiv_pieces_dropped"], 0.0, "subdivision ran out of capacity (holes in a face)");
     assert_eq!(r["warp_bytes"], 6.0 * 8.0 * 128.0 * 128.0);
-    // the faces share one set of subdivision buffers (at least 2^21 pieces + two queues of 2^20,
-    // 16 bytes each = 64 MiB): counted once, not six times
-    let set = ((1u64 << 21) * 16 + 2 * (1u64 << 20) * 16) as f64;
+    // one subdivision of all faces (at least 2^21 pieces + two queues of 2^20, 16 bytes each, and
+    // the faces' lists of finished pieces, 4 bytes a piece = 72 MiB): counted once, not six times
+    let set = ((1u64 << 21) * 16 + 2 * (1u64 << 20) * 16 + (1u64 << 21) * 4) as f64;
+    let pieces: f64 = faces.iter().filter_map(|f| r.get(&format!("subdiv_pieces_face_{f}"))).sum();
+    assert_eq!(pieces, r["subdiv_triangles_drawn"], "every piece drawn into one face");
+    assert!(pieces > 0.0);
     assert!(r["scratch_bytes"] >= set && r["scratch_bytes"] < 2.0 * set, "scratch {} bytes", r["scratch_bytes"]);
     // six warped maps (4 bytes a texel), six pairs of warps (8 w^2), 32 bytes of DV each
     assert_eq!(notw.report.shadow_data_bytes, 6 * (128 * 128 * 4 + 8 * 128 * 128 + 32));

@@ -426,7 +426,7 @@ const DEFAULT_STORAGE_BUFFERS: usize = 8;
 
 /// Shader folders (or files) and the registry techniques whose pipelines they are.
 const FOLDERS: &[(&str, &[&str])] =
-    &[("lt", &["lt", "ltt", "hybrid-pcf"]), ("warp", &["rtw", "notw", "notw-dv", "dpsm", "dpsm-notw", "cube-notw"]), ("sv", &["sv"])];
+    &[("lt", &["lt", "ltt", "hybrid-pcf"]), ("warp", &["rtw", "notw", "dpsm", "dpsm-notw", "cube-notw"]), ("sv", &["sv"])];
 
 #[test]
 fn techniques_declare_the_storage_buffers_they_need_beyond_the_default() {

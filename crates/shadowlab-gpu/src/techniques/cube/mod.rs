@@ -44,6 +44,9 @@ pub fn shaders() -> Vec<(&'static str, String)> {
         ("cube/eval_notw.wgsl (count maps)", count),
         ("warp/analyze_layers.wgsl (six faces)", analysis),
         ("cube/eval_notw.wgsl (evaluation)", eval_notw),
+        // six faces of 10 triangles each
+        ("warp/subdiv_layers.wgsl (six faces)", crate::techniques::warp::layered_subdivision_source(&[10, 20, 30, 40, 50, 60])),
+        ("warp/subdiv_scatter.wgsl (six faces)", crate::techniques::warp::layered_scatter_source(&[10, 20, 30, 40, 50, 60])),
     ]
 }
 
@@ -221,7 +224,7 @@ shadowlab_core::param_set! {
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "cube-notw",
     summary: "NoTW per cube face: each face's view samples get their own desired view, count map and row/column warps",
-    cost: "one pass each over the view for all faces' desired views, count maps and evaluation, one dispatch a step of notw's analysis for all faces; per face a subdivision and warped depth pass (none drawn on a face without view samples); 8 w^2 bytes of warps per face",
+    cost: "one pass each over the view for all faces' desired views, count maps and evaluation, one dispatch a step of notw's analysis for all faces, one subdivision of all faces' triangles (their pieces live at once); per face a warped depth pass (nothing drawn on a face without view samples); 8 w^2 bytes of warps per face",
     quality: "spreads the view samples over each face; faces with few samples gain little",
     source: "seed 002 chapter 5.3 (CubeSM w/ warping); seed 000 section 3",
     lights: &["point"],
@@ -307,15 +310,16 @@ impl Technique for CubeMap {
 }
 
 /// A frame of `cube-notw`: one pass each for every face's desired view and count map and one
-/// analysis dispatch a step (notw.rs `fit_warps`), each face's subdivision and warped depth
-/// pass, and one evaluation over every face; nothing read back during the frame.
+/// analysis dispatch a step (notw.rs `fit_warps`), one subdivision of every face's triangles,
+/// each face's warped depth pass (notw.rs `draw_maps`), and one evaluation over every face;
+/// nothing read back during the frame.
 impl Technique for CubeNotw {
     fn prepare(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         self.fit_warps(gpu, f, rec)
     }
 
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
-        self.each_face(gpu, f, rec, |w, gpu, fi, t| w.render(gpu, fi, t))
+        self.draw_maps(gpu, f, rec)
     }
 
     counted_evaluation!();

@@ -4,10 +4,12 @@
 //! textures (`warp::Layers`): one pass reduces every face's desired view from the view samples
 //! on it (the same face rule as `cube`, eval_notw.wgsl), one counts them into the faces' count
 //! maps (after each face's occluder map, `edge_importance`), one dispatch a step builds every
-//! face's row and column warps from its count map, each face's warped depth map is drawn, and
-//! one evaluation over the view reads each sample's face. Nothing is read back during the
-//! frame: a face without view samples keeps its warps and draws no pieces (its subdivision
-//! reads the count on the GPU), and the report reads the counts after the frame.
+//! face's row and column warps from its count map, one subdivision cuts every face's triangles
+//! (the faces' clipped triangles are one scene, a range a face: warp::LayerSubdivision), each
+//! face's warped depth map draws its pieces, and one evaluation over the view reads each
+//! sample's face. Nothing is read back during the frame: a face without view samples keeps its
+//! warps and draws no pieces (the subdivision reads the count on the GPU), and the report reads
+//! the counts after the frame.
 //! `warp::fit`'s spot frustum adds one texel of margin on each side, so biased samples next to
 //! an edge stay inside their face's map. Stored depth: as notw (post-projective per face).
 
@@ -20,7 +22,7 @@ use crate::frame::LightUniform;
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{FrameInputs, Technique, TechniqueReport};
-use crate::techniques::warp::{self, Knobs, LayerPasses, Layers, Warped};
+use crate::techniques::warp::{self, Knobs, LayerPasses, LayerSubdivision, Layers, Warped};
 use crate::{Gpu, GpuError};
 
 const EVAL_NOTW_WGSL: &str = include_str!("eval_notw.wgsl");
@@ -42,15 +44,18 @@ const FACE_IMAGES: &[&str] = &["count map before warping", "count map after warp
 
 struct Face {
     warped: Warped,
-    /// The scene's triangles clipped to this face (clip.rs).
-    scene: GpuScene,
     light: Light,
     light_buf: wgpu::Buffer,
 }
 
 pub struct CubeNotw {
     res: u32,
+    /// Every face's triangles clipped to its frustum (clip.rs), face f's below `ends[f]`.
+    scene: GpuScene,
+    ends: [u32; 6],
     faces: Vec<Face>,
+    /// Every face's subdivision (none with `subdiv=0`: each face draws its triangles).
+    subdivision: Option<LayerSubdivision>,
     /// The faces' warps, maps, occluder maps, DV bounds, count maps and counts, a layer each.
     layers: Layers,
     /// The desired views, the count maps, the warps and the evaluation of every face.
@@ -69,33 +74,28 @@ impl CubeNotw {
         // texels outside the map's square (fit adds one texel of margin)
         let far = scene.bounds.corners().iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
         let near = (far * 1e-3).max(1e-4);
-        let scenes = clip::face_scenes(gpu, scene, position, 2.0 * near, 1.0 + 8.0 / res as f32);
-        // the faces render one after another, so they share one set of subdivision buffers
-        // (warp::SubdivScratch): the face with the most triangles is built first and lends its
-        // set, large enough for all (about 330 MB less than six sets)
-        let mut order: Vec<usize> = (0..6).collect();
-        order.sort_by_key(|&f| std::cmp::Reverse(scenes[f].triangle_count));
-        let mut scenes: Vec<Option<GpuScene>> = scenes.into_iter().map(Some).collect();
-        let mut built: Vec<Option<Face>> = (0..6).map(|_| None).collect();
-        let mut shared = None;
-        let layers = Layers::new(gpu, "cube-notw", &knobs, 6, true);
-        for f in order {
-            let face_scene = scenes[f].take().expect("each face once");
+        let (faces_scene, ends) = clip::faces_scene(gpu, scene, position, 2.0 * near, 1.0 + 8.0 / res as f32);
+        let subdivides = knobs.subdiv > 0.0;
+        let layers = Layers::new(gpu, "cube-notw", &knobs, 6, true, subdivides);
+        let mut faces = Vec::with_capacity(6);
+        for (f, face) in FACES.iter().enumerate() {
             // one face = a spot light along the axis whose fitted frustum is the face's square
-            let light = Light::Spot { position, direction: FACES[f].n, cone_deg: 45.0 };
-            let mut warped = Warped::new_layer(gpu, &face_scene, &knobs, &light, shared.as_ref(), &layers, f as u32)?;
-            shared.get_or_insert_with(|| warped.subdiv_scratch());
-            built[f] = Some(Face {
-                warped,
-                scene: face_scene,
-                light,
-                light_buf: gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps)),
-            });
+            let light = Light::Spot { position, direction: face.n, cone_deg: 45.0 };
+            let mut warped = Warped::new_layer(gpu, &faces_scene, &knobs, &light, None, &layers, f as u32)?;
+            warped.draw_triangles(if f == 0 { 0 } else { ends[f - 1] }..ends[f]);
+            let light_buf = gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps));
+            faces.push(Face { warped, light, light_buf });
         }
-        let faces: Vec<Face> = built.into_iter().map(|f| f.expect("all six built")).collect();
         let maps: Vec<&Warped> = faces.iter().map(|f| &f.warped).collect();
+        let subdivision =
+            subdivides.then(|| LayerSubdivision::new(gpu, "cube-notw", &knobs, &layers, &maps, &faces_scene, &ends)).transpose()?;
         let passes = LayerPasses::new(gpu, "cube-notw", &layers, &maps, FACES_WGSL, EVAL_NOTW_WGSL);
-        Ok(CubeNotw { res, faces, layers, passes })
+        if let Some(s) = &subdivision {
+            for (f, face) in faces.iter_mut().enumerate() {
+                face.warped.draw_owner_pieces(s.draw(f));
+            }
+        }
+        Ok(CubeNotw { res, scene: faces_scene, ends, faces, subdivision, layers, passes })
     }
 
     /// View samples per face of the last frame (+x, -x, +y, -y, +z, -z): the sixth words of
@@ -124,7 +124,7 @@ impl CubeNotw {
         let mut result = Ok(());
         for face in self.faces.iter_mut() {
             let fi = FrameInputs {
-                scene: &face.scene,
+                scene: &self.scene,
                 gbuffer: f.gbuffer,
                 light: face.light,
                 camera: f.camera,
@@ -156,6 +156,21 @@ impl CubeNotw {
         Ok(())
     }
 
+    /// Every face's warped depth map (stage `shadow_map`), after one subdivision of all faces
+    /// (stage `subdivide`; with `cull_hidden` after each face's occluder map).
+    pub(super) fn draw_maps(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        if self.subdivision.is_some() {
+            self.each_face(gpu, f, rec, |w, gpu, fi, rec| {
+                w.draw_hidden_occluders(gpu, fi, rec);
+                Ok(())
+            })?;
+        }
+        if let Some(s) = &self.subdivision {
+            s.record(gpu, rec, &self.scene.group);
+        }
+        self.each_face(gpu, f, rec, |w, gpu, fi, rec| w.render(gpu, fi, rec))
+    }
+
     /// The evaluation of every face in one pass (`final_pass`); with `counting` the lab's
     /// analysis variant (each face's samples per warped texel, in its slice of the counts).
     pub(super) fn eval_pass(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, counting: bool) -> Result<(), GpuError> {
@@ -163,18 +178,21 @@ impl CubeNotw {
         Ok(())
     }
 
-    /// The faces' reports summed (memory, subdivision counters) or named per face (samples,
-    /// clipped triangles, sampling fractions, pictures), sampling over the six faces.
+    /// The faces' reports summed (memory, exact-depth fragments) or named per face (samples,
+    /// clipped triangles, pieces, sampling fractions, pictures), the subdivision's counters over
+    /// all faces, sampling over the six faces.
     pub(super) fn face_report(&mut self, gpu: &Gpu) -> TechniqueReport {
         let n = (self.res * self.res) as usize;
         let mut r = TechniqueReport::default();
+        let pieces = self.subdivision.as_ref().map(|s| s.report(gpu, 6 * n, &mut r));
         let mut after = Vec::with_capacity(6 * n);
         let mut active = 0;
         let samples = self.face_samples(gpu);
         for (i, face) in self.faces.iter_mut().enumerate() {
             let name = FACES[i].name;
             r.counters.insert(format!("view_samples_face_{name}"), samples[i] as f64);
-            r.counters.insert(format!("clipped_triangles_face_{name}"), face.scene.triangle_count as f64);
+            let start = if i == 0 { 0 } else { self.ends[i - 1] };
+            r.counters.insert(format!("clipped_triangles_face_{name}"), (self.ends[i] - start) as f64);
             if samples[i] == 0 {
                 // no samples: no pieces drawn this frame, nothing to report but its memory
                 after.extend(std::iter::repeat_n(0, n));
@@ -182,6 +200,10 @@ impl CubeNotw {
                 continue;
             }
             active += 1;
+            if let Some(p) = &pieces {
+                // where the pieces go
+                r.counters.insert(format!("subdiv_pieces_face_{name}"), p[i] as f64);
+            }
             let fr = face.warped.report(gpu);
             r.shadow_data_bytes += fr.shadow_data_bytes;
             r.degraded.extend(fr.degraded.iter().map(|d| format!("face {name}: {d}")));
@@ -191,20 +213,6 @@ impl CubeNotw {
                     r.counters.insert(k, v);
                 } else if k == "exact_depth_fragments" {
                     *r.counters.entry(k).or_default() += v;
-                } else if k.starts_with("subdiv_") {
-                    // pieces drawn, dropped (holes: subdivision capacity) and queue-full finishes;
-                    // the pieces per face too (where the cost goes)
-                    if k == "subdiv_triangles_drawn" {
-                        r.counters.insert(format!("subdiv_pieces_face_{name}"), v);
-                    }
-                    let total = r.counters.entry(k.clone()).or_default();
-                    match k.as_str() {
-                        // a ratio: over the six faces below
-                        "subdiv_pieces_per_texel" => {}
-                        // the deepest first cut of any face (0: none)
-                        "subdiv_cut_level" => *total = total.max(v),
-                        _ => *total += v,
-                    }
                 } else if k.ends_with("fraction") || k.ends_with("warp") {
                     r.counters.insert(format!("{k}_face_{name}"), v);
                 }
@@ -214,16 +222,12 @@ impl CubeNotw {
             }
         }
         r.counters.insert("faces_rendered".into(), active as f64);
-        // pieces per texel of the six faces (until 2026-12-07 the sum of the faces' ratios:
-        // pieces per texel of one face, 6x this)
-        if let Some(&pieces) = r.counters.get("subdiv_triangles_drawn") {
-            r.counters.insert("subdiv_pieces_per_texel".into(), pieces / (6 * n) as f64);
-        }
         // the faces' exact-depth fragments (each one inversion of its warp), per texel of the six
         let frags = *r.counters.entry("exact_depth_fragments".into()).or_default();
         r.counters.insert("exact_depth_fragments_per_texel".into(), frags / (6 * n) as f64);
-        // every face's buffers, rendered this frame or not (the subdivision set once: shared)
-        r.counters.insert("scratch_bytes".into(), self.faces.iter().map(|f| f.warped.scratch_bytes()).sum::<u64>() as f64);
+        // every face's buffers, rendered this frame or not, and the subdivision's
+        let faces: u64 = self.faces.iter().map(|f| f.warped.scratch_bytes()).sum();
+        r.counters.insert("scratch_bytes".into(), (faces + self.subdivision.as_ref().map_or(0, |s| s.bytes())) as f64);
         r.counters.insert("warp_bytes_per_face".into(), 8.0 * n as f64);
         r.counters.insert("warp_bytes".into(), 6.0 * 8.0 * n as f64);
         r.counters.insert("shadow_map_texels".into(), 6.0 * n as f64);

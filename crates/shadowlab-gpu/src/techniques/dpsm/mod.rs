@@ -245,7 +245,7 @@ impl Dpsm {
             .ok_or_else(|| GpuError::Invalid(format!("{name}: light position {position} or scene bounds not usable")))?;
         let labels: [&'static str; 2] = if warped { ["dpsm-notw.front", "dpsm-notw.back"] } else { ["dpsm.front", "dpsm.back"] };
         // dpsm-notw: both desired views, count maps and warps made together (dpsm crops none)
-        let layers = Layers::new(gpu, name, k, 2, warped);
+        let layers = Layers::new(gpu, name, k, 2, warped, false);
         let make = |i: usize| {
             let h = Hemisphere::BOTH[i];
             let proj = Projection::Paraboloid { view: dp.view(h), hemisphere: h };

@@ -103,7 +103,8 @@ impl Warped {
     pub fn draw_occluders(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         if let (Some(o), true) = (&self.occluders, self.params.edge_importance > 0) {
             let depth_group = self.depth_group(gpu);
-            rec.stage(&format!("{}.occluders", self.name()), |enc| o.record(gpu, enc, &depth_group, f.scene));
+            let triangles = self.triangles(f.scene);
+            rec.stage(&format!("{}.occluders", self.name()), |enc| o.record(gpu, enc, &depth_group, f.scene, triangles));
         }
     }
 

@@ -81,10 +81,18 @@ impl Warped {
         name: &'static str,
         target: Option<(&Layers, u32)>,
     ) -> Result<Warped, GpuError> {
-        let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size)?;
-        let resources = Resources::new(gpu, &plan, target);
+        let listed = target.filter(|(l, _)| l.owner_subdivides).map(|(l, _)| l.texels());
+        let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size, listed)?;
+        // the map's own subdivision (else its owner's, LayerSubdivision)
+        let own_subdiv = plan.subdiv && !target.is_some_and(|(l, _)| l.owner_subdivides);
+        let resources = Resources::new(gpu, &plan, target, own_subdiv);
         let by_owner = target.is_some_and(|(l, _)| l.owner_reads_view);
-        let pipelines = Pipelines::new(gpu, scene, &plan, target.map(|(l, i)| (&l.occluders, i)), by_owner);
+        let occluders = target.map(|(l, i)| occluders::Target {
+            depth: &l.occluders,
+            layer: i,
+            hzb: l.hzb.as_ref().map(|b| (b, i as u64 * l.hzb_stride)),
+        });
+        let pipelines = Pipelines::new(gpu, scene, &plan, occluders, by_owner, own_subdiv);
         let scene =
             depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None, counting: Default::default() };
         Ok(Warped::assemble(plan, resources, pipelines, scene))
@@ -127,6 +135,8 @@ impl Warped {
             queues: r.queues,
             owns_subdiv: true,
             shares_subdiv: false,
+            owner_draw: None,
+            range: None,
             dispatch: r.dispatch,
             level_uniforms: r.level_uniforms,
             prefix: p.prefix,
@@ -163,10 +173,12 @@ struct Plan {
 impl Plan {
     /// `k` for `proj` over `tris` triangles, on a device whose storage bindings hold at most
     /// `max_binding` bytes. Errors: subdivision queues beyond that limit.
-    fn new(k: &Knobs, proj: Projection, name: &'static str, tris: u32, max_binding: u64) -> Result<Plan, GpuError> {
+    /// `listed`: subdivided by its owner with other maps of these texels in all (the capacity of
+    /// that subdivision).
+    fn new(k: &Knobs, proj: Projection, name: &'static str, tris: u32, max_binding: u64, listed: Option<u64>) -> Result<Plan, GpuError> {
         let base = BaseProjection::of(proj, k.res);
         assert_eq!(k.paraboloid, base.kind != 0, "{name}: knobs made for another projection");
-        let (subdiv, extra, queue) = subdivision_capacity(k, name, tris, max_binding)?;
+        let (subdiv, extra, queue) = subdivision_capacity(k, name, tris, max_binding, listed)?;
         let params = uniform(k, &base, tris, extra);
         let occluders = k.cull_hidden || k.edge_importance > 0;
         Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, occluders })
@@ -199,18 +211,29 @@ impl BaseProjection {
 }
 
 /// (on, extra pieces, queue entries) of the subdivision of `tris` triangles within the device's
-/// storage binding limit; an error when the queues cannot hold the triangles.
-fn subdivision_capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64) -> Result<(bool, u32, u32), GpuError> {
+/// storage binding limit; an error when the queues cannot hold the triangles. `listed`: the
+/// subdivision of several maps' `texels` texels at once ([`super::LayerSubdivision`]), whose
+/// finished pieces are also listed by map (4 bytes more each).
+pub(super) fn subdivision_capacity(
+    k: &Knobs,
+    name: &str,
+    tris: u32,
+    max_binding: u64,
+    listed: Option<u64>,
+) -> Result<(bool, u32, u32), GpuError> {
     let limit = max_binding / 16;
     let on = k.subdiv > 0.0;
-    let auto = (8 * tris as u64).max(1 << 21);
+    // one map: 8 pieces a texel of a 512 map; several at once: 3 a texel of all (the most
+    // measured: 2.6, cube-notw on sponza-peer), as their own subdivisions made them
+    let auto = (8 * tris as u64).max(1 << 21).max(3 * listed.unwrap_or(0));
     let wanted = if k.subdiv_capacity > 0 { k.subdiv_capacity as u64 } else { auto };
     // an asked-for capacity is given or refused; the automatic one takes what the device holds
-    let most = limit.saturating_sub(tris as u64);
+    let piece = 16 + 4 * listed.is_some() as u64;
+    let most = max_binding.saturating_sub(16 * tris as u64) / piece;
     if on && k.subdiv_capacity > 0 && wanted > most {
         return Err(GpuError::Invalid(format!(
-            "{name}: subdiv_capacity={wanted} needs {:.1} MiB of pieces (16 bytes each), over this device's max_storage_buffer_binding_size of {:.1} MiB: at most {most} here",
-            (wanted * 16) as f64 / (1u64 << 20) as f64,
+            "{name}: subdiv_capacity={wanted} needs {:.1} MiB of pieces ({piece} bytes each), over this device's max_storage_buffer_binding_size of {:.1} MiB: at most {most} here",
+            (wanted * piece) as f64 / (1u64 << 20) as f64,
             max_binding as f64 / (1u64 << 20) as f64
         )));
     }
@@ -305,8 +328,8 @@ struct Resources {
 impl Resources {
     /// The plan's resources; with `target` its warps, map, DV bounds and counts (and the count
     /// map and analysis scratch where the owner analyses) are that layer of shared ones
-    /// ([`Layers`]).
-    fn new(gpu: &Gpu, plan: &Plan, target: Option<(&Layers, u32)>) -> Resources {
+    /// ([`Layers`]); without `own_subdiv` no subdivision buffers (a word each).
+    fn new(gpu: &Gpu, plan: &Plan, target: Option<(&Layers, u32)>, own_subdiv: bool) -> Resources {
         let (name, res, queue) = (plan.name, plan.res, plan.queue);
         let n = res as u64 * res as u64;
         let [wx, wy] = plan.warp_sizes();
@@ -361,29 +384,14 @@ impl Resources {
             work_offset,
             fwork,
             fwork_offset,
-            pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * plan.subdiv as u64),
-            queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16)),
-            counters: gpu.buffer(&wgpu::BufferDescriptor {
-                label: Some(&format!("{name}.counters")),
-                size: 1048 * 4,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::INDIRECT
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            level_uniforms: (1..=levels)
-                .map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue]))
-                .collect(),
+            pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * own_subdiv as u64),
+            queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16 * own_subdiv as u64)),
+            counters: subdiv::counters_buffer(gpu, &format!("{name}.counters"), 0),
+            level_uniforms: subdiv::level_uniforms(gpu, name, levels, queue),
             uniform: gpu.uniform(&format!("{name}.params"), &plan.params),
             dv,
             counts,
-            dispatch: gpu.buffer(&wgpu::BufferDescriptor {
-                label: Some(&format!("{name}.dispatch")),
-                size: 12,
-                usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
+            dispatch: subdiv::dispatch_buffer(gpu, &format!("{name}.dispatch")),
         }
     }
 }
@@ -395,8 +403,8 @@ struct Pipelines {
     lookup_layout: wgpu::BindGroupLayout,
     depth_pipeline: wgpu::RenderPipeline,
     occluders: Option<occluders::Occluders>,
-    split_layout: wgpu::BindGroupLayout,
-    split: [wgpu::ComputePipeline; 4],
+    split_layout: Option<wgpu::BindGroupLayout>,
+    split: Option<[wgpu::ComputePipeline; 4]>,
     eval_layout: wgpu::BindGroupLayout,
     eval: EvalPipelines,
     sampler: wgpu::Sampler,
@@ -404,15 +412,16 @@ struct Pipelines {
 }
 
 impl Pipelines {
-    /// `occluders`: the array texture and layer the occluder map draws into (else its own);
-    /// `by_owner`: the map's analysis is its owner's (no analysis pipelines).
-    fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan, occluders: Option<(&wgpu::Texture, u32)>, by_owner: bool) -> Pipelines {
+    /// `occluders`: where the occluder map (and pyramid) draws (else its own); `by_owner`: the
+    /// map's analysis is its owner's (no analysis pipelines); `own_subdiv`: the map subdivides
+    /// (else no subdivision pipelines).
+    fn new(gpu: &Gpu, scene: &GpuScene, plan: &Plan, occluders: Option<occluders::Target>, by_owner: bool, own_subdiv: bool) -> Pipelines {
         let name = plan.name;
         let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant, &plan.params, !by_owner);
         let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, &plan.params);
         let occluders =
             plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &plan.params, &lookup_layout, scene, occluders));
-        let (split_layout, split) = subdiv::pipelines(gpu, name, scene, &plan.params);
+        let (split_layout, split) = own_subdiv.then(|| subdiv::pipelines(gpu, name, scene, &plan.params)).unzip();
         let (eval_layout, eval) = eval::pipelines(gpu, name, &plan.params);
         let sampler = eval::sampler(gpu);
         let prefix = PrefixSum::new(gpu);

@@ -21,7 +21,7 @@ fn count_layers(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    enter_layer(s.p);
+    use_layer(layer_of(s.p));
     let u = map_coords(s.p, dv_rect());
     if !inside(u) {
         return;

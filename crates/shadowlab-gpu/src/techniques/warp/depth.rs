@@ -4,6 +4,8 @@
 //! warp's preimage of the fragment (depth_exact.wgsl). Its lookup bindings (the uniform, the DV
 //! bounds, the warps) are shared with the occluder and subdivision passes.
 
+use std::ops::Range;
+
 use super::{base_constants, compose, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -85,11 +87,11 @@ pub(super) fn counting_pipeline(
 }
 
 /// What a pass needs of the scene after the frame: its bind group layout and cut-outs, and the
-/// last frame's group and triangle count (set by `render`).
+/// last frame's group and triangles drawn (set by `render`).
 pub(crate) struct SceneBinding {
     pub layout: wgpu::BindGroupLayout,
     pub cutouts: bool,
-    pub last: Option<(wgpu::BindGroup, u32)>,
+    pub last: Option<(wgpu::BindGroup, Range<u32>)>,
     /// The report's fragment count: its pipeline, query set and resolve buffer, made on the
     /// first report and kept (the viewer reports after every evaluation).
     pub counting: std::sync::OnceLock<(wgpu::RenderPipeline, wgpu::QuerySet, wgpu::Buffer)>,
@@ -127,19 +129,28 @@ impl Warped {
         rec.stage(&format!("{name}.shadow_map"), |enc| {
             let mut pass = raster::begin_pass(enc, &format!("{name}.shadow_map"), &[], &self.views[2]);
             pass.set_pipeline(&self.depth_pipeline);
-            self.draw_pieces(&mut pass, depth_group, &f.scene.group, f.scene.triangle_count);
+            self.draw_pieces(&mut pass, depth_group, &f.scene.group, self.triangles(f.scene));
         });
-        self.scene.last = Some((f.scene.group.clone(), f.scene.triangle_count));
+        self.scene.last = Some((f.scene.group.clone(), self.triangles(f.scene)));
     }
 
-    /// The map's draw after its pipeline is set: the pieces (indirect) or the scene.
-    fn draw_pieces(&self, pass: &mut wgpu::RenderPass, depth_group: &wgpu::BindGroup, scene_group: &wgpu::BindGroup, triangles: u32) {
+    /// The map's draw after its pipeline is set: the pieces (indirect: its own, or its share of
+    /// its owner's) or the scene.
+    fn draw_pieces(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        depth_group: &wgpu::BindGroup,
+        scene_group: &wgpu::BindGroup,
+        triangles: Range<u32>,
+    ) {
         pass.set_bind_group(0, depth_group, &[]);
         pass.set_bind_group(1, scene_group, &[]);
-        if self.params.subdiv > 0.0 {
+        if let Some(d) = &self.owner_draw {
+            d.draw(pass);
+        } else if self.params.subdiv > 0.0 {
             pass.draw_indirect(&self.counters, 16);
         } else {
-            pass.draw(0..triangles * 3, 0..1);
+            pass.draw(triangles.start * 3..triangles.end * 3, 0..1);
         }
     }
 
@@ -147,8 +158,8 @@ impl Warped {
     /// warp; discarded ones, behind a paraboloid's split plane or cut out, not counted): its
     /// draw again, with the depth test off, under an occlusion query (the map is kept).
     /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame. A map whose
-    /// subdivision buffers are shared (cube-notw's faces, dpsm's hemispheres: after the frame
-    /// they hold another map's pieces) subdivides again first.
+    /// subdivision buffers are shared (dpsm's hemispheres: after the frame they hold another
+    /// map's pieces) subdivides again first; `cube-notw`'s faces keep theirs listed.
     pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
         let (scene_group, triangles) = self.scene.last.as_ref()?;
         if self.params.exact_depth == 0 {
@@ -191,7 +202,7 @@ impl Warped {
             });
             pass.set_pipeline(pipeline);
             pass.begin_occlusion_query(0);
-            self.draw_pieces(&mut pass, &depth_group, scene_group, *triangles);
+            self.draw_pieces(&mut pass, &depth_group, scene_group, triangles.clone());
             pass.end_occlusion_query();
         }
         enc.resolve_query_set(set, 0..1, resolve, 0);

@@ -55,6 +55,18 @@ fn bary_pos(tri: u32, b: vec2<f32>) -> vec3<f32> {
     return v0 + (vertices[3u * tri + 1u].pos - v0) * b.x + (vertices[3u * tri + 2u].pos - v0) * b.y;
 }
 
+// Piece i of the subdivision: its slot, or past the slots (the triangles' and the pieces they
+// may add) entry i - slots of the lists of a layered subdivision (subdiv_scatter.wgsl), four a
+// slot.
+fn piece_at(i: u32) -> vec4<u32> {
+    let slots = wp.triangles + wp.extra_capacity;
+    if i < slots {
+        return pieces[i];
+    }
+    let k = i - slots;
+    return pieces[pieces[slots + k / 4u][k % 4u]];
+}
+
 // Corner c of a subdivision piece (triangle, three unorm16x2 barycentrics; subdiv.wgsl).
 fn piece_vertex(p: vec4<u32>, c: u32) -> Vertex {
     let b = unpack2x16unorm(array<u32, 3>(p.y, p.z, p.w)[c]);
@@ -94,7 +106,7 @@ fn depth_vertex(vi: u32) -> VsOut {
     var v: Vertex;
     var piece = vec4<u32>(vi / 3u, 0u, 0xffffu, 0xffff0000u);
     if SUBDIVIDED {
-        piece = pieces[vi / 3u];
+        piece = piece_at(vi / 3u);
         v = piece_vertex(piece, vi % 3u);
     } else {
         v = vertices[vi];

@@ -5,28 +5,11 @@
 // `const LAYERS: u32`, `fn layer_of(p: vec3<f32>) -> u32` and `fn light_axis() -> vec3<f32>`
 // (a perspective layer's axis, read while `layer` is set).
 
-// (The uniforms and DV bounds, bindings 6-7, and the sample's layer: layer_bind.wgsl.)
-@group(0) @binding(8) var warp_x: texture_2d_array<f32>;
-@group(0) @binding(9) var warp_y: texture_2d_array<f32>;
+// (The uniforms and DV bounds, bindings 6-7, and the sample's layer: layer_bind.wgsl; the warps,
+// bindings 8-9: layer_warps.wgsl.)
 @group(0) @binding(10) var shadow_map: texture_depth_2d_array;
 @group(0) @binding(11) var cmp: sampler_comparison;
 @group(0) @binding(12) var<storage, read_write> counts: array<atomic<u32>>;
-
-fn warp_x_size() -> vec2<u32> {
-    return textureDimensions(warp_x);
-}
-
-fn warp_y_size() -> vec2<u32> {
-    return textureDimensions(warp_y);
-}
-
-fn warp_x_at(k: u32, row: u32) -> f32 {
-    return textureLoad(warp_x, vec2<u32>(k, row), layer, 0).x;
-}
-
-fn warp_y_at(col: u32, k: u32) -> f32 {
-    return textureLoad(warp_y, vec2<u32>(col, k), layer, 0).x;
-}
 
 fn map_texel(t: vec2<i32>) -> f32 {
     return textureLoad(shadow_map, t, layer, 0);
@@ -47,6 +30,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_sample(id, &s) {
         return;
     }
-    enter_layer(s.p);
+    use_layer(layer_of(s.p));
     eval_sample(s);
 }

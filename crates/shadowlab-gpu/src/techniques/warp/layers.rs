@@ -4,7 +4,8 @@
 //! buffers, so that one pass over the view reduces every map's desired view (dv_layers.wgsl),
 //! one counts every map's view samples (count_layers.wgsl), one dispatch a step builds every
 //! map's NoTW warps (analyze_layers.wgsl) and one pass evaluates every map (eval_layers.wgsl),
-//! instead of a pass a map ([`LayerPasses`]).
+//! instead of a pass a map ([`LayerPasses`]); one subdivision can cut every map's triangles
+//! (subdiv_layers.rs, with the maps' pyramids here).
 
 use super::{
     base_constants, eval, Knobs, Variant, WarpParams, Warped, COUNT_WGSL, DV_WGSL, EVAL_FNS_WGSL, LOOKUP_FNS_WGSL, NOTW_WGSL, PARAMS_WGSL,
@@ -15,8 +16,10 @@ use crate::shaders::compose;
 use crate::technique::{compose_view, view_layout, EvalPipelines, FrameInputs};
 use crate::{binding, raster, Gpu};
 
-/// The layers' uniforms and DV bounds in a pass over the view (count and evaluation).
-const LAYER_BIND_WGSL: &str = include_str!("layer_bind.wgsl");
+/// The layers' uniforms and DV bounds in a pass over every layer (count, evaluation,
+/// subdivision), and their warps (evaluation, subdivision).
+pub(super) const LAYER_BIND_WGSL: &str = include_str!("layer_bind.wgsl");
+pub(super) const LAYER_WARPS_WGSL: &str = include_str!("layer_warps.wgsl");
 const EVAL_LAYERS_WGSL: &str = include_str!("eval_layers.wgsl");
 const DV_LAYERS_WGSL: &str = include_str!("dv_layers.wgsl");
 const COUNT_LAYERS_WGSL: &str = include_str!("count_layers.wgsl");
@@ -29,6 +32,8 @@ pub struct Layers {
     /// The maps' desired views are reduced and their count maps counted together
     /// ([`LayerPasses::reduce_dv`], [`LayerPasses::count`]), not by each map.
     pub(super) owner_reads_view: bool,
+    /// The maps are subdivided together ([`super::LayerSubdivision`]), not by each map.
+    pub(super) owner_subdivides: bool,
     pub(super) warp_x: wgpu::Texture,
     pub(super) warp_y: wgpu::Texture,
     pub(super) map: wgpu::Texture,
@@ -45,14 +50,20 @@ pub struct Layers {
     pub(super) fwork_stride: u64,
     /// The occluder maps (`edge_importance`, `cull_hidden`), or a 1x1 stand-in.
     pub(super) occluders: wgpu::Texture,
+    /// Subdivided by the owner with `cull_hidden`: the occluder maps' pyramids, `hzb_stride`
+    /// bytes apart (each its map's own otherwise).
+    pub(super) hzb: Option<wgpu::Buffer>,
+    pub(super) hzb_stride: u64,
 }
 
 impl Layers {
     /// `count` layers for maps made with `k`; with `owner_reads_view` the caller reduces every
     /// layer's desired view ([`LayerPasses::reduce_dv`]) and, for NoTW, counts every layer's
     /// view samples ([`LayerPasses::count`], after the occluder maps) and builds every layer's
-    /// warps ([`LayerPasses::analyze`]) before the maps' subdivision and depth passes.
-    pub fn new(gpu: &Gpu, name: &str, k: &Knobs, count: u32, owner_reads_view: bool) -> Layers {
+    /// warps ([`LayerPasses::analyze`]) before the maps' subdivision and depth passes; with
+    /// `owner_subdivides` the caller subdivides every map ([`super::LayerSubdivision`]) and the
+    /// maps draw its pieces.
+    pub fn new(gpu: &Gpu, name: &str, k: &Knobs, count: u32, owner_reads_view: bool, owner_subdivides: bool) -> Layers {
         let res = k.res;
         let align = gpu.limits.min_storage_buffer_offset_alignment as u64;
         let dv_stride = align.max(32);
@@ -63,10 +74,15 @@ impl Layers {
         let (work_stride, fwork_stride) = (aligned(work_words), aligned(fwork_words));
         let counted = owner_reads_view && k.variant == Variant::Notw;
         let occ = if k.cull_hidden || k.edge_importance > 0 { res } else { 1 };
+        let hzb_stride = aligned(super::occluders::pyramid_len(res));
+        let pyramids = owner_subdivides && k.cull_hidden && k.subdiv > 0.0;
         Layers {
             res,
             count,
             owner_reads_view,
+            owner_subdivides,
+            hzb: pyramids.then(|| gpu.storage(&format!("{name}.hzb"), hzb_stride * count as u64)),
+            hzb_stride,
             work: counted.then(|| gpu.storage(&format!("{name}.work"), work_stride * count as u64)),
             work_stride,
             fwork: counted.then(|| gpu.storage(&format!("{name}.fwork"), fwork_stride * count as u64)),
@@ -84,6 +100,11 @@ impl Layers {
     /// The layers' count.
     pub fn count(&self) -> u32 {
         self.count
+    }
+
+    /// Texels of all layers' maps.
+    pub fn texels(&self) -> u64 {
+        self.count as u64 * self.res as u64 * self.res as u64
     }
 
     /// Every layer's DV bounds (`dv_stride()` bytes apart).
@@ -106,7 +127,10 @@ pub(super) fn r32_array(gpu: &Gpu, label: &str, (w, h): (u32, u32), layers: u32)
 /// evaluation over layers, and `select`, which defines `LAYERS`, `layer_of` and `light_axis`
 /// (eval_layers.wgsl).
 pub fn layered_eval_source(prelude: &str, select: &str) -> String {
-    compose_view(&format!("{prelude}{PARAMS_WGSL}{LAYER_BIND_WGSL}{LOOKUP_FNS_WGSL}{EVAL_FNS_WGSL}{EVAL_LAYERS_WGSL}{select}"), false)
+    compose_view(
+        &format!("{prelude}{PARAMS_WGSL}{LAYER_BIND_WGSL}{LAYER_WARPS_WGSL}{LOOKUP_FNS_WGSL}{EVAL_FNS_WGSL}{EVAL_LAYERS_WGSL}{select}"),
+        false,
+    )
 }
 
 /// The desired views of a [`LayerPasses`] (dv_layers.wgsl), with the same `prelude` and

@@ -33,6 +33,7 @@ mod params;
 mod report;
 mod settings;
 mod subdiv;
+mod subdiv_layers;
 
 use eval::EVAL_FNS_WGSL;
 pub use knobs::Knobs;
@@ -40,6 +41,7 @@ pub use layers::{layered_analysis_source, layered_count_source, layered_dv_sourc
 pub use params::*;
 pub use settings::*;
 pub use subdiv::SubdivScratch;
+pub use subdiv_layers::{layered_scatter_source, layered_subdivision_source, LayerDraw, LayerSubdivision};
 
 use bytemuck::{Pod, Zeroable};
 use shadowlab_core::lightspace;
@@ -122,8 +124,10 @@ pub const DV_INFO: TechniqueInfo = TechniqueInfo {
     lights: LIGHTS,
     params: ParamTable::of::<DvSettings>(),
     stalls: "",
-    needs: "11 storage buffers per shader stage (WebGPU default: 8): the GPU subdivision (with the hidden-edge pyramid)",
-    storage_buffers: 11,
+    // no subdivision, so no subdivision pipelines (made since 2026-12-08 only by maps that
+    // subdivide): its passes bind at most 7
+    needs: "",
+    storage_buffers: 8,
     compare: &[""],
     shaders,
     create: |gpu, scene, p, light| Ok(Box::new(Warped::new(gpu, scene, &Knobs::dv(&DvSettings::from_values(p)), light)?)),
@@ -276,6 +280,11 @@ pub struct Warped {
     owns_subdiv: bool,
     /// Whether `pieces` is lent or borrowed: after the frame it holds the last map's pieces.
     shares_subdiv: bool,
+    /// Subdivided by its owner with the other layers ([`LayerSubdivision`]): its share, drawn
+    /// instead of its own pieces (its own subdivision buffers and pipelines are not made).
+    owner_draw: Option<LayerDraw>,
+    /// Its triangles in a scene of several maps' (`cube-notw`'s faces), else the whole scene.
+    range: Option<std::ops::Range<u32>>,
     /// Indirect dispatch args of the current level (copied from `counters`).
     dispatch: wgpu::Buffer,
     level_uniforms: Vec<wgpu::Buffer>,
@@ -289,9 +298,9 @@ pub struct Warped {
     /// `cull_hidden`, `edge_importance`: the occluder pass and its pyramid; else none (a
     /// stand-in is bound).
     occluders: Option<occluders::Occluders>,
-    split_layout: wgpu::BindGroupLayout,
-    /// split_root, split_args, split_level, draw_args.
-    split: [wgpu::ComputePipeline; 4],
+    /// split_root, split_args, split_level, draw_args (none where the owner subdivides).
+    split_layout: Option<wgpu::BindGroupLayout>,
+    split: Option<[wgpu::ComputePipeline; 4]>,
     eval_layout: wgpu::BindGroupLayout,
     /// The evaluation and its analysis variant.
     eval: crate::technique::EvalPipelines,
@@ -347,8 +356,8 @@ impl Technique for Warped {
 
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
         let depth_group = self.depth_group(gpu);
-        if self.params.subdiv > 0.0 {
-            self.subdivide(gpu, f, rec, &depth_group);
+        if self.params.subdiv > 0.0 && self.owner_draw.is_none() {
+            self.subdivide(gpu, f, rec);
         }
         self.draw_shadow_map(f, rec, &depth_group);
         Ok(())

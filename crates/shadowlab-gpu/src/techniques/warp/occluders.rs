@@ -6,6 +6,8 @@
 //! edge (both pieces on it agree: no cracks) and of the map (the same on every run), and an
 //! unsplit edge is still drawn, coarser, never dropped.
 
+use std::ops::Range;
+
 use super::{base_constants, compose, layout_at, WarpParams, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::scene_gpu::GpuScene;
 use crate::{binding, raster, Gpu};
@@ -34,8 +36,19 @@ pub(super) struct Occluders {
     pub hzb: Option<Pyramid>,
 }
 
+/// Where a map's occluder map and pyramid go when they are a layer of shared ones
+/// ([`super::Layers`]): `layer` of `depth`, and the pyramid at a byte offset of `hzb` (else its
+/// own buffer).
+pub(super) struct Target<'a> {
+    pub depth: &'a wgpu::Texture,
+    pub layer: u32,
+    pub hzb: Option<(&'a wgpu::Buffer, u64)>,
+}
+
 pub(super) struct Pyramid {
-    pub buffer: wgpu::Buffer,
+    /// Its own buffer, or its slice of a shared one (from `offset`).
+    buffer: wgpu::Buffer,
+    offset: u64,
     base: wgpu::ComputePipeline,
     reduce: wgpu::ComputePipeline,
     /// One bind group per level (the occluder map, the pyramid, the level's uniform (res, level)),
@@ -67,12 +80,12 @@ impl Occluders {
         p: &WarpParams,
         lookup: &wgpu::BindGroupLayout,
         scene: &GpuScene,
-        target: Option<(&wgpu::Texture, u32)>,
+        target: Option<Target>,
     ) -> Occluders {
         let label = format!("{name}.occluders");
         let constants = base_constants(p);
         let raster = raster::depth_pipeline_with(gpu, &label, &occluders_src(), &[lookup, &scene.layout], scene.has_cutouts, &constants);
-        let (depth, layer) = match target {
+        let (depth, layer) = match target.as_ref().map(|t| (t.depth, t.layer)) {
             Some((t, layer)) => {
                 assert!(
                     t.width() == res && t.height() == res && layer < t.depth_or_array_layers(),
@@ -88,7 +101,8 @@ impl Occluders {
             array_layer_count: Some(1),
             ..Default::default()
         });
-        let hzb = (p.cull_hidden > 0.5).then(|| Pyramid::new(gpu, name, res, &constants, &view));
+        let slice = target.and_then(|t| t.hzb);
+        let hzb = (p.cull_hidden > 0.5).then(|| Pyramid::new(gpu, name, res, &constants, &view, slice));
         Occluders { res, hzb, view, depth, layer, raster }
     }
 
@@ -104,18 +118,18 @@ impl Occluders {
 
     /// Bytes of the occluder map and its pyramid.
     pub fn bytes(&self) -> u64 {
-        4 * self.res as u64 * self.res as u64 + self.hzb.as_ref().map_or(0, |h| h.buffer.size())
+        4 * self.res as u64 * self.res as u64 + self.hzb.as_ref().map_or(0, |_| pyramid_len(self.res) * 4)
     }
 
-    /// The occluder pass and (`cull_hidden`) the pyramid; `lookup` is the depth pass's group
-    /// (the DV rectangle).
-    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, lookup: &wgpu::BindGroup, scene: &GpuScene) {
+    /// The occluder pass over `triangles` of `scene` and (`cull_hidden`) the pyramid; `lookup`
+    /// is the depth pass's group (the DV rectangle).
+    pub fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, lookup: &wgpu::BindGroup, scene: &GpuScene, triangles: Range<u32>) {
         {
             let mut pass = raster::begin_pass(enc, "occluders", &[], &self.view);
             pass.set_pipeline(&self.raster);
             pass.set_bind_group(0, lookup, &[]);
             pass.set_bind_group(1, &scene.group, &[]);
-            pass.draw(0..scene.triangle_count * 3, 0..1);
+            pass.draw(triangles.start * 3..triangles.end * 3, 0..1);
         }
         if let Some(h) = &self.hzb {
             for (l, group) in h.groups.iter().enumerate() {
@@ -128,7 +142,15 @@ impl Occluders {
 }
 
 impl Pyramid {
-    fn new(gpu: &Gpu, name: &str, res: u32, constants: &[(&str, f64)], view: &wgpu::TextureView) -> Pyramid {
+    /// The pyramid of the occluder map `view`, in `slice` (a buffer and byte offset) or its own.
+    fn new(
+        gpu: &Gpu,
+        name: &str,
+        res: u32,
+        constants: &[(&str, f64)],
+        view: &wgpu::TextureView,
+        slice: Option<(&wgpu::Buffer, u64)>,
+    ) -> Pyramid {
         let layout = layout_at(
             gpu,
             &format!("{name}.hzb"),
@@ -136,7 +158,8 @@ impl Pyramid {
             &[(0, binding::texture_depth()), (1, binding::storage(false)), (2, binding::uniform())],
         );
         let src = hzb_src();
-        let buffer = gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4);
+        let (buffer, offset) =
+            slice.map_or_else(|| (gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4), 0), |(b, o)| (b.clone(), o));
         let groups = (0..=top_level(res))
             .map(|l| {
                 let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);
@@ -145,7 +168,7 @@ impl Pyramid {
                     layout: &layout,
                     entries: &[
                         wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) },
-                        wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: Pyramid::binding_of(&buffer, offset, res) },
                         wgpu::BindGroupEntry { binding: 2, resource: u.as_entire_binding() },
                     ],
                 })
@@ -155,8 +178,23 @@ impl Pyramid {
             base: gpu.compute_pipeline_with(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout], constants),
             reduce: gpu.compute_pipeline_with(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout], constants),
             buffer,
+            offset,
             groups,
         }
+    }
+
+    fn binding_of(buffer: &wgpu::Buffer, offset: u64, res: u32) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer, offset, size: wgpu::BufferSize::new(pyramid_len(res) * 4) })
+    }
+
+    /// The last frame's pyramid (all levels, level 0 first).
+    pub fn read(&self, gpu: &Gpu, res: u32) -> Vec<f32> {
+        gpu.read_buffer_at(&self.buffer, self.offset, pyramid_len(res) as usize)
+    }
+
+    /// The pyramid as a pass binds it (its slice of a shared buffer).
+    pub fn binding(&self, res: u32) -> wgpu::BindingResource<'_> {
+        Pyramid::binding_of(&self.buffer, self.offset, res)
     }
 }
 

@@ -119,16 +119,18 @@ pub const SUBDIV_LEVELS: ParamDef = ParamDef::integer(
 );
 
 /// Pieces the subdivision may add beyond the scene's triangles; 0 = automatic: 8 per triangle,
-/// at least 2^21 (32 MiB), within the device's storage binding limit. When a level's pieces do
-/// not fit, that level draws its inputs unsplit (coarser, the same on every run) and the result
-/// is flagged as degraded. Low: bent edges on dense scenes; high: memory (16 bytes a piece).
+/// at least 2^21 (32 MiB), within the device's storage binding limit. `cube-notw` subdivides its
+/// six faces at once: the capacity is all faces' (automatic: also at least 3 a texel of the six
+/// faces; 20 bytes a piece with the faces' lists). When a level's pieces do not fit, that level
+/// draws its inputs unsplit (coarser, the same on every run) and the result is flagged as
+/// degraded. Low: bent edges on dense scenes; high: memory (16 bytes a piece).
 pub const DEFAULT_SUBDIV_CAPACITY: f64 = 0.0;
 pub const SUBDIV_CAPACITY: ParamDef = ParamDef::integer(
     "subdiv_capacity",
     DEFAULT_SUBDIV_CAPACITY,
     0.0,
     268435456.0,
-    "pieces subdivision may add beyond the scene's triangles (16 bytes each; at least one per triangle); 0 = 8 per triangle, at least 2^21, within the device limit; a level whose pieces do not fit is drawn unsplit (flagged degraded)",
+    "pieces subdivision may add beyond the scene's triangles (16 bytes each; at least one per triangle; cube-notw: all six faces', 20 bytes each); 0 = 8 per triangle, at least 2^21 (cube-notw: and 3 a texel of the six faces), within the device limit; a level whose pieces do not fit is drawn unsplit (flagged degraded)",
     "shadowlab (deterministic capacity, issue 18)",
 );
 

@@ -5,7 +5,7 @@
 use shadowlab_core::metrics::sampling_stats;
 use shadowlab_core::techniques::warp::Warp2D;
 
-use super::{Variant, Warped, DV_CROP_CLOSED};
+use super::{Variant, WarpParams, Warped, DV_CROP_CLOSED};
 use crate::technique::{NamedImage, TechniqueReport};
 use crate::techniques::pictures::{count_image, depth_image};
 use crate::Gpu;
@@ -47,7 +47,8 @@ pub(super) fn report(t: &Warped, gpu: &Gpu) -> TechniqueReport {
     c.insert("scratch_bytes".into(), t.scratch_bytes() as f64);
     let dv = t.read_dv_rect(gpu);
     c.insert("dv_area_fraction".into(), ((dv[2] - dv[0]) * (dv[3] - dv[1])) as f64);
-    if t.params.subdiv > 0.0 {
+    // (a map subdivided by its owner: the owner reports the subdivision)
+    if t.params.subdiv > 0.0 && t.owner_draw.is_none() {
         subdivision(t, gpu, &mut r);
     }
     if let Some(frags) = t.exact_depth_fragments(gpu) {
@@ -77,23 +78,27 @@ pub(super) fn report(t: &Warped, gpu: &Gpu) -> TechniqueReport {
 /// The subdivision's counters (pieces drawn, dropped, unsplit) and where its capacity degraded
 /// the map.
 fn subdivision(t: &Warped, gpu: &Gpu, r: &mut TechniqueReport) {
-    let n = (t.res * t.res) as usize;
-    let c = &mut r.counters;
     let a: Vec<u32> = gpu.read_buffer_as(&t.counters, 24);
-    let drawn = a[4] / 3;
+    subdivision_counters(&a, a[4] / 3, (t.res * t.res) as usize, &t.params, r);
+}
+
+/// The counters of a subdivision whose first 24 words (subdiv.wgsl) are `a`, which drew `drawn`
+/// pieces into `texels` texels, for maps of `p` (its levels, capacity and `cull_hidden`).
+pub(super) fn subdivision_counters(a: &[u32], drawn: u32, texels: usize, p: &WarpParams, r: &mut TechniqueReport) {
+    let c = &mut r.counters;
     c.insert("subdiv_triangles_drawn".into(), drawn as f64);
-    c.insert("subdiv_pieces_per_texel".into(), drawn as f64 / n as f64);
+    c.insert("subdiv_pieces_per_texel".into(), drawn as f64 / texels as f64);
     c.insert("subdiv_pieces_dropped".into(), a[1] as f64);
     c.insert("subdiv_queue_full_finishes".into(), a[2] as f64);
     c.insert("subdiv_cut_level".into(), a[19] as f64);
     c.insert("subdiv_pieces_unsplit".into(), a[20] as f64);
-    if t.params.cull_hidden > 0.5 {
+    if p.cull_hidden > 0.5 {
         c.insert("subdiv_hidden_edge_tests".into(), a[21] as f64);
     }
     if a[19] > 0 {
         r.degraded.push(format!(
             "subdivision level {} of {}: the pieces did not fit the piece capacity ({}); {} pieces were drawn unsplit (bent edges)",
-            a[19], t.params.subdiv_levels, t.params.extra_capacity, a[20]
+            a[19], p.subdiv_levels, p.extra_capacity, a[20]
         ));
     }
     if a[1] > 0 || a[2] > 0 {
@@ -156,7 +161,7 @@ impl Warped {
     pub fn read_occluders(&self, gpu: &Gpu) -> Option<(Vec<f32>, Vec<f32>)> {
         let o = self.occluders.as_ref()?;
         let (depth, layer) = o.depth();
-        let pyramid = o.hzb.as_ref().map_or(Vec::new(), |h| gpu.read_buffer_as(&h.buffer, (h.buffer.size() / 4) as usize));
+        let pyramid = o.hzb.as_ref().map_or(Vec::new(), |h| h.read(gpu, self.res));
         Some((bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(depth, 4, layer)), pyramid))
     }
 

@@ -2,20 +2,30 @@
 //! `subdiv` > 0): a root pass queues every triangle, each level splits the queued pieces whose
 //! warped edges bend more than `subdiv` texels into the other queue and finishes the rest, and
 //! `draw_args` turns the finished count into the depth pass's indirect draw. With `cull_hidden`
-//! the occluder map is drawn first (occluders.rs) and hidden edges stay unsplit.
+//! the occluder map is drawn first (occluders.rs) and hidden edges stay unsplit. This is one
+//! map's (subdiv_map.wgsl); subdiv_layers.rs runs the same passes over several maps at once.
 
 use super::depth::lookup_entries;
-use super::{base_constants, compose, layout_at, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, compose, layout_at, LayerDraw, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::flag;
 use crate::technique::FrameInputs;
 use crate::{binding, Gpu};
 
-const SUBDIV_WGSL: &str = include_str!("subdiv.wgsl");
+pub(super) const SUBDIV_WGSL: &str = include_str!("subdiv.wgsl");
+const SUBDIV_MAP_WGSL: &str = include_str!("subdiv_map.wgsl");
 
 pub(super) fn source() -> String {
-    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{SUBDIV_WGSL}"), true)
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{SUBDIV_WGSL}{SUBDIV_MAP_WGSL}"), true)
+}
+
+/// subdiv.wgsl's pipeline constants for `p`'s map over `triangles` triangles that may add
+/// `extra` pieces.
+pub(super) fn constants(p: &WarpParams, triangles: u32, extra: u32) -> Vec<(&'static str, f64)> {
+    let mut c = base_constants(p);
+    c.extend([("CULL_HIDDEN", flag(p.cull_hidden > 0.5)), ("TRIANGLES", triangles as f64), ("EXTRA_CAPACITY", extra as f64)]);
+    c
 }
 
 /// The subdivision layout (the lookup, the pieces, the counters, the two queues, the level's
@@ -31,8 +41,7 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams)
         &[look[0], look[1], look[2], look[3], (10, rw), (11, rw), (12, rw), (13, rw), (14, binding::uniform()), (15, ro)],
     );
     let src = source();
-    let mut constants = base_constants(p);
-    constants.push(("CULL_HIDDEN", flag(p.cull_hidden > 0.5)));
+    let constants = constants(p, p.triangles, p.extra_capacity);
     let pipelines = ["split_root", "split_args", "split_level", "draw_args"]
         .map(|e| gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout], &constants));
     (layout, pipelines)
@@ -40,7 +49,7 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams)
 
 /// The subdivision buffers of a warped map (finished pieces and the two level queues), its
 /// largest scratch: 66 MB at the minimum capacity of 2^21 pieces. Maps whose passes run one after
-/// another (`cube-notw`'s faces: each face subdivides and draws before the next starts) can share
+/// another (`dpsm`'s hemispheres: each subdivides and draws before the next starts) can share
 /// one set: `Warped::subdiv_scratch` lends it, `Warped::new_sharing` borrows it when it is large
 /// enough for the borrower's triangles (otherwise the borrower allocates its own).
 #[derive(Clone)]
@@ -67,40 +76,49 @@ impl Warped {
         }
     }
 
-    /// The `subdivide` stage (after the `occluders` stage when `cull_hidden` draws them here);
-    /// `depth_group` is the depth pass's group, which the occluder pass shares.
-    pub(super) fn subdivide(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder, depth_group: &wgpu::BindGroup) {
-        let name = self.name();
+    /// The `subdivide` stage (after the `occluders` stage when `cull_hidden` draws them here).
+    pub(super) fn subdivide(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
+        self.draw_hidden_occluders(gpu, f, rec);
+        rec.stage(&format!("{}.subdivide", self.name()), |enc| self.record_subdivision(gpu, enc, &f.scene.group));
+    }
+
+    /// `cull_hidden` without `edge_importance` (which draws it before the count map): the
+    /// occluder map and its pyramid, which the subdivision reads (stage `occluders`).
+    pub fn draw_hidden_occluders(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         if let (Some(o), true) = (&self.occluders, self.params.edge_importance == 0) {
-            rec.stage(&format!("{name}.occluders"), |enc| o.record(gpu, enc, depth_group, f.scene));
+            let depth_group = self.depth_group(gpu);
+            let triangles = self.triangles(f.scene);
+            rec.stage(&format!("{}.occluders", self.name()), |enc| o.record(gpu, enc, &depth_group, f.scene, triangles));
         }
-        rec.stage(&format!("{name}.subdivide"), |enc| self.record_subdivision(gpu, enc, &f.scene.group));
+    }
+
+    /// The triangles of `scene` this map draws: its range of a scene of several maps
+    /// ([`Warped::draw_triangles`]), else all.
+    pub(super) fn triangles(&self, scene: &GpuScene) -> std::ops::Range<u32> {
+        self.range.clone().unwrap_or(0..scene.triangle_count)
+    }
+
+    /// Draws only `range` of the scenes it is given (its own in a scene of several maps').
+    pub fn draw_triangles(&mut self, range: std::ops::Range<u32>) {
+        self.range = Some(range);
+    }
+
+    /// Draws its owner's pieces of its layer ([`super::LayerSubdivision::draw`]) instead of
+    /// subdividing.
+    pub fn draw_owner_pieces(&mut self, d: LayerDraw) {
+        assert!(self.split.is_none(), "{}: made to subdivide itself", self.name());
+        self.pieces = d.pieces.clone();
+        self.owns_subdiv = false;
+        self.owner_draw = Some(d);
     }
 
     /// The subdivision's passes over the scene of `scene_group` (the root, each level, the draw
     /// arguments), after this frame's warps and occluder map: the same pieces every time.
     pub(super) fn record_subdivision(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, scene_group: &wgpu::BindGroup) {
+        let split = self.split.as_ref().expect("a map that subdivides itself");
         let groups = self.level_groups(gpu);
-        let n = self.params.triangles.div_ceil(64);
-        enc.clear_buffer(&self.counters, 0, None);
-        let pass = |enc: &mut wgpu::CommandEncoder, g: &wgpu::BindGroup, p: usize, groups: Option<u32>| {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
-            pass.set_bind_group(1, scene_group, &[]);
-            pass.set_bind_group(0, g, &[]);
-            pass.set_pipeline(&self.split[p]);
-            match groups {
-                Some(n) => gpu.dispatch(&mut pass, [n.min(65535), n.div_ceil(65535), 1]),
-                None => gpu.dispatch_indirect(&mut pass, &self.dispatch, 0),
-            }
-        };
-        pass(enc, &groups[0], 0, Some(n));
-        for (l, g) in groups.iter().enumerate().skip(1) {
-            pass(enc, g, 1, Some(1));
-            // the input queue's group counts, out of the storage buffer into the indirect one
-            enc.copy_buffer_to_buffer(&self.counters, 32 + 16 * ((l as u64 + 1) % 2) + 4, &self.dispatch, 0, 12);
-            pass(enc, g, 2, None);
-        }
-        pass(enc, &groups[0], 3, Some(1));
+        let bufs = Buffers { counters: &self.counters, dispatch: &self.dispatch };
+        record_passes(gpu, enc, split, &groups, scene_group, bufs, self.params.triangles);
     }
 
     /// One group per level (0: the root): the depth pass's bindings, the counters, the level's
@@ -118,10 +136,78 @@ impl Warped {
                 e.push(wgpu::BindGroupEntry { binding: 13, resource: self.queues[1 - qi].as_entire_binding() });
                 let u = &self.level_uniforms[l.saturating_sub(1)];
                 e.push(wgpu::BindGroupEntry { binding: 14, resource: u.as_entire_binding() });
-                let hzb = self.occluders.as_ref().and_then(|o| o.hzb.as_ref()).map_or(&self.dv, |h| &h.buffer);
-                e.push(wgpu::BindGroupEntry { binding: 15, resource: hzb.as_entire_binding() });
-                self.groups.levels[l].entries(gpu, name, &self.split_layout, &e)
+                let hzb = self.occluders.as_ref().and_then(|o| o.hzb.as_ref()).map_or(self.dv.as_entire_binding(), |h| h.binding(self.res));
+                e.push(wgpu::BindGroupEntry { binding: 15, resource: hzb });
+                self.groups.levels[l].entries(gpu, name, self.split_layout.as_ref().expect("with the subdivision"), &e)
             })
             .collect()
     }
+}
+
+/// The counters and the indirect dispatch arguments of a subdivision's levels.
+#[derive(Clone, Copy)]
+pub(super) struct Buffers<'a> {
+    pub counters: &'a wgpu::Buffer,
+    pub dispatch: &'a wgpu::Buffer,
+}
+
+/// The subdivision's passes (split_root over `triangles`, then each level's split_args and
+/// indirect split_level, then draw_args) with `groups[l]` for level l (0: the root and the
+/// draw arguments), over the scene of `scene_group`.
+pub(super) fn record_passes(
+    gpu: &Gpu,
+    enc: &mut wgpu::CommandEncoder,
+    split: &[wgpu::ComputePipeline; 4],
+    groups: &[wgpu::BindGroup],
+    scene_group: &wgpu::BindGroup,
+    b: Buffers,
+    triangles: u32,
+) {
+    let n = triangles.div_ceil(64);
+    enc.clear_buffer(b.counters, 0, None);
+    let pass = |enc: &mut wgpu::CommandEncoder, g: &wgpu::BindGroup, p: usize, groups: Option<u32>| {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("subdivide"), timestamp_writes: None });
+        pass.set_bind_group(1, scene_group, &[]);
+        pass.set_bind_group(0, g, &[]);
+        pass.set_pipeline(&split[p]);
+        match groups {
+            Some(n) => gpu.dispatch(&mut pass, [n.min(65535), n.div_ceil(65535), 1]),
+            None => gpu.dispatch_indirect(&mut pass, b.dispatch, 0),
+        }
+    };
+    pass(enc, &groups[0], 0, Some(n));
+    for (l, g) in groups.iter().enumerate().skip(1) {
+        pass(enc, g, 1, Some(1));
+        // the input queue's group counts, out of the storage buffer into the indirect one
+        enc.copy_buffer_to_buffer(b.counters, 32 + 16 * ((l as u64 + 1) % 2) + 4, b.dispatch, 0, 12);
+        pass(enc, g, 2, None);
+    }
+    pass(enc, &groups[0], 3, Some(1));
+}
+
+/// A subdivision's counters (subdiv.wgsl's 1048 words and `extra` more), which the depth passes
+/// also read as indirect draw arguments.
+pub(super) fn counters_buffer(gpu: &Gpu, label: &str, extra: u64) -> wgpu::Buffer {
+    gpu.buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (1048 + extra) * 4,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+/// The indirect dispatch arguments of the running level (copied out of the counters).
+pub(super) fn dispatch_buffer(gpu: &Gpu, label: &str) -> wgpu::Buffer {
+    gpu.buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: 12,
+        usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// One uniform a level (subdiv.wgsl `Level`): the level, whether it is the last, its input
+/// queue and the queues' capacity.
+pub(super) fn level_uniforms(gpu: &Gpu, name: &str, levels: u32, queue: u32) -> Vec<wgpu::Buffer> {
+    (1..=levels).map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue])).collect()
 }

@@ -22,10 +22,18 @@
 // limit of the running level (pieces of triangles below it split), first level cut (0: none),
 // pieces finished unsplit, bent edges left unsplit as hidden (per test: an edge counts once
 // per piece on it), -, -], then per queue BUCKETS children and BUCKETS pieces by
-// bucket of triangle index.
+// bucket of triangle index (and over layers, subdiv_layers.wgsl's words after those).
+//
+// The composing file binds the map's lookup (bindings 6-9) and defines `enter_triangle` (the
+// map a triangle is drawn into: one map, or a layer of a warp::Layers), `hzb_base` and
+// `finished` (a finished piece stored), and the draw arguments: subdiv_map.wgsl (one map),
+// subdiv_layers.wgsl (every layer at once).
 
-// `cull_hidden`, fixed at pipeline creation (subdiv.rs; PARABOLOID and WARPED in params.wgsl).
+// Fixed at pipeline creation (subdiv.rs; PARABOLOID and WARPED in params.wgsl): `cull_hidden`,
+// the triangles subdivided (their pieces' slots come first) and the pieces they may add.
 override CULL_HIDDEN: bool;
+override TRIANGLES: u32;
+override EXTRA_CAPACITY: u32;
 
 struct Level {
     // x: level (1..), y: 1 on the last level, z: input queue (0 or 1), w: capacity per queue
@@ -33,7 +41,7 @@ struct Level {
 }
 
 @group(0) @binding(10) var<storage, read_write> pieces: array<vec4<u32>>;
-@group(0) @binding(11) var<storage, read_write> counters: array<atomic<u32>, 1048>;
+@group(0) @binding(11) var<storage, read_write> counters: array<atomic<u32>>;
 @group(0) @binding(12) var<storage, read_write> q_in: array<vec4<u32>>;
 @group(0) @binding(13) var<storage, read_write> q_out: array<vec4<u32>>;
 @group(0) @binding(14) var<uniform> lv: Level;
@@ -170,9 +178,9 @@ fn hidden(lo: vec2<f32>, hi: vec2<f32>, z: f32) -> bool {
     // 2^l > the extent in texels: the rectangle touches at most 2x2 texels of level l
     let l = 32u - countLeadingZeros(max(ib.x - ia.x, ib.y - ia.y));
     let side = hzb_side(res, l);
-    let o = hzb_offset(res, l);
     let pa = min(ia >> vec2<u32>(l), vec2<u32>(side - 1u));
     let pb = min(ib >> vec2<u32>(l), vec2<u32>(side - 1u));
+    let o = hzb_base() + hzb_offset(res, l);
     let m = max(max(hzb[o + pa.y * side + pa.x], hzb[o + pa.y * side + pb.x]), max(hzb[o + pb.y * side + pa.x], hzb[o + pb.y * side + pb.x]));
     return z > m + HIDDEN_EPS;
 }
@@ -249,11 +257,12 @@ fn split_mask(p: vec4<u32>) -> u32 {
 
 fn finish(p: vec4<u32>) {
     let i = atomicAdd(&counters[0], 1u);
-    if i >= wp.extra_capacity {
+    if i >= EXTRA_CAPACITY {
         atomicAdd(&counters[1], 1u);
         return;
     }
-    pieces[wp.triangles + i] = p;
+    pieces[TRIANGLES + i] = p;
+    finished();
 }
 
 // Queue entries carry their split mask above the triangle index.
@@ -281,7 +290,8 @@ fn children_of(mask: u32) -> u32 {
 const BUCKETS: u32 = 256u;
 
 fn bucket_of(tri: u32) -> u32 {
-    return tri / ((wp.triangles + BUCKETS - 1u) / BUCKETS);
+    // (at least 1: a scene without triangles still makes its pipelines)
+    return tri / max((TRIANGLES + BUCKETS - 1u) / BUCKETS, 1u);
 }
 
 fn enqueue(p: vec4<u32>, mask: u32, q: u32) {
@@ -326,7 +336,11 @@ const ROOT_CORNERS = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
 @compute @workgroup_size(64)
 fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
     let tri = (wg.y * 65535u + wg.x) * 64u + l;
-    if tri >= wp.triangles || no_samples() {
+    if tri >= TRIANGLES {
+        return;
+    }
+    enter_triangle(tri);
+    if no_samples() {
         // no view sample on the map (an empty cube face): nothing evaluates it, nothing is drawn
         return;
     }
@@ -399,13 +413,13 @@ fn split_args() {
     for (; k < BUCKETS; k++) {
         let kids = atomicLoad(&counters[inp + k]);
         let grow = kids - atomicLoad(&counters[inp + BUCKETS + k]);
-        if total + grow > wp.extra_capacity || (lv.v.y == 0u && queued + kids > lv.v.w) {
+        if total + grow > EXTRA_CAPACITY || (lv.v.y == 0u && queued + kids > lv.v.w) {
             break;
         }
         total += grow;
         queued += kids;
     }
-    let size = (wp.triangles + BUCKETS - 1u) / BUCKETS;
+    let size = (TRIANGLES + BUCKETS - 1u) / BUCKETS;
     atomicStore(&counters[18], select(k * size, 0xffffffffu, k == BUCKETS));
     if k < BUCKETS && atomicLoad(&counters[19]) == 0u {
         atomicStore(&counters[19], lv.v.x);
@@ -436,6 +450,7 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
     let queued = q_in[id.x];
     let mask = queued.x >> MASK_SHIFT;
     let p = vec4<u32>(queued.x & TRI_BITS, queued.y, queued.z, queued.w);
+    enter_triangle(p.x);
     if p.x >= atomicLoad(&counters[18]) {
         // this piece's children do not fit (its bucket is past the level's split limit): drawn unsplit
         atomicAdd(&counters[20], 1u);
@@ -500,16 +515,6 @@ fn split_level(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = 0u; i < count; i++) {
         place(vec4<u32>(t, kids[i]));
     }
-}
-
-@compute @workgroup_size(1)
-fn draw_args() {
-    let appended = min(atomicLoad(&counters[0]), wp.extra_capacity);
-    // a map without view samples draws nothing (split_root left its slots as they were)
-    atomicStore(&counters[4], select(3u * (wp.triangles + appended), 0u, no_samples()));
-    atomicStore(&counters[5], 1u);
-    atomicStore(&counters[6], 0u);
-    atomicStore(&counters[7], 0u);
 }
 
 // Pieces wider than this fraction of the cropped map split all edges (see interior_needs_split).
