@@ -200,6 +200,31 @@ fn cube_notw_spreads_the_samples_and_beats_cube_on_the_room_at_two_pixels_per_te
     assert!(notw.report.images.iter().any(|i| i.name.starts_with("face -y: count map after warping")));
 }
 
+/// `exact_tol` (issue 48, step 1): the faces' flat pieces (whose interpolated depth lies within
+/// the tolerance of the exact one) are listed apart and drawn without the exact-depth stage.
+/// The same pieces are drawn, fewer fragments invert the warp, and with every piece flat the
+/// map is the interpolated one.
+#[test]
+fn cube_notw_draws_its_flat_pieces_without_inverting_the_warp() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("room").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, ROOM_POINT, 256);
+    let run = |extra: &str| lab.run(&v, &spec(&format!("cube-notw:res=128,window=64{extra}")), 1).unwrap();
+    let (exact, some, all, plain) = (run(",exact_tol=0"), run(",exact_tol=4"), run(",exact_tol=64"), run(",exact_depth=false"));
+    let c = |r: &shadowlab_gpu::lab::Run, k: &str| r.report.counters[k];
+    for r in [&some, &all] {
+        assert_eq!(c(r, "subdiv_triangles_drawn"), c(&exact, "subdiv_triangles_drawn"), "the same pieces");
+    }
+    let inverted = [&exact, &some, &all].map(|r| c(r, "exact_depth_fragments"));
+    assert!(inverted[0] > inverted[1] && inverted[1] > inverted[2], "inversions {inverted:?}");
+    assert!(inverted[2] < 0.1 * inverted[0], "inversions {inverted:?}");
+    let same = agreement(&all.visibility, &plain.visibility, &v.mask);
+    if same < 99.9 {
+        panic!("every piece flat: {same:.3} % agree with the interpolated map; {}", save_images("cube-notw-flat", &v, &all, &plain));
+    }
+}
+
 #[test]
 fn cube_notw_lists_notws_parameters_with_twelve_defaults_of_its_own() {
     use shadowlab_gpu::techniques::{cube, warp};

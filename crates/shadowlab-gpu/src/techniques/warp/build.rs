@@ -144,6 +144,7 @@ impl Warped {
             analyze: p.analyze,
             lookup_layout: p.lookup_layout,
             depth_pipeline: p.depth_pipeline,
+            flat_pipeline: p.flat_pipeline,
             occluders: p.occluders,
             split_layout: p.split_layout,
             split: p.split,
@@ -178,7 +179,7 @@ impl Plan {
     fn new(k: &Knobs, proj: Projection, name: &'static str, tris: u32, max_binding: u64, listed: Option<u64>) -> Result<Plan, GpuError> {
         let base = BaseProjection::of(proj, k.res);
         assert_eq!(k.paraboloid, base.kind != 0, "{name}: knobs made for another projection");
-        let (subdiv, extra, queue) = subdivision_capacity(k, name, tris, max_binding, listed)?;
+        let (subdiv, extra, queue) = subdiv::capacity(k, name, tris, max_binding, listed)?;
         let params = uniform(k, &base, tris, extra);
         let occluders = k.cull_hidden || k.edge_importance > 0;
         Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, occluders })
@@ -208,48 +209,6 @@ impl BaseProjection {
         };
         BaseProjection { view_proj, texel, perspective, kind }
     }
-}
-
-/// (on, extra pieces, queue entries) of the subdivision of `tris` triangles within the device's
-/// storage binding limit; an error when the queues cannot hold the triangles. `listed`: the
-/// subdivision of several maps' `texels` texels at once ([`super::LayerSubdivision`]), whose
-/// finished pieces are also listed by map (4 bytes more each).
-pub(super) fn subdivision_capacity(
-    k: &Knobs,
-    name: &str,
-    tris: u32,
-    max_binding: u64,
-    listed: Option<u64>,
-) -> Result<(bool, u32, u32), GpuError> {
-    let limit = max_binding / 16;
-    let on = k.subdiv > 0.0;
-    // one map: 8 pieces a texel of a 512 map; several at once: 3 a texel of all (the most
-    // measured: 2.6, cube-notw on sponza-peer), as their own subdivisions made them
-    let auto = (8 * tris as u64).max(1 << 21).max(3 * listed.unwrap_or(0));
-    let wanted = if k.subdiv_capacity > 0 { k.subdiv_capacity as u64 } else { auto };
-    // an asked-for capacity is given or refused; the automatic one takes what the device holds
-    let piece = 16 + 4 * listed.is_some() as u64;
-    let most = max_binding.saturating_sub(16 * tris as u64) / piece;
-    if on && k.subdiv_capacity > 0 && wanted > most {
-        return Err(GpuError::Invalid(format!(
-            "{name}: subdiv_capacity={wanted} needs {:.1} MiB of pieces ({piece} bytes each), over this device's max_storage_buffer_binding_size of {:.1} MiB: at most {most} here",
-            (wanted * piece) as f64 / (1u64 << 20) as f64,
-            max_binding as f64 / (1u64 << 20) as f64
-        )));
-    }
-    // at least one per triangle: the root finishes up to one extra piece per triangle (the
-    // second half of a triangle cut by the near plane) before any level can check
-    let extra = if on { wanted.max(tris as u64).min(most) as u32 } else { 0 };
-    // the root queues up to two pieces per triangle (a triangle cut by the near plane); the
-    // triangle index keeps 3 bits free for the split mask
-    let queue = if on { (2 * tris as u64).max(1 << 20).min(limit) as u32 } else { 0 };
-    if on && (2 * tris as u64 > queue as u64 || tris >= 1 << 29) {
-        return Err(GpuError::Invalid(format!(
-            "{name}: {tris} triangles need subdivision queues of {} entries, over this device's storage binding limit",
-            2 * tris as u64
-        )));
-    }
-    Ok((on, extra, queue))
 }
 
 /// The uniform of the knobs over `base`, with the subdivision's triangles and extra pieces.
@@ -294,7 +253,7 @@ fn uniform(k: &Knobs, base: &BaseProjection, tris: u32, extra: u32) -> WarpParam
         tent: if k.tent { 1.0 } else { 0.0 },
         edge_importance: k.edge_importance,
         depth_split: k.depth_split,
-        pad1: 0,
+        exact_tol: k.exact_tol,
         pad2: 0,
     }
 }
@@ -402,6 +361,7 @@ struct Pipelines {
     analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
     lookup_layout: wgpu::BindGroupLayout,
     depth_pipeline: wgpu::RenderPipeline,
+    flat_pipeline: Option<wgpu::RenderPipeline>,
     occluders: Option<occluders::Occluders>,
     split_layout: Option<wgpu::BindGroupLayout>,
     split: Option<[wgpu::ComputePipeline; 4]>,
@@ -419,6 +379,10 @@ impl Pipelines {
         let name = plan.name;
         let (analyze_layout, analyze) = analyze::pipelines(gpu, name, plan.variant, &plan.params, !by_owner);
         let (lookup_layout, depth_pipeline) = depth::pipeline(gpu, name, scene, &plan.params);
+        // subdivided by the owner, whose lists hold the flat pieces apart (subdiv_layers.rs)
+        let flat = plan.subdiv && !own_subdiv && super::subdiv_layers::flat_split(&plan.params);
+        let flat_pipeline =
+            flat.then(|| depth::pipeline_in(gpu, name, scene, &WarpParams { exact_depth: 0, ..plan.params }, &lookup_layout));
         let occluders =
             plan.occluders.then(|| occluders::Occluders::new(gpu, name, plan.res, &plan.params, &lookup_layout, scene, occluders));
         let (split_layout, split) = own_subdiv.then(|| subdiv::pipelines(gpu, name, scene, &plan.params)).unzip();
@@ -430,6 +394,7 @@ impl Pipelines {
             analyze,
             lookup_layout,
             depth_pipeline,
+            flat_pipeline,
             occluders,
             split_layout,
             split,

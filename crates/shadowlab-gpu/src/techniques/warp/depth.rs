@@ -63,14 +63,19 @@ pub(super) fn pipeline(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) 
         wgpu::ShaderStages::VERTEX_FRAGMENT,
         &[look[0], look[1], look[2], look[3], (10, binding::storage(true))],
     );
+    let pipeline = pipeline_in(gpu, name, scene, p, &layout);
+    (layout, pipeline)
+}
+
+/// [`pipeline`] with the lookup layout `layout`.
+pub(super) fn pipeline_in(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams, layout: &wgpu::BindGroupLayout) -> wgpu::RenderPipeline {
     let exact = p.exact_depth != 0;
     let clipped = p.projection != 0 && !exact && !scene.has_cutouts && gpu.clip_distances();
     let fragment = exact || scene.has_cutouts || (p.projection != 0 && !clipped);
     let label = format!("{name}.shadow_map");
-    let layouts = [&layout, &scene.layout];
+    let layouts = [layout, &scene.layout];
     let src = if clipped { clipped_source() } else { source(exact) };
-    let pipeline = raster::depth_pipeline_with(gpu, &label, &src, &layouts, fragment, &constants(p, scene.has_cutouts));
-    (layout, pipeline)
+    raster::depth_pipeline_with(gpu, &label, &src, &layouts, fragment, &constants(p, scene.has_cutouts))
 }
 
 /// The exact-depth pass with the depth test and writes off ([`raster::counting_pipeline`]): the
@@ -83,7 +88,9 @@ pub(super) fn counting_pipeline(
     p: &WarpParams,
 ) -> wgpu::RenderPipeline {
     let label = format!("{name}.exact_depth_count");
-    raster::counting_pipeline(gpu, &label, &source(true), &[lookup, &scene.layout], &constants(p, scene.cutouts))
+    let mut c = constants(p, scene.cutouts);
+    c.push(("COUNT_INVERSIONS", 1.0));
+    raster::counting_pipeline(gpu, &label, &source(true), &[lookup, &scene.layout], &c)
 }
 
 /// What a pass needs of the scene after the frame: its bind group layout and cut-outs, and the
@@ -129,24 +136,25 @@ impl Warped {
         rec.stage(&format!("{name}.shadow_map"), |enc| {
             let mut pass = raster::begin_pass(enc, &format!("{name}.shadow_map"), &[], &self.views[2]);
             pass.set_pipeline(&self.depth_pipeline);
-            self.draw_pieces(&mut pass, depth_group, &f.scene.group, self.triangles(f.scene));
+            self.draw_pieces(&mut pass, depth_group, &f.scene.group, self.triangles(f.scene), self.flat_pipeline.as_ref());
         });
         self.scene.last = Some((f.scene.group.clone(), self.triangles(f.scene)));
     }
 
     /// The map's draw after its pipeline is set: the pieces (indirect: its own, or its share of
-    /// its owner's) or the scene.
+    /// its owner's, the flat ones with `flat`) or the scene.
     fn draw_pieces(
         &self,
         pass: &mut wgpu::RenderPass,
         depth_group: &wgpu::BindGroup,
         scene_group: &wgpu::BindGroup,
         triangles: Range<u32>,
+        flat: Option<&wgpu::RenderPipeline>,
     ) {
         pass.set_bind_group(0, depth_group, &[]);
         pass.set_bind_group(1, scene_group, &[]);
         if let Some(d) = &self.owner_draw {
-            d.draw(pass);
+            d.draw(pass, flat);
         } else if self.params.subdiv > 0.0 {
             pass.draw_indirect(&self.counters, 16);
         } else {
@@ -154,9 +162,10 @@ impl Warped {
         }
     }
 
-    /// Fragments the last frame's exact-depth pass shaded and kept (each one inversion of the
-    /// warp; discarded ones, behind a paraboloid's split plane or cut out, not counted): its
-    /// draw again, with the depth test off, under an occlusion query (the map is kept).
+    /// Fragments the last frame's exact-depth pass inverted the warp for (discarded ones, behind
+    /// a paraboloid's split plane or cut out, and those of pieces without a plane or within
+    /// `exact_tol`, not counted): its draw again, with the depth test off, under an occlusion
+    /// query (the map is kept).
     /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame. A map whose
     /// subdivision buffers are shared (dpsm's hemispheres: after the frame they hold another
     /// map's pieces) subdivides again first; `cube-notw`'s faces keep theirs listed.
@@ -202,7 +211,8 @@ impl Warped {
             });
             pass.set_pipeline(pipeline);
             pass.begin_occlusion_query(0);
-            self.draw_pieces(&mut pass, &depth_group, scene_group, triangles.clone());
+            // (the flat pieces invert nothing: not drawn)
+            self.draw_pieces(&mut pass, &depth_group, scene_group, triangles.clone(), None);
             pass.end_occlusion_query();
         }
         enc.resolve_query_set(set, 0..1, resolve, 0);

@@ -57,14 +57,17 @@ fn bary_pos(tri: u32, b: vec2<f32>) -> vec3<f32> {
 
 // Piece i of the subdivision: its slot, or past the slots (the triangles' and the pieces they
 // may add) entry i - slots of the lists of a layered subdivision (subdiv_scatter.wgsl), four a
-// slot.
+// slot; without the flat mark of a layered subdivision's pieces (subdiv_layers.wgsl).
 fn piece_at(i: u32) -> vec4<u32> {
     let slots = wp.triangles + wp.extra_capacity;
+    var p: vec4<u32>;
     if i < slots {
-        return pieces[i];
+        p = pieces[i];
+    } else {
+        let k = i - slots;
+        p = pieces[pieces[slots + k / 4u][k % 4u]];
     }
-    let k = i - slots;
-    return pieces[pieces[slots + k / 4u][k % 4u]];
+    return vec4<u32>(p.x & 0x7fffffffu, p.yzw);
 }
 
 // Corner c of a subdivision piece (triangle, three unorm16x2 barycentrics; subdiv.wgsl).
@@ -136,6 +139,11 @@ fn depth_vertex(vi: u32) -> VsOut {
             base_clip(wp, bary_pos(t, unpack2x16unorm(piece.w))));
         if plane.w == 0.0 {
             plane = depth_plane(pc, r);
+        }
+        if flat_piece(wp, pc) {
+            // the interpolated depth is off by less than `exact_tol`: no inversion
+            // (depth_exact.wgsl; a layered subdivision draws such pieces without this stage)
+            plane = vec4<f32>(0.0);
         }
         o.plane = plane;
         if plane.w != 0.0 {

@@ -6,12 +6,20 @@
 // to the triangle's plane). Clamped to the piece corners' depth range, so a
 // bad inversion is never worse than the interpolated depth's worst case.
 
+// The report's count of the fragments that invert the warp (depth.rs `counting_pipeline`):
+// the others are discarded.
+override COUNT_INVERSIONS: bool = false;
+
 @fragment
 fn fs_main(in: VsOut) -> @builtin(frag_depth) f32 {
     if discarded(in) {
         discard;
     }
+    // no plane (seen edge-on), or a piece whose interpolated depth is close enough (`exact_tol`)
     if in.plane.w == 0.0 {
+        if COUNT_INVERSIONS {
+            discard;
+        }
         return in.clip.z;
     }
     let res = wp.res;

@@ -52,6 +52,9 @@ pub struct Knobs {
     pub(crate) tent: bool,
     /// Extra count of a shadow-edge sample (`edge_importance`; planar NoTW only).
     pub(crate) edge_importance: u32,
+    /// Exact depth only on pieces spread more than this along the light (`exact_tol`; planar
+    /// NoTW only; 0: all).
+    pub(crate) exact_tol: f32,
 }
 
 impl Knobs {
@@ -99,6 +102,7 @@ impl Knobs {
             cull_hidden: false,
             tent: false,
             edge_importance: 0,
+            exact_tol: 0.0,
         }
     }
 
@@ -150,7 +154,7 @@ impl Knobs {
     /// `notw` (and each face of `cube-notw`): planar, cropped, every NoTW option.
     pub fn notw(s: &NotwSettings) -> Knobs {
         let k = Knobs::notw_core(&s.core, s.res, false, s.window_tent);
-        Knobs { cull_hidden: k.subdiv > 0.0 && s.cull_hidden, edge_importance: s.edge_importance, ..k }
+        Knobs { cull_hidden: k.subdiv > 0.0 && s.cull_hidden, edge_importance: s.edge_importance, exact_tol: s.exact_tol, ..k }
     }
 
     /// `notw-dv`: planar, cropped, no warp and no subdivision.

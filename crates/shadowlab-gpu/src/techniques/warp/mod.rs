@@ -232,7 +232,9 @@ pub struct WarpParams {
     /// Planar subdivision: split on the perpendicular bend (`subdiv`) and the along-edge
     /// displacement (this); 0 = on the whole displacement against `subdiv` (`depth_split`)
     pub depth_split: f32,
-    pub pad1: u32,
+    /// Exact depth: pieces whose corners spread less than this (texels of world size) along the
+    /// light keep the interpolated depth (`exact_tol`; 0: none)
+    pub exact_tol: f32,
     pub pad2: u32,
 }
 
@@ -293,6 +295,9 @@ pub struct Warped {
     analyze: Vec<(&'static str, wgpu::ComputePipeline)>,
     lookup_layout: wgpu::BindGroupLayout,
     depth_pipeline: wgpu::RenderPipeline,
+    /// Subdivided by its owner with exact depth and `exact_tol`: the depth pipeline without the
+    /// exact-depth stage, for the pieces listed flat ([`LayerDraw`]).
+    flat_pipeline: Option<wgpu::RenderPipeline>,
     /// The scene's layout and cut-outs, and its last frame's group (the report's redraw).
     scene: depth::SceneBinding,
     /// `cull_hidden`, `edge_importance`: the occluder pass and its pyramid; else none (a

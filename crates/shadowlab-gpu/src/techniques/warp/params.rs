@@ -275,6 +275,27 @@ pub const EXACT_INVERSE: ParamDef = ParamDef::flag(
 );
 pub const NOTW_EXACT_INVERSE: ParamDef = EXACT_INVERSE.with_default(DEFAULT_NOTW_EXACT_INVERSE, NOTW_TUNED);
 
+/// Exact depth only where it changes the map (`exact_tol`, issue 48 step 1): a piece's
+/// interpolated depth and its exact (plane) depth both lie within its corners' depth range, so
+/// they differ by at most the corners' spread along the light's axis. A piece whose corners
+/// spread less than `exact_tol` texels of world size there (`texel_world`; perspective maps: at
+/// the piece's distance) keeps the interpolated depth, and its fragments invert nothing: the
+/// faces and walls that face the light, leaving the inversion to grazing receivers. 0: every
+/// fragment inverts the warp. Planar maps; `cube-notw` draws its flat pieces without the
+/// exact-depth fragment stage (subdiv_layers.rs). Default 0: by the tune's rule on `cube-notw`
+/// (train room light 1, point-courtyard; validate conference light 1, sponza-peer; 512x512) no
+/// tolerance beat the exact depth on train; 1 ties on three views and costs sponza-peer 0.0006
+/// points at 0.77x the frame (docs/bench/warp.md, issue 48).
+pub const DEFAULT_EXACT_TOL: f64 = 0.0;
+pub const EXACT_TOL: ParamDef = ParamDef::number(
+    "exact_tol",
+    DEFAULT_EXACT_TOL,
+    0.0,
+    64.0,
+    "exact_depth: a piece whose corners spread less than this along the light's axis (texels of world size) keeps the interpolated depth, off by at most that spread; 0 = every fragment inverts the warp",
+    "shadowlab (issue 48, step 1: exact depth only where the interpolated one is off)",
+);
+
 /// Subdivision leaves an edge unsplit when an unwarped occluder map (the scene drawn into the
 /// DV-cropped map, res x res, then a pyramid of maxima) is nearer than the edge all around it:
 /// the bend of a hidden edge cannot show. Planar maps (`notw`, `cube-notw`'s faces); see

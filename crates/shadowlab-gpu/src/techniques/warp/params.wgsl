@@ -71,7 +71,9 @@ struct WarpParams {
     // subdivision (planar): > 0 splits an edge on its perpendicular bend (> subdiv) and its
     // displacement along itself (> depth_split, warped texels); 0: on the whole displacement
     depth_split: f32,
-    pad1: u32,
+    // exact depth: a piece whose corners spread less than this along the light's axis (texels
+    // of world size) keeps the interpolated depth (depth.wgsl); 0: none
+    exact_tol: f32,
     pad2: u32,
 }
 
@@ -185,4 +187,23 @@ fn hzb_offset(res: u32, l: u32) -> u32 {
         o += s * s;
     }
     return o;
+}
+
+// Whether a planar piece with corners at base clip positions pc keeps the interpolated depth
+// (`exact_tol`): its interpolated and exact depths both lie within its corners' range, so they
+// differ by at most the corners' spread along the light's axis (perspective: clip w, the axial
+// distance; orthographic: z over its world scale), here below `exact_tol` texels of world size
+// (perspective: at the piece's mean distance). Never with `exact_tol` 0.
+fn flat_piece(pw: WarpParams, pc: array<vec4<f32>, 3>) -> bool {
+    if pw.exact_tol <= 0.0 {
+        return false;
+    }
+    if pw.perspective > 0.5 {
+        let spread = max(max(pc[0].w, pc[1].w), pc[2].w) - min(min(pc[0].w, pc[1].w), pc[2].w);
+        return spread < pw.exact_tol * pw.texel_world * (pc[0].w + pc[1].w + pc[2].w) / 3.0;
+    }
+    let m = pw.light_view_proj;
+    let per_unit = length(vec3<f32>(m[0][2], m[1][2], m[2][2]));
+    let spread = (max(max(pc[0].z, pc[1].z), pc[2].z) - min(min(pc[0].z, pc[1].z), pc[2].z)) / per_unit;
+    return spread < pw.exact_tol * pw.texel_world;
 }

@@ -181,6 +181,7 @@ shadowlab_core::param_set! {
         pub cull_hidden: bool = CULL_HIDDEN,
         pub window_tent: bool = WINDOW_TENT,
         pub edge_importance: u32 = EDGE_IMPORTANCE,
+        pub exact_tol: f32 = EXACT_TOL,
     }
     rules {
         fn validate(&self) -> Result<(), String> {
@@ -190,6 +191,9 @@ shadowlab_core::param_set! {
             let mut v = self.core.dead(false);
             if !self.core.subdivision.on() {
                 v.extend(dead_keys(&["cull_hidden"], "subdiv=0 turns subdivision off"));
+            }
+            if !self.core.exact_depth {
+                v.extend(dead_keys(&["exact_tol"], "exact_depth=false"));
             }
             v
         }
@@ -221,7 +225,8 @@ pub(crate) mod tests {
         #[rustfmt::skip]
         let notw = ["res", "window", "blur", "mix", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
             "depth_split", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin",
-            "strength", "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "cull_hidden", "window_tent", "edge_importance"];
+            "strength", "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "cull_hidden", "window_tent", "edge_importance",
+            "exact_tol"];
         #[rustfmt::skip]
         let dv = ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin"];
         assert_eq!(keys::<RtwSettings>(), rtw);

@@ -6,12 +6,12 @@
 //! map's (subdiv_map.wgsl); subdiv_layers.rs runs the same passes over several maps at once.
 
 use super::depth::lookup_entries;
-use super::{base_constants, compose, layout_at, LayerDraw, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
+use super::{base_constants, compose, layout_at, Knobs, LayerDraw, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::flag;
 use crate::technique::FrameInputs;
-use crate::{binding, Gpu};
+use crate::{binding, Gpu, GpuError};
 
 pub(super) const SUBDIV_WGSL: &str = include_str!("subdiv.wgsl");
 const SUBDIV_MAP_WGSL: &str = include_str!("subdiv_map.wgsl");
@@ -210,4 +210,41 @@ pub(super) fn dispatch_buffer(gpu: &Gpu, label: &str) -> wgpu::Buffer {
 /// queue and the queues' capacity.
 pub(super) fn level_uniforms(gpu: &Gpu, name: &str, levels: u32, queue: u32) -> Vec<wgpu::Buffer> {
     (1..=levels).map(|l| gpu.uniform(&format!("{name}.level{l}"), &[l, (l == levels) as u32, (l + 1) % 2, queue])).collect()
+}
+
+/// (on, extra pieces, queue entries) of the subdivision of `tris` triangles within the device's
+/// storage binding limit; an error when the queues cannot hold the triangles. `listed`: the
+/// subdivision of several maps' `texels` texels at once ([`super::LayerSubdivision`]), whose
+/// finished pieces are also listed by map (4 bytes more each).
+pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, listed: Option<u64>) -> Result<(bool, u32, u32), GpuError> {
+    let limit = max_binding / 16;
+    let on = k.subdiv > 0.0;
+    // one map: 8 pieces a texel of a 512 map; several at once: 3 a texel of all (the most
+    // measured: 2.6, cube-notw on sponza-peer), as their own subdivisions made them
+    let auto = (8 * tris as u64).max(1 << 21).max(3 * listed.unwrap_or(0));
+    let wanted = if k.subdiv_capacity > 0 { k.subdiv_capacity as u64 } else { auto };
+    // an asked-for capacity is given or refused; the automatic one takes what the device holds
+    let piece = 16 + 4 * listed.is_some() as u64;
+    let most = max_binding.saturating_sub(16 * tris as u64) / piece;
+    if on && k.subdiv_capacity > 0 && wanted > most {
+        return Err(GpuError::Invalid(format!(
+            "{name}: subdiv_capacity={wanted} needs {:.1} MiB of pieces ({piece} bytes each), over this device's max_storage_buffer_binding_size of {:.1} MiB: at most {most} here",
+            (wanted * piece) as f64 / (1u64 << 20) as f64,
+            max_binding as f64 / (1u64 << 20) as f64
+        )));
+    }
+    // at least one per triangle: the root finishes up to one extra piece per triangle (the
+    // second half of a triangle cut by the near plane) before any level can check
+    let extra = if on { wanted.max(tris as u64).min(most) as u32 } else { 0 };
+    // the root queues up to two pieces per triangle (a triangle cut by the near plane); the
+    // triangle index keeps 3 bits free for the split mask
+    // (several maps at once: at least one a texel of all, as their own queues of 2^20 held them)
+    let queue = if on { (2 * tris as u64).max(1 << 20).max(listed.unwrap_or(0)).min(limit) as u32 } else { 0 };
+    if on && (2 * tris as u64 > queue as u64 || tris >= 1 << 29) {
+        return Err(GpuError::Invalid(format!(
+            "{name}: {tris} triangles need subdivision queues of {} entries, over this device's storage binding limit",
+            2 * tris as u64
+        )));
+    }
+    Ok((on, extra, queue))
 }

@@ -26,8 +26,8 @@
 //
 // The composing file binds the map's lookup (bindings 6-9) and defines `enter_triangle` (the
 // map a triangle is drawn into: one map, or a layer of a warp::Layers), `hzb_base` and
-// `finished` (a finished piece stored), and the draw arguments: subdiv_map.wgsl (one map),
-// subdiv_layers.wgsl (every layer at once).
+// `finished` (a finished piece as it is stored), and the draw arguments: subdiv_map.wgsl (one
+// map), subdiv_layers.wgsl (every layer at once).
 
 // Fixed at pipeline creation (subdiv.rs; PARABOLOID and WARPED in params.wgsl): `cull_hidden`,
 // the triangles subdivided (their pieces' slots come first) and the pieces they may add.
@@ -261,8 +261,7 @@ fn finish(p: vec4<u32>) {
         atomicAdd(&counters[1], 1u);
         return;
     }
-    pieces[TRIANGLES + i] = p;
-    finished();
+    pieces[TRIANGLES + i] = finished(p);
 }
 
 // Queue entries carry their split mask above the triangle index.

@@ -5,22 +5,27 @@
 //! their buffer, a word an entry), so that each layer's depth pass draws its triangles' own
 //! slots and its list ([`LayerDraw`], two indirect draws). The dispatches of a frame are those
 //! of one map's subdivision and one more (the scatter), for any number of layers; the pieces of
-//! all layers live at once (the capacity: `build::subdivision_capacity`, 3 pieces a texel of all
+//! all layers live at once (the capacity: `subdiv::capacity`, 3 pieces a texel of all
 //! layers at least).
 
-use super::build::subdivision_capacity;
 use super::layers::{LAYER_BIND_WGSL, LAYER_WARPS_WGSL};
 use super::subdiv::{self, Buffers, SUBDIV_WGSL};
 use super::{report, Knobs, Layers, WarpParams, Warped, LOOKUP_FNS_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
-use crate::shaders::compose;
+use crate::shaders::{compose, flag};
 use crate::technique::TechniqueReport;
 use crate::{binding, Gpu, GpuError};
 
 const SUBDIV_LAYERS_WGSL: &str = include_str!("subdiv_layers.wgsl");
 const SUBDIV_SCATTER_WGSL: &str = include_str!("subdiv_scatter.wgsl");
 const TRIANGLE_LAYER_WGSL: &str = include_str!("triangle_layer.wgsl");
+
+/// Whether maps of `p` list their flat pieces apart (`exact_tol` with exact depth, planar): the
+/// pieces whose interpolated depth is close enough, drawn without the exact-depth stage.
+pub(super) fn flat_split(p: &WarpParams) -> bool {
+    p.exact_depth != 0 && p.exact_tol > 0.0 && p.projection == 0
+}
 
 /// The layers' triangle ranges as triangle_layer.wgsl reads them: `ends[l]` is one past layer
 /// l's last triangle.
@@ -45,20 +50,20 @@ pub fn layered_scatter_source(ends: &[u32]) -> String {
     format!("{}{SUBDIV_SCATTER_WGSL}", header(ends))
 }
 
-/// Words of the counters after subdiv.wgsl's (triangle_layer.wgsl): three a layer, the
-/// scatter's dispatch, eight a layer of draw arguments.
+/// Words of the counters after subdiv.wgsl's (triangle_layer.wgsl): two a layer, the
+/// scatter's dispatch, twelve a layer of draw arguments.
 fn layer_words(layers: u32) -> u64 {
-    3 * layers as u64 + 3 + 8 * layers as u64
+    2 * layers as u64 + 3 + 12 * layers as u64
 }
 
 /// Byte offset of layer `l`'s draw arguments in the counters of `layers` layers.
 fn draw_args_at(layers: u64, l: u64) -> u64 {
-    (1048 + 3 * layers + 3 + 8 * l) * 4
+    (1048 + 2 * layers + 3 + 12 * l) * 4
 }
 
 /// A layer's share of its owner's subdivision, as its depth pass draws it: the pieces (and the
-/// lists after them) and the counters holding its two draws' arguments at `args` (its
-/// triangles' slots, then its list).
+/// lists after them) and the counters holding its three draws' arguments at `args` (its
+/// triangles' slots, its list, its list's flat pieces).
 #[derive(Clone)]
 pub struct LayerDraw {
     pub(super) pieces: wgpu::Buffer,
@@ -67,10 +72,16 @@ pub struct LayerDraw {
 }
 
 impl LayerDraw {
-    /// The layer's pieces, drawn into the pass (its pipeline and groups set).
-    pub(super) fn draw(&self, pass: &mut wgpu::RenderPass) {
+    /// The layer's pieces, drawn into the pass (its pipeline and groups set); the flat ones
+    /// (`exact_tol`) with `flat`, the pipeline without the exact-depth fragment stage (none: not
+    /// drawn, as the report's count of inversions wants).
+    pub(super) fn draw(&self, pass: &mut wgpu::RenderPass, flat: Option<&wgpu::RenderPipeline>) {
         pass.draw_indirect(&self.counters, self.args);
         pass.draw_indirect(&self.counters, self.args + 16);
+        if let Some(p) = flat {
+            pass.set_pipeline(p);
+            pass.draw_indirect(&self.counters, self.args + 32);
+        }
     }
 }
 
@@ -110,7 +121,7 @@ impl LayerSubdivision {
         assert!(ends.windows(2).all(|w| w[0] <= w[1]) && ends.last() == Some(&scene.triangle_count), "{name}: the layers' ranges");
         let triangles = scene.triangle_count;
         let limit = gpu.limits.max_storage_buffer_binding_size;
-        let (_, extra, queue) = subdivision_capacity(k, name, triangles, limit, Some(layers.texels()))?;
+        let (_, extra, queue) = subdiv::capacity(k, name, triangles, limit, Some(layers.texels()))?;
         let params: Vec<_> = maps.iter().map(|m| m.params).collect();
         assert!(params.iter().all(|p| (p.triangles, p.extra_capacity) == (triangles, extra)), "{name}: maps planned for this subdivision");
         let levels = params[0].subdiv_levels;
@@ -134,7 +145,11 @@ impl LayerSubdivision {
         ];
         let layout = super::layout_at(gpu, &format!("{name}.subdivide"), wgpu::ShaderStages::COMPUTE, &entries);
         let mut constants = subdiv::constants(&params[0], triangles, extra);
-        constants.extend([("DV_STRIDE", (layers.dv_stride / 4) as f64), ("HZB_STRIDE", (layers.hzb_stride / 4) as f64)]);
+        constants.extend([
+            ("DV_STRIDE", (layers.dv_stride / 4) as f64),
+            ("HZB_STRIDE", (layers.hzb_stride / 4) as f64),
+            ("FLAT_SPLIT", flag(flat_split(&params[0]))),
+        ]);
         let src = layered_subdivision_source(ends);
         let split = ["split_root", "split_args", "split_level", "draw_args"]
             .map(|e| gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout], &constants));
@@ -206,7 +221,8 @@ impl LayerSubdivision {
         let b = Buffers { counters: &self.counters, dispatch: &self.dispatch };
         rec.stage(&format!("{}.subdivide", self.name), |enc| {
             subdiv::record_passes(gpu, enc, &self.split, &self.groups, scene_group, b, self.triangles);
-            enc.copy_buffer_to_buffer(&self.counters, (1048 + 3 * self.ends.len() as u64) * 4, &self.dispatch, 0, 12);
+            // the scatter's groups (triangle_layer.wgsl SCATTER_ARGS_AT)
+            enc.copy_buffer_to_buffer(&self.counters, (1048 + 2 * self.ends.len() as u64) * 4, &self.dispatch, 0, 12);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("scatter"), timestamp_writes: None });
             pass.set_pipeline(&self.scatter);
             pass.set_bind_group(0, &self.scatter_group, &[]);
@@ -223,7 +239,7 @@ impl LayerSubdivision {
         let drawn: Vec<u32> = (0..n)
             .map(|l| {
                 let d = (draw_args_at(n as u64, l as u64) / 4) as usize;
-                (words[d] + words[d + 4]) / 3
+                (words[d] + words[d + 4] + words[d + 8]) / 3
             })
             .collect();
         report::subdivision_counters(&words[..24], drawn.iter().sum(), texels, &self.params, r);

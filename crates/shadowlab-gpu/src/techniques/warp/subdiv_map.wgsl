@@ -8,7 +8,9 @@ fn hzb_base() -> u32 {
     return 0u;
 }
 
-fn finished() {}
+fn finished(p: vec4<u32>) -> vec4<u32> {
+    return p;
+}
 
 @compute @workgroup_size(1)
 fn draw_args() {

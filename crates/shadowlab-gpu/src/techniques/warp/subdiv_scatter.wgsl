@@ -1,8 +1,9 @@
 // The finished pieces of the layered subdivision (subdiv_layers.wgsl) listed by layer: each
-// takes the next entry of its layer's list, whose offset draw_args set, and writes its index
-// there; the lists follow the pieces' slots in their buffer (here as words), so that each layer
-// draws its own (depth.wgsl `piece_at`; the order within a list is the append order, which the
-// depth test's minimum does not see).
+// takes the next entry of its layer's list, from the front or, flat, from the back, writes its
+// index there and counts itself into that draw's arguments (draw_args set their starts); the
+// lists follow the pieces' slots in their buffer (here as words), so that each layer draws its
+// own (depth.wgsl `piece_at`; the order within a list is the append order, which the depth
+// test's minimum does not see).
 
 override TRIANGLES: u32;
 override EXTRA_CAPACITY: u32;
@@ -17,7 +18,16 @@ fn scatter(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
         return;
     }
     let piece = TRIANGLES + k;
-    let l = layer_of_triangle(words[4u * piece]);
-    let slot = atomicLoad(&counters[OFFSET_AT + l]) + atomicAdd(&counters[CURSOR_AT + l], 1u);
-    words[4u * (TRIANGLES + EXTRA_CAPACITY) + slot] = piece;
+    let tri = words[4u * piece];
+    let l = layer_of_triangle(tri & ~FLAT_MARK);
+    let d = DRAWS_AT + l * DRAW_WORDS;
+    var entry = atomicLoad(&counters[OFFSET_AT + l]);
+    if (tri & FLAT_MARK) != 0u {
+        // from the back: the flat draw grows downwards
+        entry += atomicLoad(&counters[FINISHED_AT + l]) - 1u - atomicAdd(&counters[d + 8u], 3u) / 3u;
+        atomicSub(&counters[d + 10u], 3u);
+    } else {
+        entry += atomicAdd(&counters[d + 4u], 3u) / 3u;
+    }
+    words[4u * (TRIANGLES + EXTRA_CAPACITY) + entry] = piece;
 }
