@@ -87,11 +87,7 @@ impl Warped {
         let own_subdiv = plan.subdiv && !target.is_some_and(|(l, _)| l.owner_subdivides);
         let resources = Resources::new(gpu, &plan, target, own_subdiv);
         let by_owner = target.is_some_and(|(l, _)| l.owner_reads_view);
-        let occluders = target.map(|(l, i)| occluders::Target {
-            depth: &l.occluders,
-            layer: i,
-            hzb: l.hzb.as_ref().map(|b| (b, i as u64 * l.hzb_stride)),
-        });
+        let occluders = target.map(|(l, i)| occluders::Target { depth: &l.occluders, layer: i, owner_pyramid: l.hzb.is_some() });
         let pipelines = Pipelines::new(gpu, scene, &plan, occluders, by_owner, own_subdiv);
         let scene =
             depth::SceneBinding { layout: scene.layout.clone(), cutouts: scene.has_cutouts, last: None, counting: Default::default() };

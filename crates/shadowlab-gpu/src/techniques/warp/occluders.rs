@@ -36,19 +36,20 @@ pub(super) struct Occluders {
     pub hzb: Option<Pyramid>,
 }
 
-/// Where a map's occluder map and pyramid go when they are a layer of shared ones
-/// ([`super::Layers`]): `layer` of `depth`, and the pyramid at a byte offset of `hzb` (else its
-/// own buffer).
+/// Where a map's occluder map goes when it is a layer of shared ones ([`super::Layers`]):
+/// `layer` of `depth`; with `owner_pyramid` the owner builds every layer's pyramid at once
+/// (subdiv_layers.rs) and the map none.
 pub(super) struct Target<'a> {
     pub depth: &'a wgpu::Texture,
     pub layer: u32,
-    pub hzb: Option<(&'a wgpu::Buffer, u64)>,
+    pub owner_pyramid: bool,
 }
 
 pub(super) struct Pyramid {
-    /// Its own buffer, or its slice of a shared one (from `offset`).
+    /// The pyramids, level 0 first, of `layers` maps of side `res` (one map: its own).
     buffer: wgpu::Buffer,
-    offset: u64,
+    res: u32,
+    layers: u32,
     base: wgpu::ComputePipeline,
     reduce: wgpu::ComputePipeline,
     /// One bind group per level (the occluder map, the pyramid, the level's uniform (res, level)),
@@ -101,8 +102,16 @@ impl Occluders {
             array_layer_count: Some(1),
             ..Default::default()
         });
-        let slice = target.and_then(|t| t.hzb);
-        let hzb = (p.cull_hidden > 0.5).then(|| Pyramid::new(gpu, name, res, &constants, &view, slice));
+        let own_pyramid = p.cull_hidden > 0.5 && !target.is_some_and(|t| t.owner_pyramid);
+        let hzb = own_pyramid.then(|| {
+            let array = depth.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                base_array_layer: layer,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            Pyramid::new(gpu, name, res, &constants, &array, None, 1, 0)
+        });
         Occluders { res, hzb, view, depth, layer, raster }
     }
 
@@ -132,34 +141,37 @@ impl Occluders {
             pass.draw(triangles.start * 3..triangles.end * 3, 0..1);
         }
         if let Some(h) = &self.hzb {
-            for (l, group) in h.groups.iter().enumerate() {
-                let side = side(self.res, l as u32);
-                let pipeline = if l == 0 { &h.base } else { &h.reduce };
-                gpu.dispatch_2d(enc, "hzb", pipeline, &[group], side, side);
-            }
+            h.record(gpu, enc);
         }
     }
 }
 
 impl Pyramid {
-    /// The pyramid of the occluder map `view`, in `slice` (a buffer and byte offset) or its own.
-    fn new(
+    /// The pyramids of the `layers` occluder maps of `view` (an array view; one map: its
+    /// layer), `stride` bytes apart in `buffer` (a storage buffer of their own when none).
+    pub(super) fn new(
         gpu: &Gpu,
         name: &str,
         res: u32,
         constants: &[(&str, f64)],
         view: &wgpu::TextureView,
-        slice: Option<(&wgpu::Buffer, u64)>,
+        buffer: Option<&wgpu::Buffer>,
+        layers: u32,
+        stride: u64,
     ) -> Pyramid {
+        let depth_array = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        };
         let layout = layout_at(
             gpu,
             &format!("{name}.hzb"),
             wgpu::ShaderStages::COMPUTE,
-            &[(0, binding::texture_depth()), (1, binding::storage(false)), (2, binding::uniform())],
+            &[(0, depth_array), (1, binding::storage(false)), (2, binding::uniform())],
         );
         let src = hzb_src();
-        let (buffer, offset) =
-            slice.map_or_else(|| (gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4), 0), |(b, o)| (b.clone(), o));
+        let buffer = buffer.cloned().unwrap_or_else(|| gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4));
         let groups = (0..=top_level(res))
             .map(|l| {
                 let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);
@@ -168,33 +180,43 @@ impl Pyramid {
                     layout: &layout,
                     entries: &[
                         wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) },
-                        wgpu::BindGroupEntry { binding: 1, resource: Pyramid::binding_of(&buffer, offset, res) },
+                        wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 2, resource: u.as_entire_binding() },
                     ],
                 })
             })
             .collect();
+        let mut constants = constants.to_vec();
+        constants.push(("HZB_STRIDE", (stride / 4) as f64));
         Pyramid {
-            base: gpu.compute_pipeline_with(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout], constants),
-            reduce: gpu.compute_pipeline_with(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout], constants),
+            base: gpu.compute_pipeline_with(&format!("{name}.hzb_base"), &src, "hzb_base", &[&layout], &constants),
+            reduce: gpu.compute_pipeline_with(&format!("{name}.hzb_reduce"), &src, "hzb_reduce", &[&layout], &constants),
             buffer,
-            offset,
+            res,
+            layers,
             groups,
         }
     }
 
-    fn binding_of(buffer: &wgpu::Buffer, offset: u64, res: u32) -> wgpu::BindingResource<'_> {
-        wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer, offset, size: wgpu::BufferSize::new(pyramid_len(res) * 4) })
+    /// Every level of every layer's pyramid, one dispatch a level.
+    pub(super) fn record(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder) {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("hzb"), timestamp_writes: None });
+        for (l, group) in self.groups.iter().enumerate() {
+            let side = side(self.res, l as u32).div_ceil(8);
+            pass.set_pipeline(if l == 0 { &self.base } else { &self.reduce });
+            pass.set_bind_group(0, group, &[]);
+            gpu.dispatch(&mut pass, [side, side, self.layers]);
+        }
     }
 
-    /// The last frame's pyramid (all levels, level 0 first).
-    pub fn read(&self, gpu: &Gpu, res: u32) -> Vec<f32> {
-        gpu.read_buffer_at(&self.buffer, self.offset, pyramid_len(res) as usize)
+    /// The last frame's pyramid (all levels, level 0 first) of a map's own.
+    pub fn read(&self, gpu: &Gpu) -> Vec<f32> {
+        gpu.read_buffer_at(&self.buffer, 0, pyramid_len(self.res) as usize)
     }
 
-    /// The pyramid as a pass binds it (its slice of a shared buffer).
-    pub fn binding(&self, res: u32) -> wgpu::BindingResource<'_> {
-        Pyramid::binding_of(&self.buffer, self.offset, res)
+    /// The pyramids as a pass binds them.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
     }
 }
 

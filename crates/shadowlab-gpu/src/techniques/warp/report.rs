@@ -161,7 +161,7 @@ impl Warped {
     pub fn read_occluders(&self, gpu: &Gpu) -> Option<(Vec<f32>, Vec<f32>)> {
         let o = self.occluders.as_ref()?;
         let (depth, layer) = o.depth();
-        let pyramid = o.hzb.as_ref().map_or(Vec::new(), |h| h.read(gpu, self.res));
+        let pyramid = o.hzb.as_ref().map_or(Vec::new(), |h| h.read(gpu));
         Some((bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(depth, 4, layer)), pyramid))
     }
 

@@ -136,8 +136,8 @@ impl Warped {
                 e.push(wgpu::BindGroupEntry { binding: 13, resource: self.queues[1 - qi].as_entire_binding() });
                 let u = &self.level_uniforms[l.saturating_sub(1)];
                 e.push(wgpu::BindGroupEntry { binding: 14, resource: u.as_entire_binding() });
-                let hzb = self.occluders.as_ref().and_then(|o| o.hzb.as_ref()).map_or(self.dv.as_entire_binding(), |h| h.binding(self.res));
-                e.push(wgpu::BindGroupEntry { binding: 15, resource: hzb });
+                let hzb = self.occluders.as_ref().and_then(|o| o.hzb.as_ref()).map_or(&self.dv, |h| h.buffer());
+                e.push(wgpu::BindGroupEntry { binding: 15, resource: hzb.as_entire_binding() });
                 self.groups.levels[l].entries(gpu, name, self.split_layout.as_ref().expect("with the subdivision"), &e)
             })
             .collect()

@@ -9,6 +9,7 @@
 //! layers at least).
 
 use super::layers::{LAYER_BIND_WGSL, LAYER_WARPS_WGSL};
+use super::occluders::Pyramid;
 use super::subdiv::{self, Buffers, SUBDIV_WGSL};
 use super::{report, Knobs, Layers, WarpParams, Warped, LOOKUP_FNS_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
@@ -102,6 +103,8 @@ pub struct LayerSubdivision {
     groups: Vec<wgpu::BindGroup>,
     scatter: wgpu::ComputePipeline,
     scatter_group: wgpu::BindGroup,
+    /// `cull_hidden`: every layer's occluder pyramid, built before the subdivision.
+    pyramids: Option<Pyramid>,
 }
 
 impl LayerSubdivision {
@@ -194,7 +197,13 @@ impl LayerSubdivision {
             .collect();
         let scatter_group =
             binding::group(gpu, &format!("{name}.scatter"), &scatter_layout, &[pieces.as_entire_binding(), counters.as_entire_binding()]);
+        let pyramids = layers.hzb.as_ref().map(|b| {
+            let d = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
+            let constants = super::base_constants(&params[0]);
+            Pyramid::new(gpu, name, layers.res, &constants, &layers.occluders.create_view(&d), Some(b), layers.count(), layers.hzb_stride)
+        });
         Ok(LayerSubdivision {
+            pyramids,
             name,
             ends: ends.to_vec(),
             triangles,
@@ -220,6 +229,9 @@ impl LayerSubdivision {
     pub fn record(&self, gpu: &Gpu, rec: &mut Recorder, scene_group: &wgpu::BindGroup) {
         let b = Buffers { counters: &self.counters, dispatch: &self.dispatch };
         rec.stage(&format!("{}.subdivide", self.name), |enc| {
+            if let Some(p) = &self.pyramids {
+                p.record(gpu, enc);
+            }
             subdiv::record_passes(gpu, enc, &self.split, &self.groups, scene_group, b, self.triangles);
             // the scatter's groups (triangle_layer.wgsl SCATTER_ARGS_AT)
             enc.copy_buffer_to_buffer(&self.counters, (1048 + 2 * self.ends.len() as u64) * 4, &self.dispatch, 0, 12);
@@ -246,8 +258,8 @@ impl LayerSubdivision {
         drawn
     }
 
-    /// Bytes of its buffers (pieces and lists, queues).
+    /// Bytes of its buffers (pieces and lists, queues, the layers' pyramids).
     pub fn bytes(&self) -> u64 {
-        self.pieces.size() + self.queues.iter().map(|q| q.size()).sum::<u64>()
+        self.pieces.size() + self.queues.iter().map(|q| q.size()).sum::<u64>() + self.pyramids.as_ref().map_or(0, |p| p.buffer().size())
     }
 }
