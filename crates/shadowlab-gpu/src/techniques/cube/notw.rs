@@ -87,9 +87,9 @@ impl CubeNotw {
             faces.push(Face { warped, light, light_buf });
         }
         let maps: Vec<&Warped> = faces.iter().map(|f| &f.warped).collect();
-        let subdivision =
-            subdivides.then(|| LayerSubdivision::new(gpu, "cube-notw", &knobs, &layers, &maps, &faces_scene, &ends)).transpose()?;
         let passes = LayerPasses::new(gpu, "cube-notw", &layers, &maps, FACES_WGSL, EVAL_NOTW_WGSL);
+        let subdivision =
+            subdivides.then(|| LayerSubdivision::new(gpu, "cube-notw", &layers, &passes, &maps, &faces_scene, &ends)).transpose()?;
         if let Some(s) = &subdivision {
             for (f, face) in faces.iter_mut().enumerate() {
                 face.warped.draw_owner_pieces(s.draw(f));

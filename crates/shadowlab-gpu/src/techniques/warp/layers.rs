@@ -160,9 +160,9 @@ const ANALYSIS: [&str; 5] = ["functions_rows", "smooth_rows", "rebuild", "functi
 pub struct LayerPasses {
     name: &'static str,
     /// The layers' uniforms, in layer order.
-    params: wgpu::Buffer,
+    pub(super) params: wgpu::Buffer,
     /// Array views of the warps and maps.
-    views: [wgpu::TextureView; 3],
+    pub(super) views: [wgpu::TextureView; 3],
     sampler: wgpu::Sampler,
     layout: wgpu::BindGroupLayout,
     eval: EvalPipelines,

@@ -110,7 +110,7 @@ impl Occluders {
                 array_layer_count: Some(1),
                 ..Default::default()
             });
-            Pyramid::new(gpu, name, res, &constants, &array, None, 1, 0)
+            Pyramid::new(gpu, name, res, &constants, &array, None)
         });
         Occluders { res, hzb, view, depth, layer, raster }
     }
@@ -147,17 +147,16 @@ impl Occluders {
 }
 
 impl Pyramid {
-    /// The pyramids of the `layers` occluder maps of `view` (an array view; one map: its
-    /// layer), `stride` bytes apart in `buffer` (a storage buffer of their own when none).
+    /// The pyramids of the occluder maps of `view` (an array view): with `shared` = (buffer,
+    /// layers, stride) every layer's, `stride` bytes apart in that buffer; else the one layer's
+    /// in a buffer of its own.
     pub(super) fn new(
         gpu: &Gpu,
         name: &str,
         res: u32,
         constants: &[(&str, f64)],
         view: &wgpu::TextureView,
-        buffer: Option<&wgpu::Buffer>,
-        layers: u32,
-        stride: u64,
+        shared: Option<(&wgpu::Buffer, u32, u64)>,
     ) -> Pyramid {
         let depth_array = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Depth,
@@ -171,7 +170,10 @@ impl Pyramid {
             &[(0, depth_array), (1, binding::storage(false)), (2, binding::uniform())],
         );
         let src = hzb_src();
-        let buffer = buffer.cloned().unwrap_or_else(|| gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4));
+        let (buffer, layers, stride) = match shared {
+            Some((b, layers, stride)) => (b.clone(), layers, stride),
+            None => (gpu.storage(&format!("{name}.hzb"), pyramid_len(res) * 4), 1, 0),
+        };
         let groups = (0..=top_level(res))
             .map(|l| {
                 let u = gpu.uniform(&format!("{name}.hzb{l}"), &[res, l, 0, 0]);

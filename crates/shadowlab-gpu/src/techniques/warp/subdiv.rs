@@ -217,7 +217,6 @@ pub(super) fn level_uniforms(gpu: &Gpu, name: &str, levels: u32, queue: u32) -> 
 /// subdivision of several maps' `texels` texels at once ([`super::LayerSubdivision`]), whose
 /// finished pieces are also listed by map (4 bytes more each).
 pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, listed: Option<u64>) -> Result<(bool, u32, u32), GpuError> {
-    let limit = max_binding / 16;
     let on = k.subdiv > 0.0;
     // one map: 8 pieces a texel of a 512 map; several at once: 3 a texel of all (the most
     // measured: 2.6, cube-notw on sponza-peer), as their own subdivisions made them
@@ -236,10 +235,8 @@ pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, liste
     // at least one per triangle: the root finishes up to one extra piece per triangle (the
     // second half of a triangle cut by the near plane) before any level can check
     let extra = if on { wanted.max(tris as u64).min(most) as u32 } else { 0 };
-    // the root queues up to two pieces per triangle (a triangle cut by the near plane); the
-    // triangle index keeps 3 bits free for the split mask
-    // (several maps at once: at least one a texel of all, as their own queues of 2^20 held them)
-    let queue = if on { (2 * tris as u64).max(1 << 20).max(listed.unwrap_or(0)).min(limit) as u32 } else { 0 };
+    let queue = if on { queue_capacity(tris, max_binding, listed) } else { 0 };
+    // the triangle index keeps 3 bits free for the split mask
     if on && (2 * tris as u64 > queue as u64 || tris >= 1 << 29) {
         return Err(GpuError::Invalid(format!(
             "{name}: {tris} triangles need subdivision queues of {} entries, over this device's storage binding limit",
@@ -247,4 +244,11 @@ pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, liste
         )));
     }
     Ok((on, extra, queue))
+}
+
+/// Entries of each level queue of the subdivision of `tris` triangles ([`capacity`]): the root
+/// queues up to two pieces per triangle (a triangle cut by the near plane); several maps at once
+/// (`listed` texels) at least one a texel of all, as their own queues of 2^20 held them.
+pub(super) fn queue_capacity(tris: u32, max_binding: u64, listed: Option<u64>) -> u32 {
+    (2 * tris as u64).max(1 << 20).max(listed.unwrap_or(0)).min(max_binding / 16) as u32
 }

@@ -11,7 +11,7 @@
 use super::layers::{LAYER_BIND_WGSL, LAYER_WARPS_WGSL};
 use super::occluders::Pyramid;
 use super::subdiv::{self, Buffers, SUBDIV_WGSL};
-use super::{report, Knobs, Layers, WarpParams, Warped, LOOKUP_FNS_WGSL, PARAMS_WGSL};
+use super::{report, LayerPasses, Layers, WarpParams, Warped, LOOKUP_FNS_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::shaders::{compose, flag};
@@ -108,14 +108,14 @@ pub struct LayerSubdivision {
 }
 
 impl LayerSubdivision {
-    /// The subdivision of `maps` (map i draws layer i of `layers`, made with `k` over `scene`:
-    /// their capacity is this subdivision's), whose triangles below `ends[i]` (and from
-    /// `ends[i - 1]`) are map i's.
+    /// The subdivision of `maps` (map i draws layer i of `layers`, made over `scene`, so that
+    /// their piece capacity is this subdivision's), whose triangles below `ends[i]` (and from
+    /// `ends[i - 1]`) are map i's; it binds `passes`' uniforms and warps.
     pub fn new(
         gpu: &Gpu,
         name: &'static str,
-        k: &Knobs,
         layers: &Layers,
+        passes: &LayerPasses,
         maps: &[&Warped],
         scene: &GpuScene,
         ends: &[u32],
@@ -123,10 +123,11 @@ impl LayerSubdivision {
         assert!(layers.owner_subdivides && maps.len() == ends.len() && ends.len() as u32 == layers.count(), "{name}: one map a layer");
         assert!(ends.windows(2).all(|w| w[0] <= w[1]) && ends.last() == Some(&scene.triangle_count), "{name}: the layers' ranges");
         let triangles = scene.triangle_count;
-        let limit = gpu.limits.max_storage_buffer_binding_size;
-        let (_, extra, queue) = subdiv::capacity(k, name, triangles, limit, Some(layers.texels()))?;
         let params: Vec<_> = maps.iter().map(|m| m.params).collect();
+        // the maps were planned for it (build.rs: subdiv::capacity with their layers' texels)
+        let extra = params[0].extra_capacity;
         assert!(params.iter().all(|p| (p.triangles, p.extra_capacity) == (triangles, extra)), "{name}: maps planned for this subdivision");
+        let queue = subdiv::queue_capacity(triangles, gpu.limits.max_storage_buffer_binding_size, Some(layers.texels()));
         let levels = params[0].subdiv_levels;
         let array = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: false },
@@ -168,9 +169,6 @@ impl LayerSubdivision {
             gpu.storage(&format!("{name}.pieces"), (triangles as u64 + extra as u64) * 16 + (extra as u64 * 4).next_multiple_of(16));
         let queues = [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16));
         let counters = subdiv::counters_buffer(gpu, &format!("{name}.counters"), layer_words(layers.count()));
-        let uniforms = gpu.uniform_array(&format!("{name}.subdivide.layers"), &params);
-        let d = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
-        let [wx, wy] = [&layers.warp_x, &layers.warp_y].map(|t| t.create_view(&d));
         let level_uniforms = subdiv::level_uniforms(gpu, name, levels, queue);
         // the pyramids (`cull_hidden`), or a stand-in never read
         let hzb = layers.hzb.as_ref().unwrap_or(&layers.dv);
@@ -179,10 +177,10 @@ impl LayerSubdivision {
             .map(|l| {
                 let qi = (l + 1) % 2;
                 let resources = [
-                    uniforms.as_entire_binding(),
+                    passes.params.as_entire_binding(),
                     layers.dv.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(&wx),
-                    wgpu::BindingResource::TextureView(&wy),
+                    wgpu::BindingResource::TextureView(&passes.views[0]),
+                    wgpu::BindingResource::TextureView(&passes.views[1]),
                     pieces.as_entire_binding(),
                     counters.as_entire_binding(),
                     queues[qi].as_entire_binding(),
@@ -200,7 +198,8 @@ impl LayerSubdivision {
         let pyramids = layers.hzb.as_ref().map(|b| {
             let d = wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() };
             let constants = super::base_constants(&params[0]);
-            Pyramid::new(gpu, name, layers.res, &constants, &layers.occluders.create_view(&d), Some(b), layers.count(), layers.hzb_stride)
+            let shared = Some((b, layers.count(), layers.hzb_stride));
+            Pyramid::new(gpu, name, layers.res, &constants, &layers.occluders.create_view(&d), shared)
         });
         Ok(LayerSubdivision {
             pyramids,
