@@ -357,3 +357,57 @@ fn depth_split_judges_the_bend_along_the_edge_apart() {
     assert!(pieces(&loose) < pieces(&equal), "{} vs {}", pieces(&loose), pieces(&equal));
     assert!(wrong(&equal) <= wrong(&whole) + 0.1 && wrong(&loose) <= wrong(&whole) + 0.25);
 }
+
+/// `tessellate` (issue 48, step 2): after the level queue's first levels, the pieces left are
+/// drawn as regular grids whose vertices on coarser edges move to those edges' nearest points.
+/// Every piece must keep its triangle's orientation (a fold overlaps its neighbours: snapping
+/// down instead of to the nearest folded 1,081 pieces here; degenerate pieces have no area but
+/// their corners' rounding), and a triangle's pieces must cover
+/// it as the queue's do: their signed areas (integer barycentric corners) sum to the same within
+/// the corners' rounding. The shadows stay close to the queue's against rt, with fewer
+/// dispatches.
+#[test]
+fn tessellated_pieces_tile_every_triangle_without_folds() {
+    let Some(gpu) = gpu() else { return };
+    let scene = builtin("courtyard").unwrap();
+    let lab = Lab::new(&gpu, &scene).unwrap();
+    let v = view(&lab, &scene, 0, 256);
+    // per triangle: twice the pieces' summed signed area (unorm16 units), and the folded pieces
+    let areas = |spec: &str| -> (Vec<i64>, usize, f64) {
+        let mut t = run_direct(&gpu, &lab, &v, spec, Variant::Notw);
+        let mut sums = vec![0i64; lab.gscene.triangle_count as usize];
+        let mut folded = 0;
+        for p in t.read_pieces(&gpu) {
+            let c = [p[1], p[2], p[3]].map(|c| [(c & 0xffff) as i64, (c >> 16) as i64]);
+            let a = (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[1][1] - c[0][1]) * (c[2][0] - c[0][0]);
+            // (three corners on one edge have no area but their rounding's, under 4 * 65535)
+            folded += (a < -4 * 65535) as usize;
+            sums[(p[0] & 0x7fff_ffff) as usize] += a;
+        }
+        let r = technique::Technique::report(&mut t, &gpu);
+        assert!(r.degraded.is_empty(), "{spec}: {:?}", r.degraded);
+        (sums, folded, r.counters.get("subdiv_pieces_degenerate").copied().unwrap_or(0.0))
+    };
+    let (queue, queue_folded, _) = areas("notw:res=256");
+    let (tess, tess_folded, degenerate) = areas("notw:res=256,tessellate=2");
+    assert_eq!((queue_folded, tess_folded), (0, 0), "folded pieces (queue, tessellated)");
+    let whole = 65535.0 * 65535.0;
+    let off: Vec<(usize, f64)> =
+        (0..tess.len()).map(|i| (i, (tess[i] - queue[i]) as f64 / whole)).filter(|(_, d)| d.abs() > 1e-4).collect();
+    assert!(off.is_empty(), "{} triangles covered otherwise than by the queue, e.g. {:?}", off.len(), &off[..off.len().min(5)]);
+    assert!(degenerate > 0.0, "grids meeting coarser edges leave degenerate pieces (counted)");
+    let rt = lab.reference(&v, 1).unwrap();
+    let run = |s: &str| lab.run(&v, &TechniqueSpec::parse(s).unwrap(), 1).unwrap();
+    let (q, t) = (run("notw:res=256"), run("notw:res=256,tessellate=2"));
+    let wrong = |r: &shadowlab_gpu::lab::Run| compare(&r.visibility, &rt.visibility, &v.mask).wrong_pct;
+    let dispatches = |r: &shadowlab_gpu::lab::Run| r.report.counters["dispatches_per_frame"];
+    eprintln!(
+        "courtyard 256, notw res 256: queue {:.3} % ({} dispatches), tessellate=2 {:.3} % ({})",
+        wrong(&q),
+        dispatches(&q),
+        wrong(&t),
+        dispatches(&t)
+    );
+    assert!(wrong(&t) <= wrong(&q) + 0.1, "tessellated {:.3} % against the queue's {:.3}", wrong(&t), wrong(&q));
+    assert!(dispatches(&t) < dispatches(&q));
+}

@@ -339,7 +339,7 @@ mod tests {
         assert_eq!(keys::<CubeSettings>(), ["res", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "depth"]);
         // each face is a notw map: notw's rows, twelve of them with other defaults (tests/cube.rs)
         assert_eq!(keys::<CubeNotwSettings>(), keys::<w::NotwSettings>());
-        assert_eq!(keys::<CubeNotwSettings>().len(), 27);
+        assert_eq!(keys::<CubeNotwSettings>().len(), 28);
         assert_eq!(CubeSettings::defaults().depth, FaceDepth::Hardware);
         assert_eq!(error("cube-notw:res=64"), "technique 'cube-notw': window 128 must be below res 64");
         assert!(error("cube-notw:subdiv=0,cull_hidden=true").contains("cull_hidden has no effect: subdiv=0"));

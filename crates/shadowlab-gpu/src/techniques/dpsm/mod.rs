@@ -346,11 +346,11 @@ mod tests {
     #[test]
     fn the_tables_keep_their_keys_in_order() {
         #[rustfmt::skip]
-        let dpsm = ["res", "split", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece", "depth_split", "exact_depth", "pcf", "bias",
+        let dpsm = ["res", "split", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece", "depth_split", "tessellate", "exact_depth", "pcf", "bias",
             "slope_bias", "max_slope", "normal_offset"];
         #[rustfmt::skip]
         let notw = ["res", "split", "window", "blur", "mix", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
-            "depth_split", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
+            "depth_split", "tessellate", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin", "strength",
             "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "window_tent"];
         assert_eq!(keys::<DpsmSettings>(), dpsm);
         assert_eq!(keys::<DpsmNotwSettings>(), notw);

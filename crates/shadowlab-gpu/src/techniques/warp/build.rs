@@ -250,7 +250,7 @@ fn uniform(k: &Knobs, base: &BaseProjection, tris: u32, extra: u32) -> WarpParam
         edge_importance: k.edge_importance,
         depth_split: k.depth_split,
         exact_tol: k.exact_tol,
-        pad2: 0,
+        tessellate: k.tessellate,
     }
 }
 
@@ -289,7 +289,7 @@ impl Resources {
         let n = res as u64 * res as u64;
         let [wx, wy] = plan.warp_sizes();
         let tris = plan.params.triangles as u64;
-        let levels = plan.params.subdiv_levels;
+        let levels = subdiv::level_count(&plan.params);
         let (warp_x, warp_y, map, dv, counts, layer, dv_offset, counts_offset) = match target {
             Some((l, i)) => {
                 let fits = l.res == res
@@ -360,7 +360,7 @@ struct Pipelines {
     flat_pipeline: Option<wgpu::RenderPipeline>,
     occluders: Option<occluders::Occluders>,
     split_layout: Option<wgpu::BindGroupLayout>,
-    split: Option<[wgpu::ComputePipeline; 4]>,
+    split: Option<Vec<wgpu::ComputePipeline>>,
     eval_layout: wgpu::BindGroupLayout,
     eval: EvalPipelines,
     sampler: wgpu::Sampler,

@@ -37,6 +37,8 @@ pub struct Knobs {
     pub(crate) min_piece: f32,
     /// Planar subdivision's along-edge threshold (`depth_split`; 0 = the whole displacement).
     pub(crate) depth_split: f32,
+    /// Queue levels before the tessellation (`tessellate`, tess.wgsl; 0: the queue alone).
+    pub(crate) tessellate: u32,
     pub(crate) exact_depth: bool,
     pub(crate) close_cracks: bool,
     pub(crate) dv_margin: f32,
@@ -91,6 +93,7 @@ impl Knobs {
             subdiv_capacity: 0,
             min_piece: 0.0,
             depth_split: 0.0,
+            tessellate: 0,
             exact_depth: false,
             close_cracks: false,
             dv_margin: 0.0,
@@ -114,6 +117,7 @@ impl Knobs {
             subdiv_capacity: s.subdiv_capacity,
             min_piece: s.min_piece,
             depth_split: s.depth_split,
+            tessellate: s.tessellate,
             exact_depth,
             ..self
         }

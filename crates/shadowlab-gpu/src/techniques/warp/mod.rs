@@ -235,7 +235,8 @@ pub struct WarpParams {
     /// Exact depth: pieces whose corners spread less than this (texels of world size) along the
     /// light keep the interpolated depth (`exact_tol`; 0: none)
     pub exact_tol: f32,
-    pub pad2: u32,
+    /// Queue levels before the tessellation (tess.wgsl; 0: the level queue alone, `tessellate`)
+    pub tessellate: u32,
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -305,7 +306,7 @@ pub struct Warped {
     occluders: Option<occluders::Occluders>,
     /// split_root, split_args, split_level, draw_args (none where the owner subdivides).
     split_layout: Option<wgpu::BindGroupLayout>,
-    split: Option<[wgpu::ComputePipeline; 4]>,
+    split: Option<Vec<wgpu::ComputePipeline>>,
     eval_layout: wgpu::BindGroupLayout,
     /// The evaluation and its analysis variant.
     eval: crate::technique::EvalPipelines,

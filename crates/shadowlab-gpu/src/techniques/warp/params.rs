@@ -171,6 +171,27 @@ pub const DEPTH_SPLIT: ParamDef = ParamDef::number(
     "shadowlab measurement (docs/bench/warp.md, issue 48)",
 );
 
+/// Tessellation (tess.wgsl, issue 48 step 2; the seeds draw with hardware tessellation): after
+/// this many of the level queue's levels, the pieces left are finished in two passes instead of
+/// a queue level after level: each edge gets a level from the warp's bend along it (a function
+/// of the edge alone: crack-free), each piece a regular grid of its largest level (4^level
+/// pieces; vertices on coarser edges moved to their nearest points), emitted at once. 0: the
+/// level queue alone. `notw` on courtyard, 512x512 (docs/bench/warp.md): 3 -> 22 dispatches
+/// instead of 30 and two thirds of the subdivide stage, but 6x the pieces (5.2 a texel against
+/// 0.84) and 2.7x the depth pass at +0.005 points wrong; 5 -> 2.2x the pieces; 7 -> 1.4x at the
+/// queue's wrong %. On the CPU rasteriser the pieces cost more than the dispatches save: off by
+/// default; a GPU's trade is not measured yet. Low: square grids on big pieces (many pieces,
+/// past the capacity at 1); high: the queue's dispatches.
+pub const DEFAULT_TESSELLATE: f64 = 0.0;
+pub const TESSELLATE: ParamDef = ParamDef::integer(
+    "tessellate",
+    DEFAULT_TESSELLATE,
+    0.0,
+    15.0,
+    "after this many subdivision levels, finish the pieces left as a tessellator does (a level per edge from its bend, a regular grid per piece, one emission pass: fewer dispatches, more pieces); 0 = the level queue alone",
+    "seeds 000/002: hardware tessellation; shadowlab measurement (docs/bench/warp.md, issue 48 step 2)",
+);
+
 /// Close subdivision cracks with a 3x3 depth minimum at evaluation. See `CLOSE_CRACKS`.
 pub const DEFAULT_CLOSE_CRACKS: f64 = 0.0;
 pub const CLOSE_CRACKS: ParamDef = ParamDef::flag("close_cracks", DEFAULT_CLOSE_CRACKS != 0.0, "test against the nearest depth of the 3x3 warped texels: closes the cracks adaptive subdivision leaves at T-junctions (light leaks through big occluders), grows occluders by one warped texel; 9 fetches per tap", "shadowlab measurement (docs/bench/warp.md)");

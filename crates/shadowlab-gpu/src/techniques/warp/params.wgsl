@@ -74,7 +74,8 @@ struct WarpParams {
     // exact depth: a piece whose corners spread less than this along the light's axis (texels
     // of world size) keeps the interpolated depth (depth.wgsl); 0: none
     exact_tol: f32,
-    pad2: u32,
+    // subdivision levels before the tessellation (tess.wgsl); 0: the level queue alone
+    tessellate: u32,
 }
 
 // Knobs that choose code paths, fixed per map at pipeline creation (mod.rs `Warped` passes

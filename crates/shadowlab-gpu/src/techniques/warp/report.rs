@@ -95,7 +95,17 @@ pub(super) fn subdivision_counters(a: &[u32], drawn: u32, texels: usize, p: &War
     if p.cull_hidden > 0.5 {
         c.insert("subdiv_hidden_edge_tests".into(), a[21] as f64);
     }
-    if a[19] > 0 {
+    if p.tessellate != 0 {
+        c.insert("subdiv_pieces_degenerate".into(), a[22] as f64);
+    }
+    if p.tessellate != 0 && a[19] == super::subdiv::level_count(p) {
+        r.degraded.push(format!(
+            "tessellation after level {}: the pieces did not fit the piece capacity ({}); {} pieces were drawn whole (bent edges)",
+            a[19] - 1,
+            p.extra_capacity,
+            a[20]
+        ));
+    } else if a[19] > 0 {
         r.degraded.push(format!(
             "subdivision level {} of {}: the pieces did not fit the piece capacity ({}); {} pieces were drawn unsplit (bent edges)",
             a[19], p.subdiv_levels, p.extra_capacity, a[20]
@@ -129,6 +139,15 @@ fn warp_images(t: &Warped, gpu: &Gpu, r: &mut TechniqueReport) {
 }
 
 impl Warped {
+    /// The pieces of its own subdivision the last frame drew: its triangles' slots, then the
+    /// pieces appended, each (triangle, three corners as packed unorm16 barycentrics; a queued
+    /// triangle's slot holds zero corners).
+    pub fn read_pieces(&self, gpu: &Gpu) -> Vec<[u32; 4]> {
+        let appended = gpu.read_buffer_as::<u32>(&self.counters, 1)[0].min(self.params.extra_capacity);
+        let words: Vec<u32> = gpu.read_buffer_as(&self.pieces, 4 * (self.params.triangles + appended) as usize);
+        words.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect()
+    }
+
     /// The warped shadow map's depths (res x res, 1 where nothing was drawn).
     pub fn read_map(&self, gpu: &Gpu) -> Vec<f32> {
         bytemuck::pod_collect_to_vec(&gpu.read_texture_layer(&self.map, 4, self.layer))

@@ -42,6 +42,7 @@ shadowlab_core::param_set! {
         pub subdiv_capacity: u32 = SUBDIV_CAPACITY,
         pub min_piece: f32 = MIN_PIECE,
         pub depth_split: f32 = DEPTH_SPLIT,
+        pub tessellate: u32 = TESSELLATE,
     }
 }
 
@@ -63,7 +64,7 @@ impl Subdivision {
         if self.on() {
             vec![]
         } else {
-            dead_keys(&["subdiv_levels", "subdiv_capacity", "min_piece", "depth_split"], "subdiv=0 turns subdivision off")
+            dead_keys(&["subdiv_levels", "subdiv_capacity", "min_piece", "depth_split", "tessellate"], "subdiv=0 turns subdivision off")
         }
     }
 }
@@ -220,11 +221,11 @@ pub(crate) mod tests {
     fn the_tables_keep_their_keys_in_order() {
         #[rustfmt::skip]
         let rtw = ["res", "w_dv", "w_eye", "blur", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
-            "depth_split", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin",
+            "depth_split", "tessellate", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin",
             "strength", "bias_mode", "footprint_cap", "depth_clamp"];
         #[rustfmt::skip]
         let notw = ["res", "window", "blur", "mix", "interp", "subdiv", "subdiv_levels", "subdiv_capacity", "min_piece",
-            "depth_split", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin",
+            "depth_split", "tessellate", "close_cracks", "exact_depth", "pcf", "bias", "slope_bias", "max_slope", "normal_offset", "dv_margin",
             "strength", "bias_mode", "footprint_cap", "depth_clamp", "exact_inverse", "cull_hidden", "window_tent", "edge_importance",
             "exact_tol"];
         #[rustfmt::skip]
@@ -241,6 +242,7 @@ pub(crate) mod tests {
         let e = error("notw:subdiv=0,cull_hidden=true");
         assert_eq!(e, "technique 'notw': cull_hidden has no effect: subdiv=0 turns subdivision off");
         assert!(error("notw:subdiv=0,min_piece=1,subdiv_levels=3").contains("subdiv_levels has no effect"));
+        assert!(error("rtw:subdiv=0,tessellate=3").contains("tessellate has no effect: subdiv=0"));
         assert!(error("rtw:subdiv=0,subdiv_capacity=64").contains("subdiv_capacity has no effect: subdiv=0"));
         assert!(error("notw:exact_depth=false,exact_inverse=true").contains("exact_inverse has no effect: exact_depth=false"));
         assert!(error("notw:bias_mode=0,footprint_cap=4").contains("footprint_cap has no effect: bias_mode=0"));

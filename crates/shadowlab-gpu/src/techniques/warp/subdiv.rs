@@ -14,10 +14,11 @@ use crate::technique::FrameInputs;
 use crate::{binding, Gpu, GpuError};
 
 pub(super) const SUBDIV_WGSL: &str = include_str!("subdiv.wgsl");
+pub(super) const TESS_WGSL: &str = include_str!("tess.wgsl");
 const SUBDIV_MAP_WGSL: &str = include_str!("subdiv_map.wgsl");
 
 pub(super) fn source() -> String {
-    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{SUBDIV_WGSL}{SUBDIV_MAP_WGSL}"), true)
+    compose(&format!("{PARAMS_WGSL}{LOOKUP_WGSL}{SUBDIV_WGSL}{TESS_WGSL}{SUBDIV_MAP_WGSL}"), true)
 }
 
 /// subdiv.wgsl's pipeline constants for `p`'s map over `triangles` triangles that may add
@@ -28,10 +29,44 @@ pub(super) fn constants(p: &WarpParams, triangles: u32, extra: u32) -> Vec<(&'st
     c
 }
 
+/// The level queue's passes (subdiv.wgsl), in [`record_passes`]' order.
+const QUEUE_ENTRIES: [&str; 4] = ["split_root", "split_args", "split_level", "draw_args"];
+/// With `tessellate`: the queue's first levels, then the tessellation's passes (tess.wgsl).
+const TESS_ENTRIES: [&str; 10] = [
+    "split_root",
+    "split_args",
+    "split_level",
+    "tess_begin",
+    "tess_levels",
+    "tess_args",
+    "tess_alloc",
+    "tess_emit_args",
+    "tess_emit",
+    "draw_args",
+];
+/// The subdivision's entry points for maps of `p`: the tessellation's or the level queue's.
+pub(super) fn entries(p: &WarpParams) -> &'static [&'static str] {
+    if p.tessellate != 0 {
+        &TESS_ENTRIES
+    } else {
+        &QUEUE_ENTRIES
+    }
+}
+
+/// Level uniforms (and groups after the root's) of the subdivision of maps of `p`: one a queue
+/// level, and with `tessellate` one more for the tessellation's passes.
+pub(super) fn level_count(p: &WarpParams) -> u32 {
+    if p.tessellate != 0 {
+        p.tessellate.min(p.subdiv_levels) + 1
+    } else {
+        p.subdiv_levels
+    }
+}
+
 /// The subdivision layout (the lookup, the pieces, the counters, the two queues, the level's
-/// uniform, the occluder pyramid) and its split_root, split_args, split_level and draw_args,
-/// specialised to `p` (params.wgsl's constants and `CULL_HIDDEN`).
-pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) -> (wgpu::BindGroupLayout, [wgpu::ComputePipeline; 4]) {
+/// uniform, the occluder pyramid) and its passes ([`entries`]), specialised to `p`
+/// (params.wgsl's constants and `CULL_HIDDEN`).
+pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams) -> (wgpu::BindGroupLayout, Vec<wgpu::ComputePipeline>) {
     let look = lookup_entries();
     let (ro, rw) = (binding::storage(true), binding::storage(false));
     let layout = layout_at(
@@ -42,8 +77,10 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams)
     );
     let src = source();
     let constants = constants(p, p.triangles, p.extra_capacity);
-    let pipelines = ["split_root", "split_args", "split_level", "draw_args"]
-        .map(|e| gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout], &constants));
+    let pipelines = entries(p)
+        .iter()
+        .map(|e| gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout], &constants))
+        .collect();
     (layout, pipelines)
 }
 
@@ -151,13 +188,14 @@ pub(super) struct Buffers<'a> {
     pub dispatch: &'a wgpu::Buffer,
 }
 
-/// The subdivision's passes (split_root over `triangles`, then each level's split_args and
-/// indirect split_level, then draw_args) with `groups[l]` for level l (0: the root and the
-/// draw arguments), over the scene of `scene_group`.
+/// The subdivision's passes over the scene of `scene_group`: split_root over `triangles`, each
+/// queue level's split_args and indirect split_level with `groups[l]` for level l, with
+/// `tessellate` ([`TESS_ENTRIES`]) the tessellation's passes with the last group, and draw_args
+/// (`groups[0]`: the root's).
 pub(super) fn record_passes(
     gpu: &Gpu,
     enc: &mut wgpu::CommandEncoder,
-    split: &[wgpu::ComputePipeline; 4],
+    split: &[wgpu::ComputePipeline],
     groups: &[wgpu::BindGroup],
     scene_group: &wgpu::BindGroup,
     b: Buffers,
@@ -175,14 +213,32 @@ pub(super) fn record_passes(
             None => gpu.dispatch_indirect(&mut pass, b.dispatch, 0),
         }
     };
+    // a level's input queue's group counts, out of the storage buffer into the indirect one
+    let queue_groups = |enc: &mut wgpu::CommandEncoder, l: usize| {
+        enc.copy_buffer_to_buffer(b.counters, 32 + 16 * ((l as u64 + 1) % 2) + 4, b.dispatch, 0, 12)
+    };
+    let tess = split.len() == TESS_ENTRIES.len();
+    let levels = groups.len() - 1 - tess as usize;
     pass(enc, &groups[0], 0, Some(n));
-    for (l, g) in groups.iter().enumerate().skip(1) {
+    for (l, g) in groups.iter().enumerate().take(levels + 1).skip(1) {
         pass(enc, g, 1, Some(1));
-        // the input queue's group counts, out of the storage buffer into the indirect one
-        enc.copy_buffer_to_buffer(b.counters, 32 + 16 * ((l as u64 + 1) % 2) + 4, b.dispatch, 0, 12);
+        queue_groups(enc, l);
         pass(enc, g, 2, None);
     }
-    pass(enc, &groups[0], 3, Some(1));
+    if tess {
+        // tess_begin sets the queued pieces' groups (for tess_levels and tess_alloc), then
+        // tess_emit_args the emission's (tess.wgsl: counters 13-15, one group a chunk)
+        let (l, g) = (levels + 1, &groups[levels + 1]);
+        pass(enc, g, 3, Some(1));
+        queue_groups(enc, l);
+        pass(enc, g, 4, None);
+        pass(enc, g, 5, Some(1));
+        pass(enc, g, 6, None);
+        pass(enc, g, 7, Some(1));
+        enc.copy_buffer_to_buffer(b.counters, 52, b.dispatch, 0, 12);
+        pass(enc, g, 8, None);
+    }
+    pass(enc, &groups[0], split.len() - 1, Some(1));
 }
 
 /// A subdivision's counters (subdiv.wgsl's 1048 words and `extra` more), which the depth passes
@@ -235,7 +291,7 @@ pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, liste
     // at least one per triangle: the root finishes up to one extra piece per triangle (the
     // second half of a triangle cut by the near plane) before any level can check
     let extra = if on { wanted.max(tris as u64).min(most) as u32 } else { 0 };
-    let queue = if on { queue_capacity(tris, max_binding, listed) } else { 0 };
+    let queue = if on { queue_capacity(tris, max_binding, listed, (k.tessellate > 0).then_some(extra)) } else { 0 };
     // the triangle index keeps 3 bits free for the split mask
     if on && (2 * tris as u64 > queue as u64 || tris >= 1 << 29) {
         return Err(GpuError::Invalid(format!(
@@ -248,7 +304,11 @@ pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, liste
 
 /// Entries of each level queue of the subdivision of `tris` triangles ([`capacity`]): the root
 /// queues up to two pieces per triangle (a triangle cut by the near plane); several maps at once
-/// (`listed` texels) at least one a texel of all, as their own queues of 2^20 held them.
-pub(super) fn queue_capacity(tris: u32, max_binding: u64, listed: Option<u64>) -> u32 {
-    (2 * tris as u64).max(1 << 20).max(listed.unwrap_or(0)).min(max_binding / 16) as u32
+/// (`listed` texels) at least one a texel of all, as their own queues of 2^20 held them. The
+/// tessellation (`tess_extra`: its piece capacity) keeps its chunks' words after the queued
+/// pieces: one a root piece and one per 64 pieces, four an entry.
+pub(super) fn queue_capacity(tris: u32, max_binding: u64, listed: Option<u64>, tess_extra: Option<u32>) -> u32 {
+    let roots = 2 * tris as u64;
+    let tess = tess_extra.map_or(0, |e| roots + (roots + e as u64 / 64).div_ceil(4) + 1);
+    roots.max(1 << 20).max(listed.unwrap_or(0)).max(tess).min(max_binding / 16) as u32
 }

@@ -145,18 +145,23 @@ fn edge_needs_split(a: Corner, b: Corner, r: vec4<f32>) -> bool {
     let wa = a.w;
     let wb = b.w;
     let e = edge_error(ua, ub, wa, wb);
-    if e <= wp.subdiv {
+    return e > wp.subdiv && !edge_hidden(a, b, e);
+}
+
+// Whether a bent edge (e warped texels) lies behind nearer occluders (`cull_hidden`; counted):
+// its unsplit chord strays up to e warped texels from the curve, which is about
+// e * (base length / warped length) cropped texels; twice that plus HIDDEN_MARGIN.
+fn edge_hidden(a: Corner, b: Corner, e: f32) -> bool {
+    if !CULL_HIDDEN || PARABOLOID {
         return false;
     }
-    // hidden: the unsplit edge's chord strays up to e warped texels from the curve, which is
-    // about e * (base length / warped length) cropped texels; twice that plus HIDDEN_MARGIN
-    let rho = length(ub - ua) / max(length(wb - wa), 1e-12);
+    let rho = length(b.u - a.u) / max(length(b.w - a.w), 1e-12);
     let m = (HIDDEN_MARGIN + 2.0 * e * rho) / wp.res;
-    if hidden(min(ua, ub) - m, max(ua, ub) + m, min(clip_to_map(a.clip).z, clip_to_map(b.clip).z)) {
+    if hidden(min(a.u, b.u) - m, max(a.u, b.u) + m, min(clip_to_map(a.clip).z, clip_to_map(b.clip).z)) {
         atomicAdd(&counters[21], 1u);
-        return false;
+        return true;
     }
-    return true;
+    return false;
 }
 
 // Whether every point of the DV-cropped rectangle [lo, hi] holds an occluder nearer than z (the
@@ -327,34 +332,30 @@ fn mix_corner(a: u32, b: u32, t: f32) -> u32 {
 // A whole triangle's corners as packed barycentrics: (0, 0), (1, 0), (0, 1).
 const ROOT_CORNERS = array<u32, 3>(0u, 0xffffu, 0xffff0000u);
 
-// Planar projections: the triangle clipped to the light's near plane (clip z >= 0) before any
-// warping, because the warp of a vertex behind a spot light is meaningless (its projection
-// flips) and one such vertex spreads its triangle across the whole map. Clip space is affine in
-// world space, so the cut corners are exact barycentric mixes. Wholly behind: nothing drawn;
-// a cut leaving a quad: its second half is appended like a finished piece.
-@compute @workgroup_size(64)
-fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
-    let tri = (wg.y * 65535u + wg.x) * 64u + l;
-    if tri >= TRIANGLES {
-        return;
-    }
-    enter_triangle(tri);
-    if no_samples() {
-        // no view sample on the map (an empty cube face): nothing evaluates it, nothing is drawn
-        return;
-    }
+// A triangle's root pieces: the whole triangle, or for planar projections the triangle
+// clipped to the light's near plane (clip z >= 0) before any warping, because the warp of a
+// vertex behind a spot light is meaningless (its projection flips) and one such vertex spreads
+// its triangle across the whole map. Clip space is affine in world space, so the cut corners are
+// exact barycentric mixes. Wholly behind: none; a cut leaving a quad: two.
+struct Roots {
+    n: u32,
+    p: array<vec4<u32>, 2>,
+}
+
+fn root_pieces(tri: u32) -> Roots {
     let c = ROOT_CORNERS;
+    var r: Roots;
+    r.p[0] = vec4<u32>(tri, c[0], c[1], c[2]);
+    r.n = 1u;
     if PARABOLOID {
-        place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
-        return;
+        return r;
     }
     var z: array<f32, 3>;
     for (var i = 0u; i < 3u; i++) {
         z[i] = base_clip(wp, corner_pos(tri, c[i])).z;
     }
     if min(min(z[0], z[1]), z[2]) >= 0.0 {
-        place_root(tri, vec4<u32>(tri, c[0], c[1], c[2]));
-        return;
+        return r;
     }
     var poly: array<u32, 4>;
     var n = 0u;
@@ -369,13 +370,33 @@ fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
             n += 1u;
         }
     }
-    if n < 3u {
+    r.n = select(n - 2u, 0u, n < 3u);
+    r.p[0] = vec4<u32>(tri, poly[0], poly[1], poly[2]);
+    r.p[1] = vec4<u32>(tri, poly[0], poly[2], poly[3]);
+    return r;
+}
+
+// Each triangle's first root piece is kept in its own slot or queued; the second half of a quad
+// is finished like a piece or queued; a triangle wholly behind the light leaves its slot empty.
+@compute @workgroup_size(64)
+fn split_root(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l: u32) {
+    let tri = (wg.y * 65535u + wg.x) * 64u + l;
+    if tri >= TRIANGLES {
+        return;
+    }
+    enter_triangle(tri);
+    if no_samples() {
+        // no view sample on the map (an empty cube face): nothing evaluates it, nothing is drawn
+        return;
+    }
+    let r = root_pieces(tri);
+    if r.n == 0u {
         pieces[tri] = vec4<u32>(tri, 0u, 0u, 0u);
         return;
     }
-    place_root(tri, vec4<u32>(tri, poly[0], poly[1], poly[2]));
-    if n == 4u {
-        let q = vec4<u32>(tri, poly[0], poly[2], poly[3]);
+    place_root(tri, r.p[0]);
+    if r.n == 2u {
+        let q = r.p[1];
         let mq = split_mask(q);
         if mq != 0u {
             enqueue(q, mq, 0u);

@@ -10,7 +10,7 @@
 
 use super::layers::{LAYER_BIND_WGSL, LAYER_WARPS_WGSL};
 use super::occluders::Pyramid;
-use super::subdiv::{self, Buffers, SUBDIV_WGSL};
+use super::subdiv::{self, Buffers, SUBDIV_WGSL, TESS_WGSL};
 use super::{report, LayerPasses, Layers, WarpParams, Warped, LOOKUP_FNS_WGSL, PARAMS_WGSL};
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
@@ -43,7 +43,10 @@ fn header(ends: &[u32]) -> String {
 /// The subdivision over layers ending at `ends` (subdiv.wgsl with subdiv_layers.wgsl).
 pub fn layered_subdivision_source(ends: &[u32]) -> String {
     let h = header(ends);
-    compose(&format!("{h}{PARAMS_WGSL}{LAYER_BIND_WGSL}{LAYER_WARPS_WGSL}{LOOKUP_FNS_WGSL}{SUBDIV_WGSL}{SUBDIV_LAYERS_WGSL}"), true)
+    compose(
+        &format!("{h}{PARAMS_WGSL}{LAYER_BIND_WGSL}{LAYER_WARPS_WGSL}{LOOKUP_FNS_WGSL}{SUBDIV_WGSL}{TESS_WGSL}{SUBDIV_LAYERS_WGSL}"),
+        true,
+    )
 }
 
 /// The scatter of the finished pieces to the layers' lists.
@@ -98,8 +101,8 @@ pub struct LayerSubdivision {
     queues: [wgpu::Buffer; 2],
     counters: wgpu::Buffer,
     dispatch: wgpu::Buffer,
-    /// split_root, split_args, split_level, draw_args; one group a level (0: the root).
-    split: [wgpu::ComputePipeline; 4],
+    /// The subdivision's passes (subdiv::entries); one group a level (0: the root).
+    split: Vec<wgpu::ComputePipeline>,
     groups: Vec<wgpu::BindGroup>,
     scatter: wgpu::ComputePipeline,
     scatter_group: wgpu::BindGroup,
@@ -127,8 +130,9 @@ impl LayerSubdivision {
         // the maps were planned for it (build.rs: subdiv::capacity with their layers' texels)
         let extra = params[0].extra_capacity;
         assert!(params.iter().all(|p| (p.triangles, p.extra_capacity) == (triangles, extra)), "{name}: maps planned for this subdivision");
-        let queue = subdiv::queue_capacity(triangles, gpu.limits.max_storage_buffer_binding_size, Some(layers.texels()));
-        let levels = params[0].subdiv_levels;
+        let tess = (params[0].tessellate != 0).then_some(extra);
+        let queue = subdiv::queue_capacity(triangles, gpu.limits.max_storage_buffer_binding_size, Some(layers.texels()), tess);
+        let levels = subdiv::level_count(&params[0]);
         let array = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: false },
             view_dimension: wgpu::TextureViewDimension::D2Array,
@@ -155,8 +159,10 @@ impl LayerSubdivision {
             ("FLAT_SPLIT", flag(flat_split(&params[0]))),
         ]);
         let src = layered_subdivision_source(ends);
-        let split = ["split_root", "split_args", "split_level", "draw_args"]
-            .map(|e| gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout], &constants));
+        let split = subdiv::entries(&params[0])
+            .iter()
+            .map(|e| gpu.compute_pipeline_with(&format!("{name}.{e}"), &src, e, &[&layout, &scene.layout], &constants))
+            .collect();
         let scatter_layout = binding::layout(&gpu.device, &format!("{name}.scatter"), wgpu::ShaderStages::COMPUTE, &[rw, rw]);
         let scatter = gpu.compute_pipeline_with(
             &format!("{name}.scatter"),
