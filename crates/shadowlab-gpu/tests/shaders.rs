@@ -344,7 +344,7 @@ fn warp_struct_layouts_match_rust() {
             size_of::<WarpParams>(),
             fields!(WarpParams; light_view_proj, texel_world, perspective, res, pcf, bias, slope_bias, normal_offset, max_slope,
                 dv_margin, dv_mode, warped, window, w_dv, w_eye, blur, subdiv, triangles, subdiv_levels, extra_capacity,
-                rtw_importance, interp, mix, exact_depth, projection, strength, bias_mode, footprint_cap, depth_clamp, min_piece, exact_inverse, cull_hidden, tent, edge_importance, depth_split, exact_tol, tessellate),
+                rtw_importance, interp, mix, exact_depth, projection, strength, bias_mode, footprint_cap, depth_clamp, min_piece, exact_inverse, cull_hidden, tent, edge_importance, depth_split, exact_tol, tessellate, scene_triangles, pad0, pad1, pad2),
         );
     }
     check(

@@ -81,7 +81,7 @@ impl CubeNotw {
         for (f, face) in FACES.iter().enumerate() {
             // one face = a spot light along the axis whose fitted frustum is the face's square
             let light = Light::Spot { position, direction: face.n, cone_deg: 45.0 };
-            let mut warped = Warped::new_layer(gpu, &faces_scene, &knobs, &light, None, &layers, f as u32)?;
+            let mut warped = Warped::new_layer(gpu, &faces_scene, &knobs, &light, &layers, f as u32)?;
             warped.draw_triangles(if f == 0 { 0 } else { ends[f - 1] }..ends[f]);
             let light_buf = gpu.uniform(&format!("cube-notw.light{f}"), &LightUniform::new(&light, scene.eps));
             faces.push(Face { warped, light, light_buf });

@@ -10,8 +10,10 @@
 //!
 //! Both are two instances of the warping module's `Warped` in its paraboloid projection mode
 //! (warp/params.wgsl `base_clip`), each drawing into its layer of shared array textures
-//! (`warp::Layers`): no pass is duplicated here. One evaluation reads both maps, each view sample
-//! through the map of its hemisphere (warp/params.wgsl `owns_sample`, eval_maps.wgsl).
+//! (`warp::Layers`): no pass is duplicated here. One subdivision makes both maps' pieces
+//! (`warp::LayerSubdivision` over a copy of the scene's triangle indices a hemisphere, the scene
+//! itself the frame's), one evaluation reads both maps, each view sample through the map of its
+//! hemisphere (warp/params.wgsl `owns_sample`, eval_maps.wgsl).
 
 use shadowlab_core::light::Light;
 use shadowlab_core::metrics::sampling_stats;
@@ -22,7 +24,7 @@ use shadowlab_core::techniques::dpsm::{split_axis, DualParaboloid, Hemisphere, S
 use crate::record::Recorder;
 use crate::scene_gpu::GpuScene;
 use crate::technique::{FrameInputs, Technique, TechniqueInfo, TechniqueReport};
-use crate::techniques::warp::{self, Knobs, LayerPasses, Layers, NotwCore, Projection, Subdivision, Warped};
+use crate::techniques::warp::{self, Knobs, LayerPasses, LayerSubdivision, Layers, NotwCore, Projection, Subdivision, Warped};
 use crate::{Gpu, GpuError};
 
 /// Side of each hemisphere's map (texels). The setting: 512 per hemisphere against
@@ -166,7 +168,8 @@ shadowlab_core::param_set! {
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "dpsm",
     summary: "dual-paraboloid shadow maps: two hemisphere depth maps of a point light, paraboloid mapping per vertex after GPU subdivision",
-    cost: "subdivision + two depth passes over the scene, one evaluation of both maps; 2 w^2 x 4 bytes; N^2 fetches per pixel",
+    cost:
+        "one subdivision of the scene for both maps + two depth passes, one evaluation of both maps; 2 w^2 x 4 bytes; N^2 fetches per pixel",
     quality: "resolution fixed per solid angle (twice as fine at the rim as at the centre), blind to the view: aliasing near the camera",
     source: "Brabec, Annen, Seidel 2002; seed 002 section 3.3.2 (eq. 3.3-3.10)",
     lights: &["point"],
@@ -182,7 +185,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 pub const NOTW_INFO: TechniqueInfo = TechniqueInfo {
     name: "dpsm-notw",
     summary: "dual-paraboloid maps warped by NoTW per hemisphere: desired view, count map, row and column warps of each hemisphere's view samples",
-    cost: "one pass each over the view for both hemispheres' desired views, count maps and evaluation, one dispatch a step of notw's analysis for both; per hemisphere a subdivision + warped depth pass; 2 x (4 + 8) w^2 bytes",
+    cost: "one pass each over the view for both hemispheres' desired views, count maps and evaluation, one dispatch a step of notw's analysis for both, one subdivision of the scene for both; per hemisphere a warped depth pass; 2 x (4 + 8) w^2 bytes",
     quality: "the view samples of each hemisphere spread over its whole map; seam at the split plane",
     source: "seed 002 section 5.3 (DPSM with NoTW), seed 000 section 3",
     lights: &["point"],
@@ -216,6 +219,8 @@ pub struct Dpsm {
     /// desired views of `dpsm-notw`, the evaluation).
     layers: Layers,
     passes: LayerPasses,
+    /// Both hemispheres' subdivision (`subdiv` > 0), before either draws.
+    subdivision: Option<LayerSubdivision>,
     warped: bool,
     res: u32,
     pcf: u32,
@@ -244,19 +249,27 @@ impl Dpsm {
         let dp = DualParaboloid::fit(position, axis, &scene.bounds)
             .ok_or_else(|| GpuError::Invalid(format!("{name}: light position {position} or scene bounds not usable")))?;
         let labels: [&'static str; 2] = if warped { ["dpsm-notw.front", "dpsm-notw.back"] } else { ["dpsm.front", "dpsm.back"] };
-        // dpsm-notw: both desired views, count maps and warps made together (dpsm crops none)
-        let layers = Layers::new(gpu, name, k, 2, warped, false);
+        // dpsm-notw: both desired views, count maps and warps made together (dpsm crops none);
+        // one subdivision of the scene for both hemispheres (a copy of it each)
+        let subdivides = k.subdiv > 0.0;
+        let layers = Layers::new(gpu, name, k, 2, warped, subdivides).repeating_scene();
         let make = |i: usize| {
             let h = Hemisphere::BOTH[i];
             let proj = Projection::Paraboloid { view: dp.view(h), hemisphere: h };
             Warped::with_projection_in(gpu, scene, k, proj, labels[i], Some((&layers, i as u32)))
         };
-        // the hemispheres render one after another: one set of subdivision buffers for both
-        let mut front = make(0)?;
-        let mut back = make(1)?;
-        back.borrow_subdiv(&front.subdiv_scratch());
-        let passes = LayerPasses::new(gpu, name, &layers, &[&front, &back], "", EVAL_MAPS_WGSL);
-        Ok(Dpsm { maps: [front, back], layers, passes, warped, res, pcf })
+        let mut maps = [make(0)?, make(1)?];
+        let passes = LayerPasses::new(gpu, name, &layers, &[&maps[0], &maps[1]], "", EVAL_MAPS_WGSL);
+        let t = scene.triangle_count;
+        let subdivision = subdivides
+            .then(|| LayerSubdivision::new(gpu, name, &layers, &passes, &[&maps[0], &maps[1]], scene, &[t, 2 * t]))
+            .transpose()?;
+        if let Some(s) = &subdivision {
+            for (i, m) in maps.iter_mut().enumerate() {
+                m.draw_owner_pieces(s.draw(i));
+            }
+        }
+        Ok(Dpsm { maps, layers, passes, subdivision, warped, res, pcf })
     }
 }
 
@@ -271,6 +284,9 @@ impl Technique for Dpsm {
     }
 
     fn render(&mut self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) -> Result<(), GpuError> {
+        if let Some(s) = &self.subdivision {
+            s.record(gpu, rec, &f.scene.group);
+        }
         for m in &mut self.maps {
             m.render(gpu, f, rec)?;
         }
@@ -291,6 +307,8 @@ impl Technique for Dpsm {
     fn report(&mut self, gpu: &Gpu) -> TechniqueReport {
         let n = (self.res * self.res) as u64;
         let mut r = TechniqueReport::default();
+        // the subdivision's counters over both maps, and the pieces each drew
+        let pieces = self.subdivision.as_ref().map(|s| s.report(gpu, 2 * n as usize, &mut r));
         let mut all_counts = Vec::with_capacity(2 * n as usize);
         let mut total_samples = [0u64; 2];
         for (i, m) in self.maps.iter_mut().enumerate() {
@@ -301,7 +319,7 @@ impl Technique for Dpsm {
             total_samples[i] = counts.iter().map(|&c| c as u64).sum();
             all_counts.extend_from_slice(&counts);
             for (k, v) in sub.counters {
-                if k.starts_with("subdiv_") || k.ends_with("_before_warp") || k == "dv_area_fraction" {
+                if k.ends_with("_before_warp") || k == "dv_area_fraction" {
                     r.counters.insert(format!("{h}.{k}"), v);
                 } else if k == "exact_depth_fragments" {
                     *r.counters.entry(k).or_default() += v;
@@ -314,6 +332,10 @@ impl Technique for Dpsm {
                 }
                 img.name = format!("{h} hemisphere: {}", img.name);
                 r.images.push(img);
+            }
+            if let Some(p) = &pieces {
+                r.counters.insert(format!("{h}.subdiv_triangles_drawn"), p[i] as f64);
+                r.counters.insert(format!("{h}.subdiv_pieces_per_texel"), p[i] as f64 / n as f64);
             }
             let s = sampling_stats(&counts);
             r.counters.insert(format!("{h}.used_texel_fraction"), s.used_texel_fraction);
@@ -330,8 +352,9 @@ impl Technique for Dpsm {
         let frags = *c.entry("exact_depth_fragments".into()).or_default();
         c.insert("exact_depth_fragments_per_texel".into(), frags / (2 * n) as f64);
         c.insert("warp_bytes".into(), warp_bytes as f64);
-        // work buffers of both maps + the one shared set of subdivision buffers
-        c.insert("scratch_bytes".into(), self.maps.iter().map(|m| m.scratch_bytes()).sum::<u64>() as f64);
+        // work buffers of both maps + their one subdivision
+        let maps: u64 = self.maps.iter().map(|m| m.scratch_bytes()).sum();
+        c.insert("scratch_bytes".into(), (maps + self.subdivision.as_ref().map_or(0, |s| s.bytes())) as f64);
         let sum = (total_samples[0] + total_samples[1]).max(1) as f64;
         c.insert("front.sample_fraction".into(), total_samples[0] as f64 / sum);
         r

@@ -9,7 +9,7 @@ use shadowlab_core::techniques::dpsm::Hemisphere;
 
 use super::layers::r32_array;
 use super::{analyze, depth, eval, occluders, subdiv};
-use super::{Groups, Knobs, Layers, Projection, SubdivScratch, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
+use super::{Groups, Knobs, Layers, Projection, Variant, WarpParams, Warped, DV_CROP, DV_CROP_CLOSED};
 use crate::prefix_sum::PrefixSum;
 use crate::scene_gpu::GpuScene;
 use crate::technique::EvalPipelines;
@@ -19,47 +19,23 @@ impl Warped {
     /// A planar warped map of a directional or spot light, with the knobs of `rtw`, `notw` or
     /// `notw-dv` ([`Knobs::rtw`], [`Knobs::notw`], [`Knobs::dv`]).
     pub fn new(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light) -> Result<Warped, GpuError> {
-        Warped::new_sharing(gpu, scene, k, light, None)
+        Warped::planar(gpu, scene, k, light, None)
     }
 
-    /// `new`, borrowing `shared`'s subdivision buffers when they are large enough.
-    pub fn new_sharing(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light, shared: Option<&SubdivScratch>) -> Result<Warped, GpuError> {
-        Warped::planar(gpu, scene, k, light, shared, None)
+    /// `new`, drawing into layer `layer` of `layers` (warps, map, DV bounds and counts),
+    /// evaluated with the others by the caller ([`super::LayerPasses`]).
+    pub fn new_layer(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light, layers: &Layers, layer: u32) -> Result<Warped, GpuError> {
+        Warped::planar(gpu, scene, k, light, Some((layers, layer)))
     }
 
-    /// `new_sharing`, drawing into layer `layer` of `layers` (warps, map, DV bounds and
-    /// counts), evaluated with the others by the caller ([`super::LayerPasses`]).
-    pub fn new_layer(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        k: &Knobs,
-        light: &Light,
-        shared: Option<&SubdivScratch>,
-        layers: &Layers,
-        layer: u32,
-    ) -> Result<Warped, GpuError> {
-        Warped::planar(gpu, scene, k, light, shared, Some((layers, layer)))
-    }
-
-    fn planar(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        k: &Knobs,
-        light: &Light,
-        shared: Option<&SubdivScratch>,
-        target: Option<(&Layers, u32)>,
-    ) -> Result<Warped, GpuError> {
+    fn planar(gpu: &Gpu, scene: &GpuScene, k: &Knobs, light: &Light, target: Option<(&Layers, u32)>) -> Result<Warped, GpuError> {
         let name = k.variant.name();
         let res = k.res;
         gpu.check_size(res, res, "shadow map")?;
         let lp = lightspace::fit(light, &scene.bounds, res).ok_or_else(|| {
             GpuError::Invalid(format!("{name} supports directional and spot lights (point lights: cube/paraboloid maps)"))
         })?;
-        let mut w = Warped::with_projection_in(gpu, scene, k, Projection::Planar(lp), name, target)?;
-        if let Some(s) = shared {
-            w.borrow_subdiv(s);
-        }
-        Ok(w)
+        Warped::with_projection_in(gpu, scene, k, Projection::Planar(lp), name, target)
     }
 
     /// A warped map over `proj`, labelled `name` (wgpu labels, stage names `{name}.<stage>`),
@@ -81,8 +57,11 @@ impl Warped {
         name: &'static str,
         target: Option<(&Layers, u32)>,
     ) -> Result<Warped, GpuError> {
-        let listed = target.filter(|(l, _)| l.owner_subdivides).map(|(l, _)| l.texels());
-        let plan = Plan::new(k, proj, name, scene.triangle_count, gpu.limits.max_storage_buffer_binding_size, listed)?;
+        let owner = target.filter(|(l, _)| l.owner_subdivides).map(|(l, _)| l);
+        let listed = owner.map(|l| l.listed_texels());
+        // one copy of the scene a layer in the owner's subdivision (Layers::repeating_scene)
+        let copies = owner.filter(|l| l.repeats_scene).map_or(1, |l| l.count());
+        let plan = Plan::new(k, proj, name, (scene.triangle_count, copies), gpu.limits.max_storage_buffer_binding_size, listed)?;
         // the map's own subdivision (else its owner's, LayerSubdivision)
         let own_subdiv = plan.subdiv && !target.is_some_and(|(l, _)| l.owner_subdivides);
         let resources = Resources::new(gpu, &plan, target, own_subdiv);
@@ -130,7 +109,6 @@ impl Warped {
             counters: r.counters,
             queues: r.queues,
             owns_subdiv: true,
-            shares_subdiv: false,
             owner_draw: None,
             range: None,
             dispatch: r.dispatch,
@@ -168,15 +146,23 @@ struct Plan {
 }
 
 impl Plan {
-    /// `k` for `proj` over `tris` triangles, on a device whose storage bindings hold at most
-    /// `max_binding` bytes. Errors: subdivision queues beyond that limit.
+    /// `k` for `proj` over a scene of `tris` triangles, subdivided `copies` times (once per
+    /// layer of an owner's subdivision over one scene, else 1), on a device whose storage
+    /// bindings hold at most `max_binding` bytes. Errors: subdivision queues beyond that limit.
     /// `listed`: subdivided by its owner with other maps of these texels in all (the capacity of
     /// that subdivision).
-    fn new(k: &Knobs, proj: Projection, name: &'static str, tris: u32, max_binding: u64, listed: Option<u64>) -> Result<Plan, GpuError> {
+    fn new(
+        k: &Knobs,
+        proj: Projection,
+        name: &'static str,
+        (tris, copies): (u32, u32),
+        max_binding: u64,
+        listed: Option<u64>,
+    ) -> Result<Plan, GpuError> {
         let base = BaseProjection::of(proj, k.res);
         assert_eq!(k.paraboloid, base.kind != 0, "{name}: knobs made for another projection");
-        let (subdiv, extra, queue) = subdiv::capacity(k, name, tris, max_binding, listed)?;
-        let params = uniform(k, &base, tris, extra);
+        let (subdiv, extra, queue) = subdiv::capacity(k, name, tris * copies, max_binding, listed)?;
+        let params = WarpParams { scene_triangles: tris, ..uniform(k, &base, tris * copies, extra) };
         let occluders = k.cull_hidden || k.edge_importance > 0;
         Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, occluders })
     }
@@ -251,6 +237,10 @@ fn uniform(k: &Knobs, base: &BaseProjection, tris: u32, extra: u32) -> WarpParam
         depth_split: k.depth_split,
         exact_tol: k.exact_tol,
         tessellate: k.tessellate,
+        scene_triangles: tris,
+        pad0: 0,
+        pad1: 0,
+        pad2: 0,
     }
 }
 

@@ -166,9 +166,8 @@ impl Warped {
     /// a paraboloid's split plane or cut out, and those of pieces without a plane or within
     /// `exact_tol`, not counted): its draw again, with the depth test off, under an occlusion
     /// query (the map is kept).
-    /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame. A map whose
-    /// subdivision buffers are shared (dpsm's hemispheres: after the frame they hold another
-    /// map's pieces) subdivides again first; `cube-notw`'s faces keep theirs listed.
+    /// 0 without `exact_depth` (no fragment inverts the warp); None before a frame. Maps
+    /// subdivided by their owner (`cube-notw`'s faces, `dpsm`'s hemispheres) keep theirs listed.
     pub(super) fn exact_depth_fragments(&self, gpu: &Gpu) -> Option<u64> {
         let (scene_group, triangles) = self.scene.last.as_ref()?;
         if self.params.exact_depth == 0 {
@@ -191,11 +190,6 @@ impl Warped {
         });
         let depth_group = self.depth_group(gpu);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        if self.shares_subdiv && self.params.subdiv > 0.0 {
-            // the shared pieces hold the last map's: this map's again (the same pieces as in
-            // its frame: the subdivision is a function of the warps, the crop and the scene)
-            self.record_subdivision(gpu, &mut enc, scene_group);
-        }
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("warp.exact_count"),

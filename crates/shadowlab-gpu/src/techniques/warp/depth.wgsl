@@ -57,7 +57,8 @@ fn bary_pos(tri: u32, b: vec2<f32>) -> vec3<f32> {
 
 // Piece i of the subdivision: its slot, or past the slots (the triangles' and the pieces they
 // may add) entry i - slots of the lists of a layered subdivision (subdiv_scatter.wgsl), four a
-// slot; without the flat mark of a layered subdivision's pieces (subdiv_layers.wgsl).
+// slot; without the flat mark of a layered subdivision's pieces (subdiv_layers.wgsl), and with
+// the scene's triangle (`scene_triangles`).
 fn piece_at(i: u32) -> vec4<u32> {
     let slots = wp.triangles + wp.extra_capacity;
     var p: vec4<u32>;
@@ -67,7 +68,7 @@ fn piece_at(i: u32) -> vec4<u32> {
         let k = i - slots;
         p = pieces[pieces[slots + k / 4u][k % 4u]];
     }
-    return vec4<u32>(p.x & 0x7fffffffu, p.yzw);
+    return vec4<u32>(scene_triangle(wp, p.x & 0x7fffffffu), p.yzw);
 }
 
 // Corner c of a subdivision piece (triangle, three unorm16x2 barycentrics; subdiv.wgsl).

@@ -34,6 +34,9 @@ pub struct Layers {
     pub(super) owner_reads_view: bool,
     /// The maps are subdivided together ([`super::LayerSubdivision`]), not by each map.
     pub(super) owner_subdivides: bool,
+    /// Every layer draws the whole scene, subdivided by the owner as one copy a layer
+    /// ([`Layers::repeating_scene`]).
+    pub(super) repeats_scene: bool,
     pub(super) warp_x: wgpu::Texture,
     pub(super) warp_y: wgpu::Texture,
     pub(super) map: wgpu::Texture,
@@ -81,6 +84,7 @@ impl Layers {
             count,
             owner_reads_view,
             owner_subdivides,
+            repeats_scene: false,
             hzb: pyramids.then(|| gpu.storage(&format!("{name}.hzb"), hzb_stride * count as u64)),
             hzb_stride,
             work: counted.then(|| gpu.storage(&format!("{name}.work"), work_stride * count as u64)),
@@ -97,9 +101,29 @@ impl Layers {
         }
     }
 
+    /// Every layer draws the whole scene (`dpsm`'s hemispheres): the owner's subdivision
+    /// ([`super::LayerSubdivision`]) numbers layer k's triangle t as k * triangles + t, the
+    /// scene stays the frame's (cube-notw's faces instead draw one scene of their clipped
+    /// triangles, a range each).
+    pub fn repeating_scene(mut self) -> Layers {
+        self.repeats_scene = true;
+        self
+    }
+
     /// The layers' count.
     pub fn count(&self) -> u32 {
         self.count
+    }
+
+    /// Texels of the layers whose triangles are their own, for the owner's subdivision's
+    /// capacity (subdiv::capacity; 0 with [`Layers::repeating_scene`]: a copy of the scene a
+    /// layer is sized by its triangles, as one map's).
+    pub(super) fn listed_texels(&self) -> u64 {
+        if self.repeats_scene {
+            0
+        } else {
+            self.texels()
+        }
     }
 
     /// Texels of all layers' maps.

@@ -40,7 +40,6 @@ pub use knobs::Knobs;
 pub use layers::{layered_analysis_source, layered_count_source, layered_dv_source, layered_eval_source, LayerPasses, Layers};
 pub use params::*;
 pub use settings::*;
-pub use subdiv::SubdivScratch;
 pub use subdiv_layers::{layered_scatter_source, layered_subdivision_source, LayerDraw, LayerSubdivision};
 
 use bytemuck::{Pod, Zeroable};
@@ -237,6 +236,12 @@ pub struct WarpParams {
     pub exact_tol: f32,
     /// Queue levels before the tessellation (tess.wgsl; 0: the level queue alone, `tessellate`)
     pub tessellate: u32,
+    /// The scene's triangles (a subdivision over several maps of one scene numbers map k's
+    /// triangle t as k * scene_triangles + t: `dpsm`'s hemispheres)
+    pub scene_triangles: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// One light's warped shadow map with its warps and scratch buffers.
@@ -279,10 +284,8 @@ pub struct Warped {
     pieces: wgpu::Buffer,
     counters: wgpu::Buffer,
     queues: [wgpu::Buffer; 2],
-    /// Whether `pieces` and `queues` were allocated here (false: lent by another map).
+    /// Whether `pieces` and `queues` were allocated here (false: its owner's, `owner_draw`).
     owns_subdiv: bool,
-    /// Whether `pieces` is lent or borrowed: after the frame it holds the last map's pieces.
-    shares_subdiv: bool,
     /// Subdivided by its owner with the other layers ([`LayerSubdivision`]): its share, drawn
     /// instead of its own pieces (its own subdivision buffers and pipelines are not made).
     owner_draw: Option<LayerDraw>,

@@ -76,6 +76,12 @@ struct WarpParams {
     exact_tol: f32,
     // subdivision levels before the tessellation (tess.wgsl); 0: the level queue alone
     tessellate: u32,
+    // the scene's triangles: a subdivision of several maps over one scene (dpsm's hemispheres,
+    // warp::LayerSubdivision) numbers map k's triangle t as k * scene_triangles + t
+    scene_triangles: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // Knobs that choose code paths, fixed per map at pipeline creation (mod.rs `Warped` passes
@@ -95,6 +101,11 @@ const DV_SCALE: f32 = 16777216.0;
 const PLANAR: u32 = 0u;
 const PARABOLOID_FRONT: u32 = 1u;
 const PARABOLOID_BACK: u32 = 2u;
+
+// The scene's triangle of a subdivided triangle index (see `scene_triangles`).
+fn scene_triangle(pw: WarpParams, t: u32) -> u32 {
+    return t % max(pw.scene_triangles, 1u);
+}
 
 // Base map coordinates (x, y) and depth of a world point as a clip position; w <= 0 behind a
 // spot. Paraboloid: the homogeneous form (n.x, n.y, depth (1 + n.z), 1 + n.z), finite for every

@@ -218,7 +218,7 @@ impl Warped {
     }
 
     /// Bytes of scratch this map allocated (work buffers, counts, the occluder map and pyramid,
-    /// and the subdivision buffers unless borrowed).
+    /// and its own subdivision buffers, not its owner's).
     pub fn scratch_bytes(&self) -> u64 {
         let subdiv = if self.owns_subdiv { self.pieces.size() + 2 * self.queues[0].size() } else { 0 };
         let occ = self.occluders.as_ref().map_or(0, |o| o.bytes());

@@ -2,8 +2,9 @@
 //! `subdiv` > 0): a root pass queues every triangle, each level splits the queued pieces whose
 //! warped edges bend more than `subdiv` texels into the other queue and finishes the rest, and
 //! `draw_args` turns the finished count into the depth pass's indirect draw. With `cull_hidden`
-//! the occluder map is drawn first (occluders.rs) and hidden edges stay unsplit. This is one
-//! map's (subdiv_map.wgsl); subdiv_layers.rs runs the same passes over several maps at once.
+//! the occluder map is drawn first (occluders.rs) and hidden edges stay unsplit; with
+//! `tessellate` the queue's first levels only, then tess.wgsl's grids. This is one map's
+//! (subdiv_map.wgsl); subdiv_layers.rs runs the same passes over several maps at once.
 
 use super::depth::lookup_entries;
 use super::{base_constants, compose, layout_at, Knobs, LayerDraw, WarpParams, Warped, LOOKUP_WGSL, PARAMS_WGSL};
@@ -84,35 +85,7 @@ pub(super) fn pipelines(gpu: &Gpu, name: &str, scene: &GpuScene, p: &WarpParams)
     (layout, pipelines)
 }
 
-/// The subdivision buffers of a warped map (finished pieces and the two level queues), its
-/// largest scratch: 66 MB at the minimum capacity of 2^21 pieces. Maps whose passes run one after
-/// another (`dpsm`'s hemispheres: each subdivides and draws before the next starts) can share
-/// one set: `Warped::subdiv_scratch` lends it, `Warped::new_sharing` borrows it when it is large
-/// enough for the borrower's triangles (otherwise the borrower allocates its own).
-#[derive(Clone)]
-pub struct SubdivScratch {
-    pieces: wgpu::Buffer,
-    queues: [wgpu::Buffer; 2],
-}
-
 impl Warped {
-    /// This map's subdivision buffers, to lend to maps rendered after it.
-    pub fn subdiv_scratch(&mut self) -> SubdivScratch {
-        self.shares_subdiv = true;
-        SubdivScratch { pieces: self.pieces.clone(), queues: self.queues.clone() }
-    }
-
-    /// Uses `s`'s subdivision buffers instead of this map's own (dropped) if they are at least as
-    /// large; bind groups are made per frame, so nothing else refers to the old ones.
-    pub fn borrow_subdiv(&mut self, s: &SubdivScratch) {
-        if s.pieces.size() >= self.pieces.size() && s.queues.iter().zip(&self.queues).all(|(a, b)| a.size() >= b.size()) {
-            self.pieces = s.pieces.clone();
-            self.queues = s.queues.clone();
-            self.owns_subdiv = false;
-            self.shares_subdiv = true;
-        }
-    }
-
     /// The `subdivide` stage (after the `occluders` stage when `cull_hidden` draws them here).
     pub(super) fn subdivide(&self, gpu: &Gpu, f: &FrameInputs, rec: &mut Recorder) {
         self.draw_hidden_occluders(gpu, f, rec);
@@ -270,12 +243,15 @@ pub(super) fn level_uniforms(gpu: &Gpu, name: &str, levels: u32, queue: u32) -> 
 
 /// (on, extra pieces, queue entries) of the subdivision of `tris` triangles within the device's
 /// storage binding limit; an error when the queues cannot hold the triangles. `listed`: the
-/// subdivision of several maps' `texels` texels at once ([`super::LayerSubdivision`]), whose
-/// finished pieces are also listed by map (4 bytes more each).
+/// subdivision of several maps at once ([`super::LayerSubdivision`]), whose finished pieces are
+/// also listed by map (4 bytes more each), with that many texels of maps that draw triangles of
+/// their own (0 for copies of one scene, [`super::Layers::repeating_scene`]).
 pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, listed: Option<u64>) -> Result<(bool, u32, u32), GpuError> {
     let on = k.subdiv > 0.0;
-    // one map: 8 pieces a texel of a 512 map; several at once: 3 a texel of all (the most
-    // measured: 2.6, cube-notw on sponza-peer), as their own subdivisions made them
+    // 8 pieces a triangle, at least 2^21 (the most measured for dpsm-notw's two hemispheres
+    // together: 0.76 M on stress-sibenik); several maps of their own triangles at once: 3 a texel
+    // of all (the most measured: 2.6, cube-notw on sponza-peer), as their own subdivisions made
+    // them
     let auto = (8 * tris as u64).max(1 << 21).max(3 * listed.unwrap_or(0));
     let wanted = if k.subdiv_capacity > 0 { k.subdiv_capacity as u64 } else { auto };
     // an asked-for capacity is given or refused; the automatic one takes what the device holds

@@ -58,8 +58,9 @@ fn pack_corner(b: vec2<u32>) -> u32 {
 
 fn corner_pos(tri: u32, c: u32) -> vec3<f32> {
     let b = vec2<f32>(corner(c)) / 65535.0;
-    let v0 = vertices[3u * tri].pos;
-    return v0 + (vertices[3u * tri + 1u].pos - v0) * b.x + (vertices[3u * tri + 2u].pos - v0) * b.y;
+    let t = scene_triangle(wp, tri);
+    let v0 = vertices[3u * t].pos;
+    return v0 + (vertices[3u * t + 1u].pos - v0) * b.x + (vertices[3u * t + 2u].pos - v0) * b.y;
 }
 
 // What the edge tests need of a piece's corner, computed once per piece (each corner lies on two

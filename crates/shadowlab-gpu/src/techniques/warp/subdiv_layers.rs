@@ -1,12 +1,13 @@
-//! One subdivision for every layer of a [`Layers`] (`cube-notw`'s faces), instead of one a map:
-//! the layers' triangles are one scene (each layer a range of it), every piece is tested with
+//! One subdivision for every layer of a [`Layers`] (`cube-notw`'s faces, `dpsm`'s hemispheres),
+//! instead of one a map: the layers' triangles are one scene (each layer a range of it; with
+//! [`Layers::repeating_scene`] a copy of the frame's scene each), every piece is tested with
 //! its layer's uniform, DV bounds, warps and pyramid (subdiv_layers.wgsl over subdiv.wgsl), and
 //! the finished pieces are listed by layer (subdiv_scatter.wgsl; the lists follow the pieces in
 //! their buffer, a word an entry), so that each layer's depth pass draws its triangles' own
 //! slots and its list ([`LayerDraw`], two indirect draws). The dispatches of a frame are those
 //! of one map's subdivision and one more (the scatter), for any number of layers; the pieces of
-//! all layers live at once (the capacity: `subdiv::capacity`, 3 pieces a texel of all
-//! layers at least).
+//! all layers live at once (the capacity: `subdiv::capacity`, for layers of their own
+//! triangles 3 pieces a texel of all layers at least).
 
 use super::layers::{LAYER_BIND_WGSL, LAYER_WARPS_WGSL};
 use super::occluders::Pyramid;
@@ -113,7 +114,8 @@ pub struct LayerSubdivision {
 impl LayerSubdivision {
     /// The subdivision of `maps` (map i draws layer i of `layers`, made over `scene`, so that
     /// their piece capacity is this subdivision's), whose triangles below `ends[i]` (and from
-    /// `ends[i - 1]`) are map i's; it binds `passes`' uniforms and warps.
+    /// `ends[i - 1]`) are map i's (of `scene`'s, or with [`Layers::repeating_scene`] of as many
+    /// copies of it, one a layer); it binds `passes`' uniforms and warps.
     pub fn new(
         gpu: &Gpu,
         name: &'static str,
@@ -124,14 +126,15 @@ impl LayerSubdivision {
         ends: &[u32],
     ) -> Result<LayerSubdivision, GpuError> {
         assert!(layers.owner_subdivides && maps.len() == ends.len() && ends.len() as u32 == layers.count(), "{name}: one map a layer");
-        assert!(ends.windows(2).all(|w| w[0] <= w[1]) && ends.last() == Some(&scene.triangle_count), "{name}: the layers' ranges");
-        let triangles = scene.triangle_count;
+        let copies = if layers.repeats_scene { layers.count() } else { 1 };
+        let triangles = scene.triangle_count * copies;
+        assert!(ends.windows(2).all(|w| w[0] <= w[1]) && ends.last() == Some(&triangles), "{name}: the layers' ranges");
         let params: Vec<_> = maps.iter().map(|m| m.params).collect();
         // the maps were planned for it (build.rs: subdiv::capacity with their layers' texels)
         let extra = params[0].extra_capacity;
         assert!(params.iter().all(|p| (p.triangles, p.extra_capacity) == (triangles, extra)), "{name}: maps planned for this subdivision");
         let tess = (params[0].tessellate != 0).then_some(extra);
-        let queue = subdiv::queue_capacity(triangles, gpu.limits.max_storage_buffer_binding_size, Some(layers.texels()), tess);
+        let queue = subdiv::queue_capacity(triangles, gpu.limits.max_storage_buffer_binding_size, Some(layers.listed_texels()), tess);
         let levels = subdiv::level_count(&params[0]);
         let array = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: false },
