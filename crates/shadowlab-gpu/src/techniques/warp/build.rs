@@ -137,10 +137,12 @@ struct Plan {
     pcf: u32,
     /// The uniform, as every pass reads it.
     params: WarpParams,
-    /// Subdivision on; pieces it may add beyond the triangles; entries of each level queue.
+    /// Subdivision on; pieces it may add beyond the triangles; entries of each level queue and
+    /// the bytes of its buffer (subdiv::queue_bytes).
     subdiv: bool,
     extra: u32,
     queue: u32,
+    queue_bytes: u64,
     /// The occluder map and its pyramid (`cull_hidden`, `edge_importance`).
     occluders: bool,
 }
@@ -162,9 +164,10 @@ impl Plan {
         let base = BaseProjection::of(proj, k.res);
         assert_eq!(k.paraboloid, base.kind != 0, "{name}: knobs made for another projection");
         let (subdiv, extra, queue) = subdiv::capacity(k, name, tris * copies, max_binding, listed)?;
-        let params = WarpParams { scene_triangles: tris, ..uniform(k, &base, tris * copies, extra) };
+        let params = uniform(k, &base, (tris, copies), extra);
+        let queue_bytes = subdiv::queue_bytes(&params, queue, max_binding);
         let occluders = k.cull_hidden || k.edge_importance > 0;
-        Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, occluders })
+        Ok(Plan { variant: k.variant, name, res: k.res, pcf: k.pcf, params, subdiv, extra, queue, queue_bytes, occluders })
     }
 
     fn warp_sizes(&self) -> [(u32, u32); 2] {
@@ -193,8 +196,9 @@ impl BaseProjection {
     }
 }
 
-/// The uniform of the knobs over `base`, with the subdivision's triangles and extra pieces.
-fn uniform(k: &Knobs, base: &BaseProjection, tris: u32, extra: u32) -> WarpParams {
+/// The uniform of the knobs over `base`, with the subdivision's triangles (`copies` of a scene of
+/// `tris`) and extra pieces.
+fn uniform(k: &Knobs, base: &BaseProjection, (tris, copies): (u32, u32), extra: u32) -> WarpParams {
     WarpParams {
         light_view_proj: base.view_proj.to_cols_array_2d(),
         texel_world: base.texel,
@@ -217,7 +221,7 @@ fn uniform(k: &Knobs, base: &BaseProjection, tris: u32, extra: u32) -> WarpParam
         w_eye: k.w_eye,
         blur: k.blur as f32,
         subdiv: k.subdiv,
-        triangles: tris,
+        triangles: tris * copies,
         subdiv_levels: k.subdiv_levels,
         extra_capacity: extra,
         rtw_importance: (k.variant == Variant::Rtw) as u32,
@@ -330,9 +334,9 @@ impl Resources {
             fwork,
             fwork_offset,
             pieces: gpu.storage(&format!("{name}.pieces"), (tris + plan.extra as u64) * 16 * own_subdiv as u64),
-            queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16 * own_subdiv as u64)),
+            queues: [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), plan.queue_bytes * own_subdiv as u64)),
             counters: subdiv::counters_buffer(gpu, &format!("{name}.counters"), 0),
-            level_uniforms: subdiv::level_uniforms(gpu, name, levels, queue),
+            level_uniforms: if own_subdiv { subdiv::level_uniforms(gpu, name, levels, queue) } else { Vec::new() },
             uniform: gpu.uniform(&format!("{name}.params"), &plan.params),
             dv,
             counts,

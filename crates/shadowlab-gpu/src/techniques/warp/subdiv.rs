@@ -267,7 +267,7 @@ pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, liste
     // at least one per triangle: the root finishes up to one extra piece per triangle (the
     // second half of a triangle cut by the near plane) before any level can check
     let extra = if on { wanted.max(tris as u64).min(most) as u32 } else { 0 };
-    let queue = if on { queue_capacity(tris, max_binding, listed, (k.tessellate > 0).then_some(extra)) } else { 0 };
+    let queue = if on { queue_capacity(tris, max_binding, listed) } else { 0 };
     // the triangle index keeps 3 bits free for the split mask
     if on && (2 * tris as u64 > queue as u64 || tris >= 1 << 29) {
         return Err(GpuError::Invalid(format!(
@@ -278,13 +278,18 @@ pub(super) fn capacity(k: &Knobs, name: &str, tris: u32, max_binding: u64, liste
     Ok((on, extra, queue))
 }
 
-/// Entries of each level queue of the subdivision of `tris` triangles ([`capacity`]): the root
-/// queues up to two pieces per triangle (a triangle cut by the near plane); several maps at once
-/// (`listed` texels) at least one a texel of all, as their own queues of 2^20 held them. The
-/// tessellation (`tess_extra`: its piece capacity) keeps its chunks' words after the queued
-/// pieces: one a root piece and one per 64 pieces, four an entry.
-pub(super) fn queue_capacity(tris: u32, max_binding: u64, listed: Option<u64>, tess_extra: Option<u32>) -> u32 {
-    let roots = 2 * tris as u64;
-    let tess = tess_extra.map_or(0, |e| roots + (roots + e as u64 / 64).div_ceil(4) + 1);
-    roots.max(1 << 20).max(listed.unwrap_or(0)).max(tess).min(max_binding / 16) as u32
+/// Entries of each level queue of the subdivision of `tris` triangles ([`capacity`]; the levels'
+/// uniform holds it): the root queues up to two pieces per triangle (a triangle cut by the near
+/// plane); several maps at once (`listed` texels) at least one a texel of all, as their own
+/// queues of 2^20 held them.
+pub(super) fn queue_capacity(tris: u32, max_binding: u64, listed: Option<u64>) -> u32 {
+    (2 * tris as u64).max(1 << 20).max(listed.unwrap_or(0)).min(max_binding / 16) as u32
+}
+
+/// Bytes of each queue buffer of `queue` entries for maps of `p`: with `tessellate` the chunks'
+/// words follow the queued pieces (tess.wgsl: one a queued piece and one per 64 pieces, four an
+/// entry), past the entries the levels may fill, so that a full queue leaves them room.
+pub(super) fn queue_bytes(p: &WarpParams, queue: u32, max_binding: u64) -> u64 {
+    let chunks = if p.tessellate != 0 { (queue as u64 + p.extra_capacity as u64 / 64).div_ceil(4) + 1 } else { 0 };
+    ((queue as u64 + chunks) * 16).min(max_binding)
 }

@@ -133,8 +133,8 @@ impl LayerSubdivision {
         // the maps were planned for it (build.rs: subdiv::capacity with their layers' texels)
         let extra = params[0].extra_capacity;
         assert!(params.iter().all(|p| (p.triangles, p.extra_capacity) == (triangles, extra)), "{name}: maps planned for this subdivision");
-        let tess = (params[0].tessellate != 0).then_some(extra);
-        let queue = subdiv::queue_capacity(triangles, gpu.limits.max_storage_buffer_binding_size, Some(layers.listed_texels()), tess);
+        let max_binding = gpu.limits.max_storage_buffer_binding_size;
+        let queue = subdiv::queue_capacity(triangles, max_binding, Some(layers.listed_texels()));
         let levels = subdiv::level_count(&params[0]);
         let array = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: false },
@@ -176,7 +176,8 @@ impl LayerSubdivision {
         );
         let pieces =
             gpu.storage(&format!("{name}.pieces"), (triangles as u64 + extra as u64) * 16 + (extra as u64 * 4).next_multiple_of(16));
-        let queues = [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue as u64 * 16));
+        let queue_bytes = subdiv::queue_bytes(&WarpParams { extra_capacity: extra, ..params[0] }, queue, max_binding);
+        let queues = [0, 1].map(|i| gpu.storage(&format!("{name}.queue{i}"), queue_bytes));
         let counters = subdiv::counters_buffer(gpu, &format!("{name}.counters"), layer_words(layers.count()));
         let level_uniforms = subdiv::level_uniforms(gpu, name, levels, queue);
         // the pyramids (`cull_hidden`), or a stand-in never read

@@ -14,7 +14,8 @@
 // They run with the group of the level after the queue's last (lv.v.x - 1 queue levels ran):
 // q_in holds the queued pieces (counters[8 + 4 lv.v.z] of them, their split masks above the
 // triangle index) and after them the chunks' piece indices (4 a vec4); q_out[i] is piece i's
-// (levels, first slot, first chunk, pieces). counters as subdiv.wgsl's, with [16] the chunks,
+// (levels, first slot, first chunk, pieces). The buffers hold the chunks' words past the
+// entries the levels may fill (lv.v.w). counters as subdiv.wgsl's, with [16] the chunks,
 // [13..15] the emission's groups, [22] the degenerate pieces; the buckets' words hold the
 // pieces by bucket, the queued pieces by bucket and a word per bucket whose sum overflowed.
 
@@ -322,8 +323,9 @@ fn tess_alloc(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     q_out[i] = vec4<u32>(levels, first, c0, n);
     for (var c = c0; c < c0 + chunks; c++) {
         let s = chunk_slot(c);
-        if s.x >= lv.v.w {
-            // not reached: the queue's capacity counts the chunks (subdiv.rs)
+        if s.x >= arrayLength(&q_in) {
+            // not reached: the queue's buffer holds the chunks past its entries (subdiv.rs
+            // queue_bytes)
             atomicAdd(&counters[1], 1u);
             return;
         }
